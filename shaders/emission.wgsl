@@ -1,0 +1,63 @@
+// emission(light, ω): RGB radiance leaving the light along ω (DESIGN.md §3).
+// Twin of src/cpu/emission.rs, which carries the spec citations.
+
+// #import shared/light.wgsl
+// #import shared/shaping.wgsl
+
+// Emission along unit direction e (pointing away from the light; for a dome, toward the
+// environment).
+fn emission_of(light: Light, e: vec3<f32>) -> vec3<f32> {
+    let base = light.base.xyz;
+    switch light.kind {
+        case KIND_DOME: {
+            return base;
+        }
+        case KIND_DISTANT: {
+            // A delta light (θmax = 0) has no emission; a finite cone's boundary is inclusive.
+            let theta_max = light.axis.w;
+            if theta_max > 0.0 && off_axis_angle(light.axis.xyz, e) <= theta_max {
+                return base;
+            }
+            return vec3<f32>(0.0);
+        }
+        case KIND_RECT, KIND_DISK: {
+            if dot(e, light.normal.xyz) > 0.0 {
+                return base * shaping(light, e);
+            }
+            return vec3<f32>(0.0);
+        }
+        case KIND_CYLINDER: {
+            // Some point of the side faces e unless e is parallel to the axis.
+            let el = to_local_dir(light, e);
+            if el.y != 0.0 || el.z != 0.0 {
+                return base * shaping(light, e);
+            }
+            return vec3<f32>(0.0);
+        }
+        default: {
+            // KIND_SPHERE: the outward surface faces every direction.
+            return base * shaping(light, e);
+        }
+    }
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn emission_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = sample_index(gid);
+    if i >= params.count {
+        return;
+    }
+    let e = normalize(load3(false, i));
+    var sum = vec3<f32>(0.0);
+    for (var l = 0u; l < params.light_count; l++) {
+        let v = emission_of(lights[l], e);
+        if params.per_light != 0u {
+            store3(l * params.count + i, v);
+        } else {
+            sum += v;
+        }
+    }
+    if params.per_light == 0u {
+        store3(i, sum);
+    }
+}

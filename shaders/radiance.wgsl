@@ -1,0 +1,63 @@
+// radiance(x, ω): RGB radiance arriving at x from direction ω (DESIGN.md §3).
+// Twin of src/cpu/radiance.rs, which carries the spec citations.
+
+// #import shared/light.wgsl
+// #import shared/shapes.wgsl
+// #import emission.wgsl
+
+fn radiance_of(light: Light, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
+    switch light.kind {
+        case KIND_DOME, KIND_DISTANT: {
+            // The environment, or the distant light's cone, in direction w.
+            return emission_of(light, -w);
+        }
+        default: {}
+    }
+    if has_flag(light, FLAG_TREAT_AS_POINT_OR_LINE) {
+        return vec3<f32>(0.0);
+    }
+    let xl = to_local_point(light, x);
+    let dl = to_local_dir(light, w);
+    var hit = false;
+    switch light.kind {
+        case KIND_RECT: {
+            hit = rect_hit(xl, dl, light.size.x, light.size.y);
+        }
+        case KIND_DISK: {
+            hit = disk_hit(xl, dl, light.size.x);
+        }
+        case KIND_SPHERE: {
+            hit = sphere_hit(xl, dl, light.size.x);
+        }
+        case KIND_CYLINDER: {
+            hit = cylinder_hit(xl, dl, light.size.x, light.size.y);
+        }
+        default: {}
+    }
+    if !hit {
+        return vec3<f32>(0.0);
+    }
+    return emission_of(light, -w);
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn radiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = sample_index(gid);
+    if i >= params.count {
+        return;
+    }
+    let x = load3(false, i);
+    let w = normalize(load3(true, i));
+    var sum = vec3<f32>(0.0);
+    for (var l = 0u; l < params.light_count; l++) {
+        let v = radiance_of(lights[l], x, w);
+        if params.per_light != 0u {
+            store3(l * params.count + i, v);
+        } else {
+            sum += v;
+        }
+    }
+    if params.per_light == 0u {
+        store3(i, sum);
+    }
+}

@@ -1,0 +1,85 @@
+// The GPU light record and the query bindings shared by every kernel.
+//
+// The record's Rust twin is `LightRecord` in src/gpu/pack.rs; tests/wgsl.rs asserts both layouts
+// against naga's layouter. The constants KIND_* and FLAG_* come from a prelude that
+// src/gpu/shaders.rs generates from the Rust constants, so they are never retyped here.
+//
+// All per-light constants (base radiance including colour temperature and normalize, the
+// world->local map, axes, cone angles) are computed on the CPU in f64 and rounded once.
+
+struct Light {
+    // Rows of the world->local affine map: local = (dot(row.xyz, p) + row.w) for points,
+    // dot(row.xyz, v) for directions.
+    to_local0: vec4<f32>,
+    to_local1: vec4<f32>,
+    to_local2: vec4<f32>,
+    // xyz: unit primary axis in world space (the image of local -Z); w: distant θmax (radians).
+    axis: vec4<f32>,
+    // xyz: unit world normal of the emitting side of a rect or disk (inverse transpose of -Z).
+    normal: vec4<f32>,
+    // rgb: intensity · 2^exposure · color ⊙ temperature / sizeFactor.
+    base: vec4<f32>,
+    // rgb: shaping:focusTint; w: shaping:focus.
+    focus_tint: vec4<f32>,
+    // x: cone angle θcone (radians); y: smoothstep start (1 - softness)·θcone.
+    cone: vec4<f32>,
+    // rect: (width/2, height/2); disk, sphere: (radius); cylinder: (length/2, radius).
+    size: vec4<f32>,
+    kind: u32,
+    flags: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+struct Params {
+    // Samples in this dispatch.
+    count: u32,
+    light_count: u32,
+    // 1: write (light, sample) rows; 0: write the sum over lights.
+    per_light: u32,
+    // Invocations per row of the 2D dispatch grid (workgroups_x · WORKGROUP_SIZE).
+    row_stride: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> lights: array<Light>;
+// Float triples: directions (emission) or points (radiance).
+@group(0) @binding(2) var<storage, read> in_a: array<f32>;
+// Float triples: directions (radiance); unused by emission.
+@group(0) @binding(3) var<storage, read> in_b: array<f32>;
+@group(0) @binding(4) var<storage, read_write> out_rgb: array<f32>;
+
+fn sample_index(gid: vec3<u32>) -> u32 {
+    return gid.x + gid.y * params.row_stride;
+}
+
+fn load3(buf_is_b: bool, i: u32) -> vec3<f32> {
+    if buf_is_b {
+        return vec3<f32>(in_b[3u * i], in_b[3u * i + 1u], in_b[3u * i + 2u]);
+    }
+    return vec3<f32>(in_a[3u * i], in_a[3u * i + 1u], in_a[3u * i + 2u]);
+}
+
+// Writes one result: to the (light, sample) row when per_light, else (the caller passes the sum)
+// to the sample's row.
+fn store3(row: u32, v: vec3<f32>) {
+    out_rgb[3u * row] = v.x;
+    out_rgb[3u * row + 1u] = v.y;
+    out_rgb[3u * row + 2u] = v.z;
+}
+
+fn has_flag(light: Light, flag: u32) -> bool {
+    return (light.flags & flag) != 0u;
+}
+
+fn to_local_point(light: Light, p: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(
+        dot(light.to_local0.xyz, p) + light.to_local0.w,
+        dot(light.to_local1.xyz, p) + light.to_local1.w,
+        dot(light.to_local2.xyz, p) + light.to_local2.w,
+    );
+}
+
+fn to_local_dir(light: Light, v: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(light.to_local0.xyz, v), dot(light.to_local1.xyz, v), dot(light.to_local2.xyz, v));
+}

@@ -1,0 +1,103 @@
+//! ShapingAPI on the CPU (f64). Twin of `shaders/shared/shaping.wgsl`.
+//!
+//! spec/002, as pinned by DESIGN.md §2 "Shaping":
+//! - θoff = angle between the emission direction and the light's primary axis (world image of
+//!   local −Z), computed as atan2(|e × a|, e · a) for precision near 0;
+//! - cone: `L ·= 1 − smoothstep(θoff; (1 − softness)·θcone, θcone)` on the angle, softness
+//!   clamped to [0, 1]; θoff > θcone is always 0 ("guaranteed to be zero"); at softness 0 the
+//!   cut-off is hard and the boundary itself is lit;
+//! - focus: `f = |cos θoff|^focus`, `L ⊙= lerp(focusTint, 1, f)` = tint + f·(1 − tint);
+//!   focus ≤ 0 is ignored.
+
+use glam::DVec3;
+
+use crate::light::Shaping;
+
+/// The RGB factor ShapingAPI applies to emission along unit direction `e`, for a light whose
+/// unit primary axis is `axis`.
+pub fn shaping(s: &Shaping, axis: DVec3, e: DVec3) -> DVec3 {
+    let cos = e.dot(axis);
+    let theta = off_axis_angle(axis, e);
+    focus_factor(s.focus, s.focus_tint, cos) * cone_factor(theta, s.cone_angle.to_radians(), s.cone_softness)
+}
+
+/// θoff in radians, in [0, π].
+pub fn off_axis_angle(axis: DVec3, e: DVec3) -> f64 {
+    e.cross(axis).length().atan2(e.dot(axis))
+}
+
+/// `1 − smoothstep(θ; (1 − softness)·θcone, θcone)`, with the spec's guarantee θ > θcone → 0.
+pub fn cone_factor(theta: f64, cone: f64, softness: f64) -> f64 {
+    if theta > cone {
+        return 0.0;
+    }
+    let start = (1.0 - softness.clamp(0.0, 1.0)) * cone;
+    1.0 - smoothstep_angle(theta, start, cone)
+}
+
+/// UsdLux's `_Smoothstep(t, [lo, hi])` (value first): a zero-width range is a step that is 0 at
+/// and below `lo`.
+pub fn smoothstep_angle(t: f64, lo: f64, hi: f64) -> f64 {
+    if hi - lo == 0.0 {
+        return if t <= lo { 0.0 } else { 1.0 };
+    }
+    let s = ((t - lo) / (hi - lo)).clamp(0.0, 1.0);
+    s * s * (3.0 - 2.0 * s)
+}
+
+/// `lerp(|cos|^focus, focusTint, 1)` per channel; white when focus ≤ 0.
+pub fn focus_factor(focus: f64, tint: DVec3, cos: f64) -> DVec3 {
+    if focus <= 0.0 {
+        return DVec3::ONE;
+    }
+    let f = cos.abs().powf(focus);
+    tint + f * (DVec3::ONE - tint)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// reference/openusd-reference.md §3.2: angle 45°, softness 0.25 → factor 1 up to 33.75°,
+    /// 0.5 at 39.375°, 0 at 45°.
+    #[test]
+    fn cone_softness_example() {
+        let c = 45f64.to_radians();
+        assert_eq!(cone_factor(33.0f64.to_radians(), c, 0.25), 1.0);
+        assert_eq!(cone_factor(33.75f64.to_radians(), c, 0.25), 1.0);
+        assert!((cone_factor(39.375f64.to_radians(), c, 0.25) - 0.5).abs() < 1e-12);
+        assert_eq!(cone_factor(45.0f64.to_radians(), c, 0.25), 0.0);
+        assert_eq!(cone_factor(45.1f64.to_radians(), c, 0.25), 0.0);
+    }
+
+    #[test]
+    fn hard_cone_boundary_is_lit_and_softness_is_clamped() {
+        let c = 30f64.to_radians();
+        assert_eq!(cone_factor(c, c, 0.0), 1.0);
+        assert_eq!(cone_factor(c + 1e-12, c, 0.0), 0.0);
+        assert_eq!(cone_factor(c * 0.5, c, -3.0), 1.0); // softness −3 → 0: hard
+        assert_eq!(cone_factor(0.2 * c, c, 7.0), cone_factor(0.2 * c, c, 1.0));
+        // A negative cone angle lights nothing (θ ≥ 0 > θcone).
+        assert_eq!(cone_factor(0.0, -0.1, 0.5), 0.0);
+    }
+
+    #[test]
+    fn focus_tint_channels() {
+        // reference/luxtest.md §6 A5: tint red leaves R at 1; G, B follow |cos|^focus.
+        let f = focus_factor(2.0, DVec3::X, 0.5);
+        assert_eq!(f, DVec3::new(1.0, 0.25, 0.25));
+        // tint (0, .5, 0), focus 3: G = .5 + .5·cos³.
+        let f = focus_factor(3.0, DVec3::new(0.0, 0.5, 0.0), -0.5);
+        assert_eq!(f, DVec3::new(0.125, 0.5 + 0.5 * 0.125, 0.125));
+        assert_eq!(focus_factor(0.0, DVec3::ZERO, 0.1), DVec3::ONE);
+        assert_eq!(focus_factor(-1.0, DVec3::ZERO, 0.1), DVec3::ONE);
+    }
+
+    #[test]
+    fn off_axis_angle_is_accurate_near_zero() {
+        let axis = DVec3::NEG_Z;
+        let tiny = 1e-9f64;
+        let e = DVec3::new(tiny.sin(), 0.0, -tiny.cos());
+        assert!((off_axis_angle(axis, e) - tiny).abs() < 1e-20);
+    }
+}

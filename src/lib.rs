@@ -1,0 +1,42 @@
+//! luxeval evaluates USD lights (UsdLux) in wgpu compute shaders and cross-checks every GPU
+//! result against an f64 CPU reference.
+//!
+//! ```
+//! use luxeval::{Accumulate, Evaluator, Light, Shaping};
+//! use glam::{DMat4, DVec3};
+//!
+//! // A 2 × 1 rect light 3 m up, facing down, shaped into a 40° spot.
+//! let light = Light::rect(2.0, 1.0)
+//!     .with_path("/lights/key")
+//!     .with_intensity(10.0)
+//!     .with_shaping(Shaping { cone_angle: 40.0, cone_softness: 0.2, ..Shaping::default() })
+//!     .with_transform(DMat4::from_rotation_translation(
+//!         glam::DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), // local −Z → world −Y
+//!         DVec3::new(0.0, 3.0, 0.0),
+//!     ));
+//!
+//! // Radiance arriving at the floor point (0, 0, 0) looking straight up, on the CPU reference.
+//! let cpu = Evaluator::cpu();
+//! let rgb = cpu.radiance(&[light.clone()], &[[0.0, 0.0, 0.0]], &[[0.0, 1.0, 0.0]], Accumulate::Sum)?;
+//! assert_eq!(rgb[0], [10.0, 10.0, 10.0]);
+//!
+//! // The same query on the GPU, when one is available.
+//! if let Ok(gpu) = Evaluator::gpu() {
+//!     let g = gpu.radiance(&[light], &[[0.0, 0.0, 0.0]], &[[0.0, 1.0, 0.0]], Accumulate::Sum)?;
+//!     assert!((g[0][0] - 10.0).abs() < 1e-4);
+//! }
+//! # Ok::<(), luxeval::LuxError>(())
+//! ```
+
+pub mod check;
+pub mod cpu;
+pub mod error;
+pub mod gpu;
+pub mod light;
+pub mod query;
+pub mod schema;
+
+pub use cpu::TemperatureMode;
+pub use error::{LuxError, Result};
+pub use light::{Light, LightInputs, LightType, Shaping};
+pub use query::{Accumulate, Backend, Evaluator};

@@ -1,0 +1,106 @@
+//! Offline WGSL checks with naga (no GPU): every composed kernel parses and validates, and the
+//! GPU record layouts equal their Rust twins.
+
+use std::mem::{offset_of, size_of};
+
+use luxeval::gpu::shaders::{compose, Kernel};
+use luxeval::gpu::{LightRecord, Params};
+
+fn module(kernel: Kernel) -> naga::Module {
+    let src = compose(kernel);
+    naga::front::wgsl::parse_str(&src)
+        .unwrap_or_else(|e| panic!("{}:\n{}", kernel.file(), e.emit_to_string(&src)))
+}
+
+#[test]
+fn every_kernel_parses_and_validates() {
+    for kernel in Kernel::ALL {
+        let m = module(kernel);
+        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+            .validate(&m)
+            .unwrap_or_else(|e| panic!("{}: {}", kernel.file(), e.emit_to_string(&compose(kernel))));
+        let _ = info;
+        assert!(
+            m.entry_points.iter().any(|e| e.name == kernel.entry_point()),
+            "{} has no entry point {}",
+            kernel.file(),
+            kernel.entry_point()
+        );
+    }
+}
+
+/// Offsets and sizes of a WGSL struct's members as naga lays them out for storage buffers.
+fn wgsl_layout(m: &naga::Module, name: &str) -> (u32, u32, Vec<(String, u32)>) {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(m.to_ctx()).expect("layout");
+    let (handle, ty) = m
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        panic!("{name} is not a struct")
+    };
+    let l = &layouter[handle];
+    let align = l.alignment.round_up(1);
+    (
+        l.size,
+        align,
+        members
+            .iter()
+            .map(|mb| (mb.name.clone().unwrap_or_default(), mb.offset))
+            .collect(),
+    )
+}
+
+#[test]
+fn light_record_layout_matches_naga() {
+    let m = module(Kernel::Radiance);
+    let (size, align, members) = wgsl_layout(&m, "Light");
+    assert_eq!(size as usize, size_of::<LightRecord>(), "struct size");
+    assert_eq!(size_of::<LightRecord>() % align as usize, 0, "array stride");
+    let rust = [
+        ("to_local0", offset_of!(LightRecord, to_local)),
+        ("to_local1", offset_of!(LightRecord, to_local) + 16),
+        ("to_local2", offset_of!(LightRecord, to_local) + 32),
+        ("axis", offset_of!(LightRecord, axis)),
+        ("normal", offset_of!(LightRecord, normal)),
+        ("base", offset_of!(LightRecord, base)),
+        ("focus_tint", offset_of!(LightRecord, focus_tint)),
+        ("cone", offset_of!(LightRecord, cone)),
+        ("size", offset_of!(LightRecord, size)),
+        ("kind", offset_of!(LightRecord, kind)),
+        ("flags", offset_of!(LightRecord, flags)),
+        ("pad0", offset_of!(LightRecord, pad)),
+        ("pad1", offset_of!(LightRecord, pad) + 4),
+    ];
+    assert_eq!(members.len(), rust.len(), "member count: {members:?}");
+    for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
+        assert_eq!(wname, rname);
+        assert_eq!(*woff as usize, roff, "offset of {wname}");
+    }
+}
+
+#[test]
+fn params_layout_matches_naga() {
+    let m = module(Kernel::Emission);
+    let (size, _, members) = wgsl_layout(&m, "Params");
+    assert_eq!(size as usize, size_of::<Params>());
+    let rust = [
+        ("count", offset_of!(Params, count)),
+        ("light_count", offset_of!(Params, light_count)),
+        ("per_light", offset_of!(Params, per_light)),
+        ("row_stride", offset_of!(Params, row_stride)),
+    ];
+    for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
+        assert_eq!((wname.as_str(), *woff as usize), (rname, roff));
+    }
+}
+
+/// A WGSL error must surface as a readable diagnostic, not be swallowed: a broken module is
+/// rejected by the same check the kernels pass.
+#[test]
+fn validation_rejects_a_type_error() {
+    let src = format!("{}\nfn broken() -> f32 {{ let x: f32 = 1u; return x; }}", compose(Kernel::Emission));
+    assert!(naga::front::wgsl::parse_str(&src).is_err());
+}
