@@ -1,0 +1,454 @@
+//! CPU-vs-GPU conformance: randomised samples per light, the GPU result compared with the f64
+//! reference, and the largest errors reported. Used by `luxeval check` and by the conformance
+//! test suite (DESIGN.md §5).
+//!
+//! Error measure: for each sample, `‖gpu − cpu‖∞ / ‖cpu‖∞` over the RGB channels (0 when both
+//! are 0; a sample where exactly one side is 0 has error 1). Tolerance 1e-4.
+//!
+//! Excluded band: samples near a discontinuity, where an f32 rounding legitimately flips or
+//! amplifies the answer, are counted and reported but not compared:
+//! - within [`BAND`] rad of a distant light's cone edge, of the one-sided horizon of a rect or
+//!   disk, or of a cylinder's axis direction;
+//! - within [`CONE_BAND`]·θcone of a ShapingAPI cone edge, hard or soft (see its docs);
+//! - for radiance, a shape's silhouette: the hit point or the closest approach within `BAND` of
+//!   the boundary (as a fraction of the shape's size), grazing rays, and ray origins within
+//!   `BAND` of the surface.
+//! Everything else must be within tolerance.
+
+use glam::DVec3;
+
+use crate::cpu::normalize::distant_half_angle;
+use crate::cpu::shaping::off_axis_angle;
+use crate::cpu::{PreparedLight, emission, radiance};
+use crate::error::Result;
+use crate::gpu::{GpuContext, Kernel, pack};
+use crate::light::{Light, LightType};
+
+/// Relative tolerance of GPU (f32) against CPU (f64).
+pub const TOLERANCE: f64 = 1e-4;
+/// Half-width of the excluded band around discontinuities (radians, or a fraction of the
+/// shape's size).
+pub const BAND: f64 = 1e-4;
+
+/// Relative half-width of the band around a cone edge, as a fraction of the cone angle.
+///
+/// f32 angles carry ~1.5e-7·θ of rounding (the direction and the axis are f32), and the cone
+/// factor 1 − smoothstep vanishes quadratically at θcone, so its relative error is
+/// 2δθ/(θcone − θoff): it exceeds 1e-4 within ~4e-3·θcone of the edge, soft or hard.
+pub const CONE_BAND: f64 = 4e-3;
+
+/// The queries `check` compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Query {
+    Emission,
+    Radiance,
+}
+
+/// One light's result for one query.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct QueryReport {
+    pub light: String,
+    pub light_type: &'static str,
+    pub query: Query,
+    pub samples: usize,
+    /// Samples in the excluded band (not compared).
+    pub excluded: usize,
+    /// Compared samples where the CPU value is non-zero.
+    pub nonzero: usize,
+    pub max_rel_error: f64,
+    /// The worst compared sample.
+    pub worst: Option<Worst>,
+    pub pass: bool,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Worst {
+    pub index: usize,
+    /// Direction (emission) or point (radiance).
+    pub a: [f32; 3],
+    /// Direction (radiance).
+    pub b: Option<[f32; 3]>,
+    pub cpu: [f64; 3],
+    pub gpu: [f32; 3],
+}
+
+/// The whole comparison.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CheckReport {
+    pub device: String,
+    pub tolerance: f64,
+    pub band: f64,
+    pub samples: usize,
+    pub excluded: usize,
+    pub rows: Vec<QueryReport>,
+}
+
+impl CheckReport {
+    pub fn pass(&self) -> bool {
+        self.rows.iter().all(|r| r.pass)
+    }
+
+    pub fn max_rel_error(&self) -> f64 {
+        self.rows
+            .iter()
+            .map(|r| r.max_rel_error)
+            .fold(0.0, f64::max)
+    }
+}
+
+/// A small deterministic generator (SplitMix64) so that a check is reproducible from its seed.
+#[derive(Clone, Debug)]
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.f64()
+    }
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.f64() * n as f64) as usize % n.max(1)
+    }
+    pub fn chance(&mut self, p: f64) -> bool {
+        self.f64() < p
+    }
+    /// Uniform on the unit sphere.
+    pub fn unit(&mut self) -> DVec3 {
+        let z = self.range(-1.0, 1.0);
+        let phi = self.range(0.0, std::f64::consts::TAU);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+    /// Uniform within `max_angle` of `axis` (unit).
+    pub fn cone(&mut self, axis: DVec3, max_angle: f64) -> DVec3 {
+        let cos_max = max_angle.min(std::f64::consts::PI).cos();
+        let z = self.range(cos_max, 1.0);
+        let phi = self.range(0.0, std::f64::consts::TAU);
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let (t, b) = axis.any_orthonormal_pair();
+        (r * phi.cos() * t + r * phi.sin() * b + z * axis).normalize()
+    }
+}
+
+fn f32x3(v: DVec3) -> [f32; 3] {
+    v.as_vec3().to_array()
+}
+
+/// The local-space half extent of a light's shape, for scaling samples.
+fn local_extent(l: &Light) -> DVec3 {
+    match l.kind {
+        LightType::Rect { width, height } => DVec3::new(width / 2.0, height / 2.0, 0.0),
+        LightType::Disk { radius } => DVec3::new(radius, radius, 0.0),
+        LightType::Sphere { radius, .. } => DVec3::splat(radius),
+        LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
+        LightType::Distant { .. } | LightType::Dome => DVec3::ONE,
+    }
+}
+
+/// Emission directions for one light: half uniform, half concentrated where the light is
+/// interesting (around its axis, its cone edge, its horizon).
+pub fn emission_samples(p: &PreparedLight, n: usize, rng: &mut Rng) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|i| {
+            let e = if i % 2 == 0 {
+                rng.unit()
+            } else {
+                match (&p.light.kind, &p.light.shaping) {
+                    (LightType::Distant { angle }, _) => {
+                        rng.cone(p.axis, (2.0 * distant_half_angle(*angle)).max(1e-3))
+                    }
+                    (_, Some(s)) => rng.cone(
+                        p.axis,
+                        (1.3 * s.cone_angle.to_radians()).clamp(0.05, std::f64::consts::PI),
+                    ),
+                    _ => rng.cone(p.axis, std::f64::consts::FRAC_PI_2 * 1.1),
+                }
+            };
+            f32x3(e)
+        })
+        .collect()
+}
+
+/// Radiance rays for one light: origins around the light (up to a few sizes away), aimed at
+/// random points of a box slightly larger than the shape, so that hits, misses and silhouettes
+/// all occur; for distant lights, rays around the direction toward the light.
+pub fn radiance_samples(
+    p: &PreparedLight,
+    n: usize,
+    rng: &mut Rng,
+) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let l = &p.light;
+    let ext = local_extent(l);
+    let size = ext.max_element().max(1e-3);
+    let mut points = Vec::with_capacity(n);
+    let mut dirs = Vec::with_capacity(n);
+    for _ in 0..n {
+        let (x, w) = match l.kind {
+            LightType::Distant { angle } => {
+                let x = DVec3::new(
+                    rng.range(-10.0, 10.0),
+                    rng.range(-10.0, 10.0),
+                    rng.range(-10.0, 10.0),
+                );
+                (
+                    x,
+                    rng.cone(-p.axis, (2.0 * distant_half_angle(angle)).max(1e-3)),
+                )
+            }
+            LightType::Dome => (
+                DVec3::new(
+                    rng.range(-5.0, 5.0),
+                    rng.range(-5.0, 5.0),
+                    rng.range(-5.0, 5.0),
+                ),
+                rng.unit(),
+            ),
+            _ => {
+                // Origin in local space: a random direction at 1.05..6 sizes from the centre,
+                // biased to the emitting side for one-sided shapes.
+                let mut o = rng.unit() * size * rng.range(1.05, 6.0);
+                if matches!(l.kind, LightType::Rect { .. } | LightType::Disk { .. })
+                    && rng.chance(0.8)
+                {
+                    o.z = -o.z.abs();
+                }
+                let target = DVec3::new(
+                    rng.range(-1.2, 1.2) * ext.x.max(0.05 * size),
+                    rng.range(-1.2, 1.2) * ext.y.max(0.05 * size),
+                    rng.range(-1.2, 1.2) * ext.z.max(0.05 * size),
+                );
+                let x = l.world.transform_point3(o);
+                let t = l.world.transform_point3(target);
+                let w = t - x;
+                let w = if w.length() > 0.0 {
+                    w.normalize()
+                } else {
+                    rng.unit()
+                };
+                (x, w)
+            }
+        };
+        points.push(f32x3(x));
+        dirs.push(f32x3(w));
+    }
+    (points, dirs)
+}
+
+/// Distance of an emission direction from the light's discontinuities, in radians.
+pub fn emission_margin(p: &PreparedLight, e: DVec3) -> f64 {
+    let e = e.normalize();
+    let mut m = f64::INFINITY;
+    match p.light.kind {
+        LightType::Distant { angle } => {
+            let tm = distant_half_angle(angle);
+            m = m.min((off_axis_angle(p.axis, e) - tm).abs());
+        }
+        LightType::Rect { .. } | LightType::Disk { .. } => {
+            // Angle from the horizon of the emitting side.
+            m = m.min(e.dot(p.normal).clamp(-1.0, 1.0).asin().abs());
+        }
+        LightType::Cylinder { .. } => {
+            let el = (p.to_local * e).normalize();
+            m = m.min((el.y * el.y + el.z * el.z).sqrt().asin());
+        }
+        LightType::Sphere { .. } | LightType::Dome => {}
+    }
+    if let (Some(s), true) = (&p.light.shaping, p.light.kind.is_shapeable()) {
+        // The cone edge, hard or soft: scaled so that the band is BAND where
+        // |θoff − θcone| = CONE_BAND·θcone.
+        let cone = s.cone_angle.to_radians();
+        if cone > 0.0 {
+            m = m.min((off_axis_angle(p.axis, e) - cone).abs() / (CONE_BAND * cone) * BAND);
+        }
+    }
+    m
+}
+
+/// Distance of a radiance ray from the light's discontinuities (dimensionless: radians, or a
+/// fraction of the shape's size).
+pub fn radiance_margin(p: &PreparedLight, x: DVec3, w: DVec3) -> f64 {
+    let w = w.normalize();
+    let m_emit = emission_margin(p, -w);
+    let xl = p.to_local * (x - p.origin);
+    let dl = p.to_local * w;
+    let u = dl.normalize();
+    let m_shape = match p.light.kind {
+        LightType::Distant { .. } | LightType::Dome => f64::INFINITY,
+        LightType::Sphere {
+            treat_as_point: true,
+            ..
+        }
+        | LightType::Cylinder {
+            treat_as_line: true,
+            ..
+        } => f64::INFINITY,
+        LightType::Rect { width, height } => {
+            let (hw, hh) = (width / 2.0, height / 2.0);
+            let s = hw.max(hh);
+            let mut m = (xl.z.abs() / s).min(u.z.abs());
+            if dl.z != 0.0 {
+                let h = xl - xl.z / dl.z * dl;
+                m = m.min(((h.x.abs() - hw).abs() / s).min((h.y.abs() - hh).abs() / s));
+            }
+            m
+        }
+        LightType::Disk { radius } => {
+            let mut m = (xl.z.abs() / radius).min(u.z.abs());
+            if dl.z != 0.0 {
+                let h = xl - xl.z / dl.z * dl;
+                m = m.min(((h.x * h.x + h.y * h.y).sqrt() - radius).abs() / radius);
+            }
+            m
+        }
+        LightType::Sphere { radius, .. } => {
+            let tc = -xl.dot(u);
+            let closest = (xl + tc * u).length();
+            ((closest - radius).abs() / radius)
+                .min((xl.length() - radius).abs() / radius)
+                .min(tc.abs() / radius)
+        }
+        LightType::Cylinder { length, radius, .. } => {
+            let hl = length / 2.0;
+            let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+            let mut m = (rho - radius).abs() / radius;
+            let dyz = (dl.y * dl.y + dl.z * dl.z).sqrt();
+            m = m.min(dyz / dl.length());
+            if dyz > 0.0 {
+                let (uy, uz) = (dl.y / dyz, dl.z / dyz);
+                let tc = -(xl.y * uy + xl.z * uz);
+                let (cy, cz) = (xl.y + tc * uy, xl.z + tc * uz);
+                let closest = (cy * cy + cz * cz).sqrt();
+                m = m
+                    .min((closest - radius).abs() / radius)
+                    .min(tc.abs() / radius);
+                let h2 = radius * radius - closest * closest;
+                if h2 >= 0.0 {
+                    let t1 = (tc - h2.sqrt()) / dyz;
+                    m = m.min(((xl.x + t1 * dl.x).abs() - hl).abs() / hl.max(radius));
+                }
+            }
+            m
+        }
+    };
+    m_emit.min(m_shape)
+}
+
+/// Relative error of one sample (see the module docs).
+pub fn rel_error(cpu: DVec3, gpu: [f32; 3]) -> f64 {
+    let g = DVec3::new(gpu[0] as f64, gpu[1] as f64, gpu[2] as f64);
+    let scale = cpu.abs().max_element();
+    let diff = (g - cpu).abs().max_element();
+    if diff == 0.0 {
+        0.0
+    } else if scale == 0.0 {
+        1.0
+    } else {
+        (diff / scale).min(1.0)
+    }
+}
+
+/// Compares GPU and CPU on `samples` emission directions and `samples` radiance rays per light.
+pub fn check(
+    gpu: &GpuContext,
+    device: &str,
+    lights: &[PreparedLight],
+    samples: usize,
+    seed: u64,
+) -> Result<CheckReport> {
+    let mut rng = Rng::new(seed);
+    let mut rows = Vec::new();
+    for p in lights {
+        let rec = [pack::pack(p)];
+        // Emission.
+        let dirs = emission_samples(p, samples, &mut rng);
+        let got = gpu.run(Kernel::Emission, &rec, &dirs, None, false)?;
+        rows.push(compare(p, Query::Emission, samples, |i| {
+            let e = crate::cpu::dvec(dirs[i]);
+            (
+                emission::emission(p, e),
+                emission_margin(p, e),
+                got[i],
+                dirs[i],
+                None,
+            )
+        }));
+        // Radiance.
+        let (pts, dirs) = radiance_samples(p, samples, &mut rng);
+        let got = gpu.run(Kernel::Radiance, &rec, &pts, Some(&dirs), false)?;
+        rows.push(compare(p, Query::Radiance, samples, |i| {
+            let (x, w) = (crate::cpu::dvec(pts[i]), crate::cpu::dvec(dirs[i]));
+            (
+                radiance::radiance(p, x, w),
+                radiance_margin(p, x, w),
+                got[i],
+                pts[i],
+                Some(dirs[i]),
+            )
+        }));
+    }
+    Ok(CheckReport {
+        device: device.to_string(),
+        tolerance: TOLERANCE,
+        band: BAND,
+        samples: rows.iter().map(|r| r.samples).sum(),
+        excluded: rows.iter().map(|r| r.excluded).sum(),
+        rows,
+    })
+}
+
+type SampleEval = (DVec3, f64, [f32; 3], [f32; 3], Option<[f32; 3]>);
+
+fn compare(
+    p: &PreparedLight,
+    query: Query,
+    n: usize,
+    f: impl Fn(usize) -> SampleEval,
+) -> QueryReport {
+    let mut report = QueryReport {
+        light: p.light.path.clone(),
+        light_type: p.light.kind.usd_type(),
+        query,
+        samples: n,
+        excluded: 0,
+        nonzero: 0,
+        max_rel_error: 0.0,
+        worst: None,
+        pass: true,
+    };
+    for i in 0..n {
+        let (cpu, margin, gpu, a, b) = f(i);
+        if margin < BAND {
+            report.excluded += 1;
+            continue;
+        }
+        if cpu != DVec3::ZERO {
+            report.nonzero += 1;
+        }
+        let err = rel_error(cpu, gpu);
+        if err > report.max_rel_error || report.worst.is_none() {
+            report.max_rel_error = report.max_rel_error.max(err);
+            report.worst = Some(Worst {
+                index: i,
+                a,
+                b,
+                cpu: cpu.to_array(),
+                gpu,
+            });
+        }
+    }
+    report.pass = report.max_rel_error <= TOLERANCE;
+    report
+}

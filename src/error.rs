@@ -26,7 +26,9 @@ pub enum LuxError {
     InvalidInput { what: String, reason: String },
 
     /// No wgpu adapter could be found.
-    #[error("no GPU adapter found ({0}); use --device cpu, or install a Vulkan driver (e.g. Mesa's lavapipe: mesa-vulkan-drivers)")]
+    #[error(
+        "no GPU adapter found ({0}); use --device cpu, or install a Vulkan driver (e.g. Mesa's lavapipe: mesa-vulkan-drivers)"
+    )]
     NoAdapter(String),
 
     /// The GPU device failed: creation, validation, out of memory, device lost, readback.

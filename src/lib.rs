@@ -36,6 +36,11 @@ pub mod light;
 pub mod query;
 pub mod schema;
 
+/// Compiles and runs the README's examples as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 pub use cpu::TemperatureMode;
 pub use error::{LuxError, Result};
 pub use light::{Light, LightInputs, LightType, Shaping};

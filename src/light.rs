@@ -318,9 +318,7 @@ impl Light {
         if last_col != [0.0, 0.0, 0.0, 1.0] {
             return Err(LuxError::InvalidTransform {
                 light: self.path.clone(),
-                reason: format!(
-                    "is not affine (last column {last_col:?}, expected [0, 0, 0, 1])"
-                ),
+                reason: format!("is not affine (last column {last_col:?}, expected [0, 0, 0, 1])"),
             });
         }
         let a = self.linear();
@@ -381,7 +379,10 @@ mod tests {
             .validate()
             .unwrap_err()
             .to_string();
-        assert!(e.contains("/lights/key") && e.contains("inputs:radius"), "{e}");
+        assert!(
+            e.contains("/lights/key") && e.contains("inputs:radius"),
+            "{e}"
+        );
         let e = Light::rect(1.0, -2.0).validate().unwrap_err().to_string();
         assert!(e.contains("inputs:height"), "{e}");
         let e = Light::disk(1.0)

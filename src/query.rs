@@ -51,6 +51,14 @@ impl Evaluator {
         })
     }
 
+    /// A GPU evaluator on an existing context.
+    pub fn from_context(gpu: GpuContext) -> Self {
+        Evaluator {
+            backend: Backend::Gpu(gpu),
+            temperature_mode: TemperatureMode::default(),
+        }
+    }
+
     pub fn with_temperature_mode(mut self, mode: TemperatureMode) -> Self {
         self.temperature_mode = mode;
         self
@@ -78,7 +86,12 @@ impl Evaluator {
     }
 
     /// emission(light, ω) for every direction (DESIGN.md §3).
-    pub fn emission(&self, lights: &[Light], dirs: &[[f32; 3]], acc: Accumulate) -> Result<Vec<[f32; 3]>> {
+    pub fn emission(
+        &self,
+        lights: &[Light],
+        dirs: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
         check_directions("directions", dirs)?;
         let prepared = self.prepare(lights)?;
         let per_light = acc == Accumulate::PerLight;
@@ -101,14 +114,26 @@ impl Evaluator {
         if points.len() != dirs.len() {
             return Err(LuxError::input(
                 "points/directions",
-                format!("{} points but {} directions; they pair up row by row", points.len(), dirs.len()),
+                format!(
+                    "{} points but {} directions; they pair up row by row",
+                    points.len(),
+                    dirs.len()
+                ),
             ));
         }
         let prepared = self.prepare(lights)?;
         let per_light = acc == Accumulate::PerLight;
         match &self.backend {
-            Backend::Cpu => Ok(to_f32(cpu::radiance_batch(&prepared, points, dirs, per_light))),
-            Backend::Gpu(g) => g.run(Kernel::Radiance, &records(&prepared), points, Some(dirs), per_light),
+            Backend::Cpu => Ok(to_f32(cpu::radiance_batch(
+                &prepared, points, dirs, per_light,
+            ))),
+            Backend::Gpu(g) => g.run(
+                Kernel::Radiance,
+                &records(&prepared),
+                points,
+                Some(dirs),
+                per_light,
+            ),
         }
     }
 }
@@ -124,7 +149,10 @@ fn to_f32(v: Vec<DVec3>) -> Vec<[f32; 3]> {
 /// Every point must be finite.
 pub fn check_points(what: &str, points: &[[f32; 3]]) -> Result<()> {
     if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-        return Err(LuxError::input(what, format!("row {i} is not finite: {:?}", points[i])));
+        return Err(LuxError::input(
+            what,
+            format!("row {i} is not finite: {:?}", points[i]),
+        ));
     }
     Ok(())
 }
@@ -133,7 +161,10 @@ pub fn check_points(what: &str, points: &[[f32; 3]]) -> Result<()> {
 pub fn check_directions(what: &str, dirs: &[[f32; 3]]) -> Result<()> {
     check_points(what, dirs)?;
     if let Some(i) = dirs.iter().position(|d| d.iter().all(|c| *c == 0.0)) {
-        return Err(LuxError::input(what, format!("row {i} is the zero vector, which has no direction")));
+        return Err(LuxError::input(
+            what,
+            format!("row {i} is the zero vector, which has no direction"),
+        ));
     }
     Ok(())
 }

@@ -127,7 +127,11 @@ pub const TABLE: &[SchemaAttr] = &[
     attr("LightAPI", "inputs:diffuse", Float(light_api::DIFFUSE)),
     attr("LightAPI", "inputs:specular", Float(light_api::SPECULAR)),
     // ShapingAPI
-    attr("ShapingAPI", "inputs:shaping:focus", Float(shaping_api::FOCUS)),
+    attr(
+        "ShapingAPI",
+        "inputs:shaping:focus",
+        Float(shaping_api::FOCUS),
+    ),
     attr(
         "ShapingAPI",
         "inputs:shaping:focusTint",
@@ -155,17 +159,33 @@ pub const TABLE: &[SchemaAttr] = &[
         Bool(shaping_api::IES_NORMALIZE),
     ),
     // ShadowAPI
-    attr("ShadowAPI", "inputs:shadow:enable", Bool(shadow_api::ENABLE)),
+    attr(
+        "ShadowAPI",
+        "inputs:shadow:enable",
+        Bool(shadow_api::ENABLE),
+    ),
     attr("ShadowAPI", "inputs:shadow:color", Color(shadow_api::COLOR)),
-    attr("ShadowAPI", "inputs:shadow:distance", Float(shadow_api::DISTANCE)),
-    attr("ShadowAPI", "inputs:shadow:falloff", Float(shadow_api::FALLOFF)),
+    attr(
+        "ShadowAPI",
+        "inputs:shadow:distance",
+        Float(shadow_api::DISTANCE),
+    ),
+    attr(
+        "ShadowAPI",
+        "inputs:shadow:falloff",
+        Float(shadow_api::FALLOFF),
+    ),
     attr(
         "ShadowAPI",
         "inputs:shadow:falloffGamma",
         Float(shadow_api::FALLOFF_GAMMA),
     ),
     // Typed lights
-    attr("DistantLight", "inputs:intensity", Float(distant::INTENSITY)),
+    attr(
+        "DistantLight",
+        "inputs:intensity",
+        Float(distant::INTENSITY),
+    ),
     attr("DistantLight", "inputs:angle", Float(distant::ANGLE)),
     attr("SphereLight", "inputs:radius", Float(sphere::RADIUS)),
     attr("SphereLight", "treatAsPoint", Bool(sphere::TREAT_AS_POINT)),
@@ -175,7 +195,11 @@ pub const TABLE: &[SchemaAttr] = &[
     attr("RectLight", "inputs:texture:file", Asset),
     attr("CylinderLight", "inputs:length", Float(cylinder::LENGTH)),
     attr("CylinderLight", "inputs:radius", Float(cylinder::RADIUS)),
-    attr("CylinderLight", "treatAsLine", Bool(cylinder::TREAT_AS_LINE)),
+    attr(
+        "CylinderLight",
+        "treatAsLine",
+        Bool(cylinder::TREAT_AS_LINE),
+    ),
     attr("DomeLight", "inputs:texture:file", Asset),
     attr(
         "DomeLight",
@@ -259,7 +283,10 @@ mod tests {
 
     #[test]
     fn shaping_rows_only_when_applied() {
-        assert_eq!(fallback("DiskLight", &[], "inputs:shaping:cone:angle"), None);
+        assert_eq!(
+            fallback("DiskLight", &[], "inputs:shaping:cone:angle"),
+            None
+        );
         assert_eq!(
             fallback("DiskLight", &["ShapingAPI"], "inputs:shaping:cone:angle"),
             Some(Float(90.0))

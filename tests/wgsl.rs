@@ -3,7 +3,7 @@
 
 use std::mem::{offset_of, size_of};
 
-use luxeval::gpu::shaders::{compose, Kernel};
+use luxeval::gpu::shaders::{Kernel, compose};
 use luxeval::gpu::{LightRecord, Params};
 
 fn module(kernel: Kernel) -> naga::Module {
@@ -16,12 +16,17 @@ fn module(kernel: Kernel) -> naga::Module {
 fn every_kernel_parses_and_validates() {
     for kernel in Kernel::ALL {
         let m = module(kernel);
-        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
-            .validate(&m)
-            .unwrap_or_else(|e| panic!("{}: {}", kernel.file(), e.emit_to_string(&compose(kernel))));
+        let info = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&m)
+        .unwrap_or_else(|e| panic!("{}: {}", kernel.file(), e.emit_to_string(&compose(kernel))));
         let _ = info;
         assert!(
-            m.entry_points.iter().any(|e| e.name == kernel.entry_point()),
+            m.entry_points
+                .iter()
+                .any(|e| e.name == kernel.entry_point()),
             "{} has no entry point {}",
             kernel.file(),
             kernel.entry_point()
@@ -101,6 +106,9 @@ fn params_layout_matches_naga() {
 /// rejected by the same check the kernels pass.
 #[test]
 fn validation_rejects_a_type_error() {
-    let src = format!("{}\nfn broken() -> f32 {{ let x: f32 = 1u; return x; }}", compose(Kernel::Emission));
+    let src = format!(
+        "{}\nfn broken() -> f32 {{ let x: f32 = 1u; return x; }}",
+        compose(Kernel::Emission)
+    );
     assert!(naga::front::wgsl::parse_str(&src).is_err());
 }

@@ -2,10 +2,11 @@
 // (spec/002 cone:angle, cone:softness, focus, focusTint; DESIGN.md §2 "Shaping").
 
 // #import shared/light.wgsl
+// #import shared/math.wgsl
 
 // θoff in radians: atan2(|e × a|, e · a), accurate near 0 where acos is not.
 fn off_axis_angle(axis: vec3<f32>, e: vec3<f32>) -> f32 {
-    return atan2(length(cross(e, axis)), dot(e, axis));
+    return atan2_accurate(length(cross(e, axis)), dot(e, axis));
 }
 
 // UsdLux's _Smoothstep(t, [lo, hi]): a zero-width range is a step that is 0 at and below lo.
@@ -22,7 +23,12 @@ fn cone_factor(theta: f32, cone: f32, start: f32) -> f32 {
     if theta > cone {
         return 0.0;
     }
-    return 1.0 - smoothstep_angle(theta, start, cone);
+    // 1 − smoothstep(s) = smoothstep(1 − s): evaluated from the cone end so that f32 does not
+    // cancel where the factor is small.
+    if cone - start == 0.0 {
+        return 1.0;
+    }
+    return smoothstep_angle(cone - theta, 0.0, cone - start);
 }
 
 // lerp(|cos|^focus, focusTint, 1); white when focus <= 0.

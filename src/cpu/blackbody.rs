@@ -54,7 +54,9 @@ impl std::str::FromStr for TemperatureMode {
         Self::ALL
             .into_iter()
             .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown temperature mode {s:?} (expected spec, usd or planckian)"))
+            .ok_or_else(|| {
+                format!("unknown temperature mode {s:?} (expected spec, usd or planckian)")
+            })
     }
 }
 

@@ -7,10 +7,10 @@
 
 use glam::DVec3;
 
-use super::blackbody::{temperature_rgb, TemperatureMode};
+use super::PreparedLight;
+use super::blackbody::{TemperatureMode, temperature_rgb};
 use super::normalize::distant_half_angle;
 use super::shaping::{off_axis_angle, shaping};
-use super::PreparedLight;
 use crate::light::{Light, LightType};
 
 /// `intensity · 2^exposure · color ⊙ temperature(T)` (spec/001 intensity, exposure, color,
@@ -102,18 +102,33 @@ mod tests {
     fn a2_area_size_factors_as_emission() {
         for r in [0.1, 0.2, 0.3, 0.4, 0.5] {
             let s = prep(&Light::sphere(r).with_intensity(5.0).with_normalize(true));
-            assert!((emission(&s, DVec3::X).x - 5.0 / (4.0 * std::f64::consts::PI * r * r)).abs() < 1e-12);
+            assert!(
+                (emission(&s, DVec3::X).x - 5.0 / (4.0 * std::f64::consts::PI * r * r)).abs()
+                    < 1e-12
+            );
             let d = prep(&Light::disk(r).with_intensity(5.0).with_normalize(true));
-            assert!((emission(&d, DVec3::NEG_Z).x - 5.0 / (std::f64::consts::PI * r * r)).abs() < 1e-12);
-            let c = prep(&Light::cylinder(1.0, r).with_intensity(5.0).with_normalize(true));
-            assert!((emission(&c, DVec3::Y).x - 5.0 / (2.0 * std::f64::consts::PI * r)).abs() < 1e-12);
+            assert!(
+                (emission(&d, DVec3::NEG_Z).x - 5.0 / (std::f64::consts::PI * r * r)).abs() < 1e-12
+            );
+            let c = prep(
+                &Light::cylinder(1.0, r)
+                    .with_intensity(5.0)
+                    .with_normalize(true),
+            );
+            assert!(
+                (emission(&c, DVec3::Y).x - 5.0 / (2.0 * std::f64::consts::PI * r)).abs() < 1e-12
+            );
         }
         for w in [0.2, 0.65, 1.1, 1.55, 2.0] {
             let l = prep(&Light::rect(w, 2.0).with_intensity(5.0).with_normalize(true));
             assert!((emission(&l, DVec3::NEG_Z).x - 5.0 / (2.0 * w)).abs() < 1e-12);
         }
         // Distant: 0.3 lux at any angle once normalised: L = 0.3 / (π sin²θmax).
-        let d = prep(&Light::distant(40.0).with_intensity(0.3).with_normalize(true));
+        let d = prep(
+            &Light::distant(40.0)
+                .with_intensity(0.3)
+                .with_normalize(true),
+        );
         let want = 0.3 / (std::f64::consts::PI * 20f64.to_radians().sin().powi(2));
         assert!((emission(&d, DVec3::NEG_Z).x - want).abs() < 1e-12);
     }
@@ -130,7 +145,10 @@ mod tests {
         let outside = DQuat::from_rotation_x(5.1f64.to_radians()) * DVec3::NEG_Z;
         assert_eq!(emission(&d, inside), DVec3::ONE);
         assert_eq!(emission(&d, outside), DVec3::ZERO);
-        assert_eq!(emission(&prep(&Light::distant(0.0)), DVec3::NEG_Z), DVec3::ZERO);
+        assert_eq!(
+            emission(&prep(&Light::distant(0.0)), DVec3::NEG_Z),
+            DVec3::ZERO
+        );
     }
 
     /// Shaping uses the primary axis (direction image of −Z); one-sidedness uses the normal
@@ -147,7 +165,11 @@ mod tests {
         assert!((p.axis - DVec3::new(-1.0, 0.0, -1.0).normalize()).length() < 1e-15);
         assert!((p.normal - DVec3::NEG_Z).length() < 1e-15);
         // Focus with a narrow power peaks along the axis, not along the normal.
-        let s = Shaping { focus: 50.0, cone_angle: 180.0, ..Shaping::default() };
+        let s = Shaping {
+            focus: 50.0,
+            cone_angle: 180.0,
+            ..Shaping::default()
+        };
         let p = prep(&Light::disk(0.5).with_transform(m).with_shaping(s));
         assert!(emission(&p, p.axis).x > 0.999);
         assert!(emission(&p, DVec3::NEG_Z).x < 1e-6);
@@ -167,10 +189,26 @@ mod tests {
             (0.5, [0.561985, 0.074913, 0.020415, 0.449588]),
         ];
         let variants = [
-            Shaping { cone_angle: 30.0, cone_softness: 0.0, ..Shaping::default() },
-            Shaping { cone_angle: 30.0, cone_softness: 0.5, ..Shaping::default() },
-            Shaping { cone_angle: 30.0, cone_softness: 1.0, ..Shaping::default() },
-            Shaping { cone_angle: 180.0, focus: 2.0, ..Shaping::default() },
+            Shaping {
+                cone_angle: 30.0,
+                cone_softness: 0.0,
+                ..Shaping::default()
+            },
+            Shaping {
+                cone_angle: 30.0,
+                cone_softness: 0.5,
+                ..Shaping::default()
+            },
+            Shaping {
+                cone_angle: 30.0,
+                cone_softness: 1.0,
+                ..Shaping::default()
+            },
+            Shaping {
+                cone_angle: 180.0,
+                focus: 2.0,
+                ..Shaping::default()
+            },
         ];
         for (x, want) in rows {
             let theta = f64::atan(x);
@@ -178,7 +216,11 @@ mod tests {
             for (k, s) in variants.iter().enumerate() {
                 let p = prep(&Light::sphere(0.005).with_shaping(s.clone()));
                 let e_floor = i0 * emission(&p, e).x * theta.cos().powi(3);
-                assert!((e_floor - want[k]).abs() < 1.5e-6, "x={x} variant {k}: {e_floor} vs {}", want[k]);
+                assert!(
+                    (e_floor - want[k]).abs() < 1.5e-6,
+                    "x={x} variant {k}: {e_floor} vs {}",
+                    want[k]
+                );
             }
         }
         // Beyond the cone (x = 0.6, θ = 30.96°) the cone variants are dark; focus is not.
@@ -195,7 +237,12 @@ mod tests {
     /// reference/luxtest.md §6 A5: focusTint separates channels.
     #[test]
     fn a5_focus_tint_channel_separation() {
-        let s = Shaping { focus: 2.5, focus_tint: DVec3::X, cone_angle: 180.0, ..Shaping::default() };
+        let s = Shaping {
+            focus: 2.5,
+            focus_tint: DVec3::X,
+            cone_angle: 180.0,
+            ..Shaping::default()
+        };
         let p = prep(&Light::sphere(0.5).with_shaping(s));
         let theta = 0.7f64;
         let e = DVec3::new(0.0, theta.sin(), -theta.cos());
@@ -208,13 +255,32 @@ mod tests {
     /// reference/luxtest.md §6 A7 through the emission formula, with the three modes.
     #[test]
     fn a7_temperature_in_emission() {
-        let l = Light::rect(1.0, 1.0).with_intensity(5.0).with_temperature(2000.0);
-        let spec = emission(&PreparedLight::new(&l, TemperatureMode::Spec).unwrap(), DVec3::NEG_Z);
-        let usd = emission(&PreparedLight::new(&l, TemperatureMode::Usd).unwrap(), DVec3::NEG_Z);
-        assert!((usd - 5.0 * DVec3::new(2.52057, 0.64689, 0.02040)).abs().max_element() < 5e-5);
+        let l = Light::rect(1.0, 1.0)
+            .with_intensity(5.0)
+            .with_temperature(2000.0);
+        let spec = emission(
+            &PreparedLight::new(&l, TemperatureMode::Spec).unwrap(),
+            DVec3::NEG_Z,
+        );
+        let usd = emission(
+            &PreparedLight::new(&l, TemperatureMode::Usd).unwrap(),
+            DVec3::NEG_Z,
+        );
+        assert!(
+            (usd - 5.0 * DVec3::new(2.52057, 0.64689, 0.02040))
+                .abs()
+                .max_element()
+                < 5e-5
+        );
         let white = DVec3::new(1.04333, 0.98362, 1.03461);
         assert!((spec - usd / white).abs().max_element() < 1e-4);
         let l6500 = l.clone().with_temperature(6500.0);
-        assert_eq!(emission(&PreparedLight::new(&l6500, TemperatureMode::Spec).unwrap(), DVec3::NEG_Z), DVec3::splat(5.0));
+        assert_eq!(
+            emission(
+                &PreparedLight::new(&l6500, TemperatureMode::Spec).unwrap(),
+                DVec3::NEG_Z
+            ),
+            DVec3::splat(5.0)
+        );
     }
 }

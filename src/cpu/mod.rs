@@ -85,7 +85,7 @@ pub fn prepare(lights: &[Light], mode: TemperatureMode) -> Result<Vec<PreparedLi
 }
 
 /// Converts an f32 triple to f64.
-pub(crate) fn dvec(v: [f32; 3]) -> DVec3 {
+pub fn dvec(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
 }
 
@@ -98,11 +98,13 @@ where
     if per_light {
         let mut out = vec![DVec3::ZERO; lights.len() * n];
         if n > 0 {
-            out.par_chunks_mut(n).zip(lights.par_iter()).for_each(|(rows, light)| {
-                rows.par_iter_mut()
-                    .enumerate()
-                    .for_each(|(i, o)| *o = f(light, i))
-            });
+            out.par_chunks_mut(n)
+                .zip(lights.par_iter())
+                .for_each(|(rows, light)| {
+                    rows.par_iter_mut()
+                        .enumerate()
+                        .for_each(|(i, o)| *o = f(light, i))
+                });
         }
         out
     } else {

@@ -129,7 +129,9 @@ pub fn singular_values(m: DMat3) -> DVec3 {
             }
         }
     }
-    DVec3::new(a[0][0], a[1][1], a[2][2]).max(DVec3::ZERO).powf(0.5)
+    DVec3::new(a[0][0], a[1][1], a[2][2])
+        .max(DVec3::ZERO)
+        .powf(0.5)
 }
 
 /// Carlson's R_F(x, y, z), at most one argument zero (Carlson 1995, duplication).
@@ -228,12 +230,22 @@ mod tests {
         // Conjugate diameters of a circle at 60° give the same ellipse family.
         let u = DVec3::new(1.0, 0.0, 0.0);
         let v = DVec3::new(0.0, 2.0, 0.0);
-        assert!(rel(ellipse_perimeter_conjugate(u, v), ellipse_perimeter(2.0, 1.0)) < 1e-14);
+        assert!(
+            rel(
+                ellipse_perimeter_conjugate(u, v),
+                ellipse_perimeter(2.0, 1.0)
+            ) < 1e-14
+        );
         // Any other pair of conjugate semi-diameters of the same ellipse (a phase shift of the
         // parametrisation) gives the same perimeter.
         let t = 0.4f64;
         let (u2, v2) = (t.cos() * u + t.sin() * v, -t.sin() * u + t.cos() * v);
-        assert!(rel(ellipse_perimeter_conjugate(u2, v2), ellipse_perimeter(2.0, 1.0)) < 1e-14);
+        assert!(
+            rel(
+                ellipse_perimeter_conjugate(u2, v2),
+                ellipse_perimeter(2.0, 1.0)
+            ) < 1e-14
+        );
     }
 
     /// Spheroids have elementary closed forms; compare the elliptic-integral path with them.
@@ -299,7 +311,12 @@ mod tests {
         let quad = sum * 2.0 * PI / n as f64;
         let exact = world_area(&light);
         assert!(rel(exact, quad) < 1e-12, "{exact} vs {quad}");
-        assert!(rel(world_area(&Light::cylinder(2.0, 0.25)), 2.0 * PI * 0.25 * 2.0) < 1e-15);
+        assert!(
+            rel(
+                world_area(&Light::cylinder(2.0, 0.25)),
+                2.0 * PI * 0.25 * 2.0
+            ) < 1e-15
+        );
     }
 
     #[test]
@@ -332,7 +349,10 @@ mod tests {
             (180.0, 0.94248),
         ] {
             // E (normalize off) = 0.3·π·sin²θmax = 0.3·sizeFactor for θmax ≤ 90°.
-            assert!((0.3 * distant_size_factor(angle) - e_off).abs() < 5e-6, "{angle}");
+            assert!(
+                (0.3 * distant_size_factor(angle) - e_off).abs() < 5e-6,
+                "{angle}"
+            );
         }
         // Above 180° the (2 − sin²)π branch: 270° → θmax = 135°, sin² = 1/2.
         assert!(rel(distant_size_factor(270.0), 1.5 * PI) < 1e-15);

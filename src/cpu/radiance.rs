@@ -8,9 +8,9 @@
 
 use glam::DVec3;
 
+use super::PreparedLight;
 use super::emission::emission;
 use super::shapes::{cylinder_hit, disk_hit, rect_hit, sphere_hit};
-use super::PreparedLight;
 use crate::light::LightType;
 
 /// radiance at `x` from direction `w` (any non-zero length; normalised here).
@@ -32,9 +32,15 @@ pub fn hits_emitting_surface(p: &PreparedLight, x: DVec3, w: DVec3) -> bool {
         LightType::Dome | LightType::Distant { .. } => true,
         LightType::Rect { width, height } => rect_hit(xl, dl, width / 2.0, height / 2.0),
         LightType::Disk { radius } => disk_hit(xl, dl, radius),
-        LightType::Sphere { treat_as_point: true, .. } => false,
+        LightType::Sphere {
+            treat_as_point: true,
+            ..
+        } => false,
         LightType::Sphere { radius, .. } => sphere_hit(xl, dl, radius),
-        LightType::Cylinder { treat_as_line: true, .. } => false,
+        LightType::Cylinder {
+            treat_as_line: true,
+            ..
+        } => false,
         LightType::Cylinder { length, radius, .. } => cylinder_hit(xl, dl, length / 2.0, radius),
     }
 }
@@ -53,24 +59,46 @@ mod tests {
     #[test]
     fn rect_seen_from_its_emitting_side_only() {
         // A rect at (0, 1, 0) rotated to face down (−Z → −Y).
-        let m = DMat4::from_rotation_translation(DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2), DVec3::Y);
+        let m = DMat4::from_rotation_translation(
+            DQuat::from_rotation_x(-std::f64::consts::FRAC_PI_2),
+            DVec3::Y,
+        );
         let p = prep(&Light::rect(1.0, 2.0).with_intensity(3.0).with_transform(m));
         assert!((p.axis - DVec3::NEG_Y).length() < 1e-15);
         assert_eq!(radiance(&p, DVec3::ZERO, DVec3::Y), DVec3::splat(3.0));
-        assert_eq!(radiance(&p, DVec3::new(0.0, 2.0, 0.0), DVec3::NEG_Y), DVec3::ZERO);
+        assert_eq!(
+            radiance(&p, DVec3::new(0.0, 2.0, 0.0), DVec3::NEG_Y),
+            DVec3::ZERO
+        );
         // Height 2 lies along world ±Z after the rotation: z = 0.9 hits, x = 0.6 misses.
-        assert_eq!(radiance(&p, DVec3::new(0.0, 0.0, 0.9), DVec3::Y), DVec3::splat(3.0));
-        assert_eq!(radiance(&p, DVec3::new(0.6, 0.0, 0.0), DVec3::Y), DVec3::ZERO);
+        assert_eq!(
+            radiance(&p, DVec3::new(0.0, 0.0, 0.9), DVec3::Y),
+            DVec3::splat(3.0)
+        );
+        assert_eq!(
+            radiance(&p, DVec3::new(0.6, 0.0, 0.0), DVec3::Y),
+            DVec3::ZERO
+        );
     }
 
     #[test]
     fn scaled_sphere_is_an_ellipsoid() {
-        let m = DMat4::from_scale_rotation_translation(DVec3::new(4.0, 1.0, 1.0), DQuat::IDENTITY, DVec3::new(0.0, 0.0, -10.0));
+        let m = DMat4::from_scale_rotation_translation(
+            DVec3::new(4.0, 1.0, 1.0),
+            DQuat::IDENTITY,
+            DVec3::new(0.0, 0.0, -10.0),
+        );
         let p = prep(&Light::sphere(0.5));
         let q = prep(&Light::sphere(0.5).with_transform(m));
         // x = 1.9 along X is inside the stretched sphere's silhouette (semi-axis 2).
-        assert_eq!(radiance(&q, DVec3::new(1.9, 0.0, 0.0), DVec3::NEG_Z), DVec3::ONE);
-        assert_eq!(radiance(&q, DVec3::new(2.1, 0.0, 0.0), DVec3::NEG_Z), DVec3::ZERO);
+        assert_eq!(
+            radiance(&q, DVec3::new(1.9, 0.0, 0.0), DVec3::NEG_Z),
+            DVec3::ONE
+        );
+        assert_eq!(
+            radiance(&q, DVec3::new(2.1, 0.0, 0.0), DVec3::NEG_Z),
+            DVec3::ZERO
+        );
         assert_eq!(radiance(&p, DVec3::ZERO, DVec3::X), DVec3::ZERO); // inside
     }
 
@@ -87,7 +115,10 @@ mod tests {
     #[test]
     fn treat_as_point_and_line_have_no_radiance() {
         let mut s = Light::sphere(0.5);
-        s.kind = LightType::Sphere { radius: 0.5, treat_as_point: true };
+        s.kind = LightType::Sphere {
+            radius: 0.5,
+            treat_as_point: true,
+        };
         let p = prep(&s.with_transform(DMat4::from_translation(DVec3::Z * 3.0)));
         assert_eq!(radiance(&p, DVec3::ZERO, DVec3::Z), DVec3::ZERO);
         assert_eq!(emission(&p, DVec3::Z), DVec3::ONE);

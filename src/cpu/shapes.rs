@@ -105,16 +105,36 @@ mod tests {
     #[test]
     fn cylinder_open_ends_and_side() {
         // Side hit.
-        assert!(cylinder_hit(DVec3::new(0.2, 0.0, -3.0), DVec3::Z, 0.5, 0.25));
+        assert!(cylinder_hit(
+            DVec3::new(0.2, 0.0, -3.0),
+            DVec3::Z,
+            0.5,
+            0.25
+        ));
         // Beyond the end along the side direction: miss.
-        assert!(!cylinder_hit(DVec3::new(0.7, 0.0, -3.0), DVec3::Z, 0.5, 0.25));
+        assert!(!cylinder_hit(
+            DVec3::new(0.7, 0.0, -3.0),
+            DVec3::Z,
+            0.5,
+            0.25
+        ));
         // Down the axis through the open end: sees the inside (or nothing).
-        assert!(!cylinder_hit(DVec3::new(-3.0, 0.0, 0.0), DVec3::X, 0.5, 0.25));
+        assert!(!cylinder_hit(
+            DVec3::new(-3.0, 0.0, 0.0),
+            DVec3::X,
+            0.5,
+            0.25
+        ));
         // Entering the open end obliquely and hitting the inner wall: 0.
         let x = DVec3::new(-2.0, 0.0, 0.0);
         let d = DVec3::new(2.0, 0.2, 0.0); // reaches y = 0.25 at x = 0.5 -> inside wall
         assert!(!cylinder_hit(x, d, 0.5, 0.25));
         // From inside the tube: 0.
-        assert!(!cylinder_hit(DVec3::new(0.0, 0.1, 0.0), DVec3::Y, 0.5, 0.25));
+        assert!(!cylinder_hit(
+            DVec3::new(0.0, 0.1, 0.0),
+            DVec3::Y,
+            0.5,
+            0.25
+        ));
     }
 }

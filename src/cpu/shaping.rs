@@ -18,7 +18,8 @@ use crate::light::Shaping;
 pub fn shaping(s: &Shaping, axis: DVec3, e: DVec3) -> DVec3 {
     let cos = e.dot(axis);
     let theta = off_axis_angle(axis, e);
-    focus_factor(s.focus, s.focus_tint, cos) * cone_factor(theta, s.cone_angle.to_radians(), s.cone_softness)
+    focus_factor(s.focus, s.focus_tint, cos)
+        * cone_factor(theta, s.cone_angle.to_radians(), s.cone_softness)
 }
 
 /// θoff in radians, in [0, π].

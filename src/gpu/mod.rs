@@ -82,7 +82,12 @@ impl GpuContext {
                 let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
                 adapters
                     .into_iter()
-                    .find(|a| a.get_info().name.to_lowercase().contains(&want.to_lowercase()))
+                    .find(|a| {
+                        a.get_info()
+                            .name
+                            .to_lowercase()
+                            .contains(&want.to_lowercase())
+                    })
                     .ok_or_else(|| {
                         LuxError::NoAdapter(format!(
                             "{ADAPTER_ENV}={want:?} matches none of {names:?}"
@@ -167,7 +172,8 @@ impl GpuContext {
 
     /// The largest number of samples one dispatch handles for `lights` lights.
     pub fn chunk_capacity(&self, lights: usize, per_light: bool) -> usize {
-        let binding = (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
+        let binding =
+            (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
         // Keep each buffer at most 256 MiB so that host and device memory stay bounded.
         let budget = binding.min(256 << 20);
         let rows = if per_light { lights.max(1) as u64 } else { 1 };
@@ -245,8 +251,13 @@ impl GpuContext {
         };
         let in_bytes = (chunk * 12) as u64;
         let out_bytes = (chunk * rows * 12) as u64;
-        let light_buf = storage("lights", (lights * std::mem::size_of::<LightRecord>()) as u64, wgpu::BufferUsages::COPY_DST);
-        self.queue.write_buffer(&light_buf, 0, bytemuck::cast_slice(records));
+        let light_buf = storage(
+            "lights",
+            (lights * std::mem::size_of::<LightRecord>()) as u64,
+            wgpu::BufferUsages::COPY_DST,
+        );
+        self.queue
+            .write_buffer(&light_buf, 0, bytemuck::cast_slice(records));
         let buf_a = storage("in_a", in_bytes, wgpu::BufferUsages::COPY_DST);
         let buf_b = b.map(|_| storage("in_b", in_bytes, wgpu::BufferUsages::COPY_DST));
         let buf_out = storage("out", out_bytes, wgpu::BufferUsages::COPY_SRC);
@@ -280,9 +291,11 @@ impl GpuContext {
         let mut start = 0;
         while start < n {
             let count = chunk.min(n - start);
-            self.queue.write_buffer(&buf_a, 0, bytemuck::cast_slice(&a[start..start + count]));
+            self.queue
+                .write_buffer(&buf_a, 0, bytemuck::cast_slice(&a[start..start + count]));
             if let (Some(buf), Some(b)) = (&buf_b, b) {
-                self.queue.write_buffer(buf, 0, bytemuck::cast_slice(&b[start..start + count]));
+                self.queue
+                    .write_buffer(buf, 0, bytemuck::cast_slice(&b[start..start + count]));
             }
             let groups = (count as u32).div_ceil(pack::WORKGROUP_SIZE);
             let gx = groups.min(max_groups);
@@ -293,8 +306,11 @@ impl GpuContext {
                 per_light: per_light as u32,
                 row_stride: gx * pack::WORKGROUP_SIZE,
             };
-            self.queue.write_buffer(&params_buf, 0, bytemuck::bytes_of(&params));
-            let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(kernel.entry_point()) });
+            self.queue
+                .write_buffer(&params_buf, 0, bytemuck::bytes_of(&params));
+            let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some(kernel.entry_point()),
+            });
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some(kernel.entry_point()),

@@ -89,21 +89,32 @@ pub fn pack(p: &PreparedLight) -> LightRecord {
             r.axis[3] = crate::cpu::normalize::distant_half_angle(angle) as f32;
             (KIND_DISTANT, [0.0; 4])
         }
-        LightType::Sphere { radius, treat_as_point } => {
+        LightType::Sphere {
+            radius,
+            treat_as_point,
+        } => {
             if treat_as_point {
                 r.flags |= FLAG_TREAT_AS_POINT_OR_LINE;
             }
             (KIND_SPHERE, [radius as f32, 0.0, 0.0, 0.0])
         }
         LightType::Disk { radius } => (KIND_DISK, [radius as f32, 0.0, 0.0, 0.0]),
-        LightType::Rect { width, height } => {
-            (KIND_RECT, [(width / 2.0) as f32, (height / 2.0) as f32, 0.0, 0.0])
-        }
-        LightType::Cylinder { length, radius, treat_as_line } => {
+        LightType::Rect { width, height } => (
+            KIND_RECT,
+            [(width / 2.0) as f32, (height / 2.0) as f32, 0.0, 0.0],
+        ),
+        LightType::Cylinder {
+            length,
+            radius,
+            treat_as_line,
+        } => {
             if treat_as_line {
                 r.flags |= FLAG_TREAT_AS_POINT_OR_LINE;
             }
-            (KIND_CYLINDER, [(length / 2.0) as f32, radius as f32, 0.0, 0.0])
+            (
+                KIND_CYLINDER,
+                [(length / 2.0) as f32, radius as f32, 0.0, 0.0],
+            )
         }
         LightType::Dome => (KIND_DOME, [0.0; 4]),
     };

@@ -8,9 +8,22 @@ use super::pack::WGSL_CONSTANTS;
 
 /// Every WGSL source file, by its path under `shaders/`.
 pub const SOURCES: &[(&str, &str)] = &[
-    ("shared/light.wgsl", include_str!("../../shaders/shared/light.wgsl")),
-    ("shared/shaping.wgsl", include_str!("../../shaders/shared/shaping.wgsl")),
-    ("shared/shapes.wgsl", include_str!("../../shaders/shared/shapes.wgsl")),
+    (
+        "shared/light.wgsl",
+        include_str!("../../shaders/shared/light.wgsl"),
+    ),
+    (
+        "shared/math.wgsl",
+        include_str!("../../shaders/shared/math.wgsl"),
+    ),
+    (
+        "shared/shaping.wgsl",
+        include_str!("../../shaders/shared/shaping.wgsl"),
+    ),
+    (
+        "shared/shapes.wgsl",
+        include_str!("../../shaders/shared/shapes.wgsl"),
+    ),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
 ];

@@ -1,0 +1,289 @@
+//! CPU (f64) vs GPU (f32, WGSL) conformance over randomised lights and samples covering every
+//! light type, transform kind and attribute (issue: foundation, item 6).
+//!
+//! Tolerance: relative error ≤ 1e-4 (luxeval::check::TOLERANCE); the excluded band around
+//! discontinuities is luxeval::check::BAND (1e-4 rad, or 1e-4 of the shape's size) — see
+//! src/check.rs for exactly which samples it covers. The test prints its sample count, the
+//! excluded count and the largest errors.
+
+mod common;
+
+use glam::{DMat4, DQuat, DVec3};
+use luxeval::check::{self, Rng};
+use luxeval::cpu::{self, PreparedLight};
+use luxeval::{Accumulate, Evaluator, Light, LightType, Shaping, TemperatureMode};
+
+/// The transform kinds every type is tested under.
+const TRANSFORMS: [&str; 7] = [
+    "identity",
+    "translate",
+    "rotate",
+    "uniform-scale",
+    "nonuniform-scale",
+    "shear",
+    "mirror",
+];
+
+fn transform(kind: &str, rng: &mut Rng) -> DMat4 {
+    let t = DVec3::new(
+        rng.range(-3.0, 3.0),
+        rng.range(-3.0, 3.0),
+        rng.range(-3.0, 3.0),
+    );
+    let q = DQuat::from_axis_angle(rng.unit(), rng.range(0.0, std::f64::consts::TAU));
+    match kind {
+        "identity" => DMat4::IDENTITY,
+        "translate" => DMat4::from_translation(t),
+        "rotate" => DMat4::from_rotation_translation(q, t),
+        "uniform-scale" => {
+            DMat4::from_scale_rotation_translation(DVec3::splat(rng.range(0.3, 3.0)), q, t)
+        }
+        "nonuniform-scale" => DMat4::from_scale_rotation_translation(
+            DVec3::new(
+                rng.range(0.3, 3.0),
+                rng.range(0.3, 3.0),
+                rng.range(0.3, 3.0),
+            ),
+            q,
+            t,
+        ),
+        "shear" => {
+            // luxtest frames 26-30 use rows (1.25,0,0),(0,1,0),(0.6,0,0.75) under a rotation.
+            let shear = DMat4::from_cols_array_2d(&[
+                [rng.range(0.8, 1.5), rng.range(-0.5, 0.5), 0.0, 0.0],
+                [0.0, 1.0, rng.range(-0.5, 0.5), 0.0],
+                [rng.range(-0.8, 0.8), 0.0, rng.range(0.5, 1.2), 0.0],
+                [0.0, 0.0, 0.0, 1.0],
+            ]);
+            DMat4::from_rotation_translation(q, t) * shear
+        }
+        "mirror" => {
+            DMat4::from_rotation_translation(q, t)
+                * DMat4::from_scale(DVec3::new(-1.0, rng.range(0.5, 2.0), 1.0))
+        }
+        _ => unreachable!(),
+    }
+}
+
+fn random_light(ty: usize, xf: &str, rng: &mut Rng, id: usize) -> Light {
+    let mut l = match ty {
+        0 => Light::distant(if rng.chance(0.15) {
+            0.0
+        } else {
+            rng.range(0.1, 250.0)
+        }),
+        1 => {
+            let mut l = Light::sphere(rng.range(0.05, 1.0));
+            if rng.chance(0.15) {
+                l.kind = LightType::Sphere {
+                    radius: rng.range(0.05, 1.0),
+                    treat_as_point: true,
+                };
+            }
+            l
+        }
+        2 => Light::disk(rng.range(0.05, 1.0)),
+        3 => Light::rect(rng.range(0.1, 2.0), rng.range(0.1, 2.0)),
+        4 => {
+            let mut l = Light::cylinder(rng.range(0.2, 2.0), rng.range(0.05, 0.5));
+            if rng.chance(0.15) {
+                l.kind = LightType::Cylinder {
+                    length: 1.0,
+                    radius: 0.2,
+                    treat_as_line: true,
+                };
+            }
+            l
+        }
+        _ => Light::dome(),
+    };
+    let name = format!("/random/{id}_{}_{xf}", l.kind.usd_type());
+    l = l
+        .with_path(name)
+        .with_intensity(rng.range(0.1, 100.0))
+        .with_exposure(rng.range(-4.0, 4.0))
+        .with_color(DVec3::new(
+            rng.range(0.05, 1.0),
+            rng.range(0.05, 1.0),
+            rng.range(0.05, 1.0),
+        ))
+        .with_normalize(rng.chance(0.5))
+        .with_transform(transform(xf, rng));
+    if rng.chance(0.4) {
+        l = l.with_temperature(rng.range(800.0, 16000.0));
+    }
+    if rng.chance(0.7) {
+        let cone_angle = match rng.below(4) {
+            0 => 90.0,
+            1 => rng.range(5.0, 90.0),
+            2 => rng.range(90.0, 180.0),
+            _ => rng.range(-10.0, 200.0),
+        };
+        l = l.with_shaping(Shaping {
+            focus: if rng.chance(0.6) {
+                rng.range(-1.0, 8.0)
+            } else {
+                0.0
+            },
+            focus_tint: DVec3::new(rng.f64(), rng.f64(), rng.f64()),
+            cone_angle,
+            cone_softness: if rng.chance(0.3) {
+                0.0
+            } else {
+                rng.range(-0.2, 1.3)
+            },
+        });
+    }
+    l
+}
+
+fn random_lights(rng: &mut Rng, per_combo: usize) -> Vec<Light> {
+    let mut lights = Vec::new();
+    for ty in 0..6 {
+        for xf in TRANSFORMS {
+            for _ in 0..per_combo {
+                let id = lights.len();
+                lights.push(random_light(ty, xf, rng, id));
+            }
+        }
+    }
+    lights
+}
+
+#[test]
+fn gpu_matches_cpu_on_randomised_lights() {
+    let Some(gpu) = common::gpu() else { return };
+    let device = format!("{}", gpu.adapter().name);
+    let mut rng = Rng::new(0x1A7E_5EED);
+    let lights = random_lights(&mut rng, 6); // 6 types × 7 transforms × 6 = 252 lights
+    let samples_per_query = 200;
+    let mut total = 0;
+    let mut excluded = 0;
+    let mut worst: Vec<check::QueryReport> = Vec::new();
+    for (k, mode) in TemperatureMode::ALL.into_iter().enumerate() {
+        // Every light under the spec mode; a third of them under the other two modes.
+        let subset: Vec<&Light> = lights
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| k == 0 || i % 3 == k)
+            .map(|(_, l)| l)
+            .collect();
+        let prepared: Vec<PreparedLight> = subset
+            .iter()
+            .map(|l| PreparedLight::new(l, mode).expect("valid light"))
+            .collect();
+        let report = check::check(&gpu, &device, &prepared, samples_per_query, 7 + k as u64)
+            .expect("GPU check runs");
+        total += report.samples;
+        excluded += report.excluded;
+        worst.extend(report.rows);
+    }
+    worst.sort_by(|a, b| b.max_rel_error.total_cmp(&a.max_rel_error));
+    let compared_nonzero: usize = worst.iter().map(|r| r.nonzero).sum();
+    println!("device: {device}");
+    println!(
+        "conformance: {total} (light, sample) pairs over {} lights; {excluded} excluded (within {} rad / {} of size of an edge, or {} of the cone angle of a cone edge); {compared_nonzero} compared samples with non-zero CPU value",
+        lights.len(),
+        check::BAND,
+        check::BAND,
+        check::CONE_BAND
+    );
+    println!("largest relative errors:");
+    for r in worst.iter().take(8) {
+        println!(
+            "  {:>10.3e}  {:8} {:>14} {}  worst {:?}",
+            r.max_rel_error,
+            format!("{:?}", r.query),
+            r.light_type,
+            r.light,
+            r.worst
+        );
+    }
+    assert!(total >= 100_000, "only {total} samples");
+    assert!(
+        excluded * 100 < total,
+        "excluded band swallowed {excluded} of {total}"
+    );
+    let failures: Vec<_> = worst.iter().filter(|r| !r.pass).collect();
+    assert!(
+        failures.is_empty(),
+        "{} light/query pairs over tolerance {}; worst {:?}",
+        failures.len(),
+        check::TOLERANCE,
+        failures.first()
+    );
+}
+
+/// Summed and per-light batches, many lights at once, through the public Evaluator on both
+/// backends: the GPU sum equals the CPU sum, and the per-light rows add up to the sum.
+#[test]
+fn summed_and_per_light_batches_agree() {
+    let Some(gpu) = common::gpu() else { return };
+    let gpu = Evaluator::from_context(gpu);
+    let cpu = Evaluator::cpu();
+    let mut rng = Rng::new(99);
+    let lights = random_lights(&mut rng, 1);
+    let prepared = cpu::prepare(&lights, TemperatureMode::Spec).unwrap();
+    let n = 4000;
+    let dirs: Vec<[f32; 3]> = (0..n).map(|_| rng.unit().as_vec3().to_array()).collect();
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|_| {
+            DVec3::new(
+                rng.range(-6.0, 6.0),
+                rng.range(-6.0, 6.0),
+                rng.range(-6.0, 6.0),
+            )
+            .as_vec3()
+            .to_array()
+        })
+        .collect();
+    for query in ["emission", "radiance"] {
+        let run = |e: &Evaluator, acc| match query {
+            "emission" => e.emission(&lights, &dirs, acc).unwrap(),
+            _ => e.radiance(&lights, &points, &dirs, acc).unwrap(),
+        };
+        let (gs, gp, cs) = (
+            run(&gpu, Accumulate::Sum),
+            run(&gpu, Accumulate::PerLight),
+            run(&cpu, Accumulate::Sum),
+        );
+        assert_eq!(gs.len(), n);
+        assert_eq!(gp.len(), n * lights.len());
+        let mut compared = 0;
+        for i in 0..n {
+            let x = glam::Vec3::from_array(points[i]).as_dvec3();
+            let w = glam::Vec3::from_array(dirs[i]).as_dvec3();
+            let near_edge = prepared.iter().any(|p| match query {
+                "emission" => check::emission_margin(p, w) < check::BAND,
+                _ => check::radiance_margin(p, x, w) < check::BAND,
+            });
+            let per_light_sum: glam::Vec3 = (0..lights.len())
+                .map(|l| glam::Vec3::from_array(gp[l * n + i]))
+                .sum();
+            // Same kernel, same lights: the per-light rows add up to the summed row (f32 sums
+            // in the same order).
+            assert!(
+                (per_light_sum - glam::Vec3::from_array(gs[i]))
+                    .abs()
+                    .max_element()
+                    <= 1e-5 * per_light_sum.abs().max_element().max(1e-30),
+                "row {i}"
+            );
+            if near_edge {
+                continue;
+            }
+            compared += 1;
+            let c = glam::Vec3::from_array(cs[i]).as_dvec3();
+            // Summed over ~42 lights of very different magnitudes: relative to the sample's
+            // largest per-light value, since cancellation cannot occur (all values ≥ 0 except
+            // negative tints, which random_light never makes).
+            let err = check::rel_error(c, gs[i]);
+            assert!(
+                err <= check::TOLERANCE,
+                "{query} row {i}: cpu {c} gpu {:?} err {err:e}",
+                gs[i]
+            );
+        }
+        assert!(compared > n / 2, "{query}: only {compared} rows compared");
+    }
+}
