@@ -32,6 +32,7 @@ pub mod check;
 pub mod cpu;
 pub mod error;
 pub mod gpu;
+pub mod io;
 pub mod light;
 pub mod query;
 pub mod schema;
