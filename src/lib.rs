@@ -31,6 +31,7 @@
 pub mod check;
 pub mod cpu;
 pub mod error;
+pub mod falloff;
 pub mod gpu;
 pub mod io;
 pub mod light;

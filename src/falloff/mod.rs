@@ -1,0 +1,206 @@
+//! Headless falloff maps (DESIGN.md §4 `falloff`): irradiance over a rectangle of a plane, as a
+//! linear float RGB EXR and a false-colour PNG with a colour bar in lux.
+//!
+//! The plane is the parallelogram `origin + s·u + t·v`, s, t ∈ [0, 1]; the receiver normal is
+//! `normalize(u × v)`, so the map shows the plane as seen from the side its normal points to,
+//! with `u` to the right and `v` up. Pixel (column i, row j), row 0 at the top of the image, is
+//! evaluated at its centre: `origin + (i + ½)/W·u + (1 − (j + ½)/H)·v`.
+
+mod font;
+pub mod png;
+mod viridis;
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::error::{LuxError, Result};
+use crate::io::write_atomic;
+
+/// The most pixels one map may have (memory for points, normals and results stays < 4 GiB).
+pub const MAX_PIXELS: u64 = 1 << 27;
+
+/// A rectangle of a plane sampled at pixel centres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plane {
+    /// The corner at the image's bottom-left.
+    pub origin: DVec3,
+    /// The image's horizontal edge (left to right).
+    pub u: DVec3,
+    /// The image's vertical edge (bottom to top).
+    pub v: DVec3,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Plane {
+    /// Validates the plane: finite vectors, u and v not parallel, 1 ≤ pixels ≤ [`MAX_PIXELS`].
+    pub fn new(origin: DVec3, u: DVec3, v: DVec3, width: u32, height: u32) -> Result<Self> {
+        for (name, x) in [("--origin", origin), ("--u", u), ("--v", v)] {
+            if !x.is_finite() {
+                return Err(LuxError::input(name, format!("{x} is not finite")));
+            }
+        }
+        if !(u.cross(v).length() > 0.0) {
+            return Err(LuxError::input(
+                "--u/--v",
+                format!("u = {u} and v = {v} are parallel or zero: they span no plane"),
+            ));
+        }
+        if width == 0 || height == 0 || width as u64 * height as u64 > MAX_PIXELS {
+            return Err(LuxError::input(
+                "--res",
+                format!("{width}×{height}: need 1 to {MAX_PIXELS} pixels"),
+            ));
+        }
+        Ok(Plane {
+            origin,
+            u,
+            v,
+            width,
+            height,
+        })
+    }
+
+    /// The receiver normal, `normalize(u × v)`.
+    pub fn normal(&self) -> DVec3 {
+        self.u.cross(self.v).normalize()
+    }
+
+    /// The centre of pixel (column i, row j), row 0 at the top.
+    pub fn pixel_centre(&self, i: u32, j: u32) -> DVec3 {
+        let s = (i as f64 + 0.5) / self.width as f64;
+        let t = 1.0 - (j as f64 + 0.5) / self.height as f64;
+        self.origin + s * self.u + t * self.v
+    }
+
+    /// Every pixel centre, row-major from the top row.
+    pub fn points(&self) -> Vec<[f32; 3]> {
+        (0..self.height)
+            .flat_map(|j| (0..self.width).map(move |i| (j, i)))
+            .map(|(j, i)| self.pixel_centre(i, j).as_vec3().to_array())
+            .collect()
+    }
+
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+}
+
+/// An evaluated map: linear RGB irradiance (lux for lights in nits), row-major from the top row.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Map {
+    pub width: u32,
+    pub height: u32,
+    pub rgb: Vec<[f32; 3]>,
+}
+
+impl Map {
+    /// Rec.709 luminance of each pixel: the photometric value the PNG shows.
+    pub fn luminance(&self) -> Vec<f64> {
+        self.rgb
+            .iter()
+            .map(|c| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64)
+            .collect()
+    }
+}
+
+/// Writes the map as a scanline EXR with linear float R, G, B channels (ZIP compressed),
+/// atomically.
+pub fn write_exr(path: &Path, map: &Map, comment: &str) -> Result<()> {
+    use exr::prelude::*;
+    let (w, h) = (map.width as usize, map.height as usize);
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let c = map.rgb[y * w + x];
+        (c[0], c[1], c[2])
+    });
+    let mut attributes = LayerAttributes::named("irradiance");
+    attributes.comments = Some(Text::from(comment));
+    attributes.software_name = Some(Text::from(concat!("luxeval ", env!("CARGO_PKG_VERSION"))));
+    let layer = Layer::new((w, h), attributes, Encoding::SMALL_LOSSLESS, channels);
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| LuxError::Format {
+            path: path.to_path_buf(),
+            line: None,
+            reason: format!("encoding EXR: {e}"),
+        })?;
+    write_atomic(path, |f| f.write_all(bytes.get_ref()))
+}
+
+/// Reads an RGB(A) EXR back as a map (used by tests and tools; alpha is dropped).
+pub fn read_exr(path: &Path) -> Result<Map> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| {
+            (
+                resolution.width(),
+                vec![[0f32; 3]; resolution.width() * resolution.height()],
+            )
+        },
+        |(w, px): &mut (usize, Vec<[f32; 3]>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = [r, g, b]
+        },
+    )
+    .map_err(|e| LuxError::Format {
+        path: path.to_path_buf(),
+        line: None,
+        reason: format!("reading EXR: {e}"),
+    })?;
+    let size = image.layer_data.size;
+    Ok(Map {
+        width: size.width() as u32,
+        height: size.height() as u32,
+        rgb: image.layer_data.channel_data.pixels.1,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pixel_centres_and_normal() {
+        // The luxtest top camera's floor: x right, −Z up the image, normal +Y.
+        let half = 6.2865;
+        let p = Plane::new(
+            DVec3::new(-half, 0.0, half),
+            DVec3::X * 2.0 * half,
+            DVec3::NEG_Z * 2.0 * half,
+            512,
+            512,
+        )
+        .unwrap();
+        assert!((p.normal() - DVec3::Y).length() < 1e-15);
+        // Column i → x = (2(i+0.5)/512 − 1)·6.2865; row j (top = 0) → z = (2(j+0.5)/512 − 1)·6.2865.
+        let c = p.pixel_centre(0, 0);
+        assert!((c.x - (1.0 / 512.0 - 1.0) * half).abs() < 1e-12);
+        assert!((c.z - (1.0 / 512.0 - 1.0) * half).abs() < 1e-12);
+        let c = p.pixel_centre(511, 511);
+        assert!(
+            (c.x - (1.0 - 1.0 / 512.0) * half).abs() < 1e-12
+                && (c.z - (1.0 - 1.0 / 512.0) * half).abs() < 1e-12
+        );
+        assert_eq!(p.points().len(), 512 * 512);
+        assert!(Plane::new(DVec3::ZERO, DVec3::X, DVec3::X * 2.0, 4, 4).is_err());
+        assert!(Plane::new(DVec3::ZERO, DVec3::X, DVec3::Y, 0, 4).is_err());
+    }
+
+    #[test]
+    fn exr_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("m.exr");
+        let map = Map {
+            width: 3,
+            height: 2,
+            rgb: (0..6)
+                .map(|i| [i as f32, 0.5 * i as f32, 1e-3 * i as f32])
+                .collect(),
+        };
+        write_exr(&path, &map, "test").unwrap();
+        assert_eq!(read_exr(&path).unwrap(), map);
+    }
+}
