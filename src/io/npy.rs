@@ -138,3 +138,44 @@ mod tests {
         assert_eq!(names.len(), 3, "{names:?}");
     }
 }
+
+#[cfg(test)]
+mod numpy_files {
+    use super::*;
+
+    fn data(name: &str) -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/npy")
+            .join(name)
+    }
+
+    /// Files written by NumPy (tools/gen_npy_fixtures.py): every accepted layout reads the same.
+    #[test]
+    fn numpy_layouts_read_the_same() {
+        let want = read_vec3(&data("dirs_f32.npy")).unwrap();
+        assert_eq!(want[1], [0.3, -0.9, 0.1]);
+        for f in [
+            "dirs_f64.npy",
+            "dirs_f32_fortran.npy",
+            "dirs_f32_bigendian.npy",
+        ] {
+            assert_eq!(read_vec3(&data(f)).unwrap(), want, "{f}");
+        }
+    }
+
+    #[test]
+    fn numpy_files_with_the_wrong_dtype_or_shape_are_named_errors() {
+        let e = read_vec3(&data("dirs_int.npy")).unwrap_err().to_string();
+        assert!(
+            e.contains("dirs_int.npy") && e.contains("float32 or float64"),
+            "{e}"
+        );
+        let e = read_vec3(&data("dirs_shape_4x2.npy"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("dirs_shape_4x2.npy") && e.contains("[4, 2]"),
+            "{e}"
+        );
+    }
+}
