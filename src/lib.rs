@@ -34,9 +34,12 @@ pub mod error;
 pub mod gpu;
 pub mod light;
 pub mod query;
+pub mod scene;
 pub mod schema;
+pub mod usd;
 
 pub use cpu::TemperatureMode;
 pub use error::{LuxError, Result};
 pub use light::{Light, LightInputs, LightType, Shaping};
 pub use query::{Accumulate, Backend, Evaluator};
+pub use scene::Scene;

@@ -1,0 +1,523 @@
+//! Reading lights from USD stages: the only module that imports openusd.
+//!
+//! It opens `.usda`, `.usdc` and `.usdz` files with full composition (sublayers, references,
+//! payloads all loaded, variant selections, inherits, specializes, instancing) and returns plain
+//! data: stage metadata, and for every light prim its type, applied schemas, visibility, world
+//! matrix and every attribute of [`crate::schema::attrs_for`] resolved at one time. What a light
+//! means to luxeval is decided in [`crate::scene`].
+//!
+//! Value resolution and transforms are openusd's, checked against Pixar's usd-core in
+//! `tests/usd_fixtures.rs`. Fallbacks of unauthored attributes come from luxeval's schema table,
+//! not from openusd's registry, so there is exactly one table of them.
+
+use std::path::{Path, PathBuf};
+
+use openusd::sdf;
+use openusd::usd::{self as ousd, PrimPredicate, TimeCode};
+use openusd_schemas::geom::{Imageable, ImageableExt, Visibility, XformCache};
+
+use crate::error::{LuxError, Result};
+use crate::scene::{Input, Value};
+use crate::schema::{self, Fallback};
+
+/// Prim types that are lights.
+pub const LIGHT_TYPES: &[&str] = &[
+    "DistantLight",
+    "SphereLight",
+    "DiskLight",
+    "RectLight",
+    "CylinderLight",
+    "DomeLight",
+    "DomeLight_1",
+    "PortalLight",
+    "GeometryLight",
+    "PluginLight",
+];
+
+/// API schemas that make a prim of any type a light.
+pub const LIGHT_APIS: &[&str] = &["MeshLightAPI", "VolumeLightAPI"];
+
+/// The time attributes are read at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Time {
+    /// A numeric time code, interpolated between samples as USD does (linear for floating
+    /// types, slerp for quaternions, held for bool, token and asset).
+    Code(f64),
+    /// USD's `EarliestTime`: every attribute (and xformOp) at its own earliest time sample, or
+    /// its default value when it has none.
+    Earliest,
+}
+
+impl Time {
+    fn code(self) -> TimeCode {
+        match self {
+            Time::Code(t) => TimeCode::new(t),
+            Time::Earliest => TimeCode::EARLIEST,
+        }
+    }
+}
+
+/// Stage metadata.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageInfo {
+    /// `Y` when unauthored, as USD does.
+    pub up_axis: String,
+    /// 0.01 when unauthored, as USD does.
+    pub meters_per_unit: f64,
+    /// The root layer's `startTimeCode`, when authored.
+    pub start_time_code: Option<f64>,
+    /// The root layer's `endTimeCode`, when authored.
+    pub end_time_code: Option<f64>,
+}
+
+/// One light prim resolved at one time.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightPrim {
+    pub path: String,
+    /// The prim's type name (`Mesh`, `Volume`, ... for MeshLightAPI / VolumeLightAPI prims).
+    pub usd_type: String,
+    /// The composed API schemas, as usd-core's `GetAppliedSchemas()` lists them (built-ins
+    /// included, e.g. `LightAPI`), followed by authored names the schema registry does not know
+    /// (e.g. a renderer's own `HoudiniViewportLightAPI`), which usd-core drops.
+    pub applied_schemas: Vec<String>,
+    /// `MeshLightAPI` or `VolumeLightAPI` when that is what makes the prim a light.
+    pub light_api: Option<String>,
+    /// False when `visibility` is `invisible` on the prim or an imageable ancestor.
+    pub visible: bool,
+    /// Local-to-world, USD row-vector convention.
+    pub world: [[f64; 4]; 4],
+    /// Every attribute of `schema::attrs_for(usd_type, applied_schemas)`, in that order.
+    pub inputs: Vec<Input>,
+}
+
+/// What does not change with time: found once at open.
+struct LightSite {
+    prim: ousd::Prim,
+    path: String,
+    usd_type: String,
+    applied_schemas: Vec<String>,
+    light_api: Option<String>,
+    attrs: Vec<schema::SchemaAttr>,
+}
+
+/// An open stage and its light prims.
+pub struct UsdStage {
+    file: PathBuf,
+    info: StageInfo,
+    lights: Vec<LightSite>,
+    // Keeps the composed stage alive for the prim handles above.
+    _stage: ousd::Stage,
+}
+
+impl UsdStage {
+    /// Opens `path` with every payload loaded. A missing or unreadable file is
+    /// [`LuxError::Io`]; a malformed one [`LuxError::Format`] (with the line for `.usda`); a
+    /// sublayer, reference or payload that cannot be found or read is an error naming that layer.
+    pub fn open(path: &Path) -> Result<UsdStage> {
+        // The filesystem's own error (not found, permission denied) is the clearest message.
+        std::fs::File::open(path).map_err(|source| LuxError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let name = path.to_str().ok_or_else(|| LuxError::Format {
+            path: path.to_path_buf(),
+            line: None,
+            reason: "the path is not valid UTF-8, which openusd requires".into(),
+        })?;
+        let stage = ousd::Stage::builder()
+            .schema_registry(openusd_schemas::schema_registry())
+            .load(ousd::InitialLoadSet::LoadAll)
+            .open(name)
+            .map_err(|e| open_error(path, e))?;
+        let e = |e: openusd::Error| stage_error(path, e);
+
+        let up_axis = stage
+            .stage_metadata("upAxis")
+            .map_err(e)?
+            .and_then(|v| v.cast::<String>().ok())
+            .unwrap_or_else(|| "Y".to_string());
+        let meters_per_unit = stage
+            .stage_metadata("metersPerUnit")
+            .map_err(e)?
+            .and_then(|v| v.cast::<f64>().ok())
+            .unwrap_or(0.01);
+        let (start_time_code, end_time_code) = {
+            let root = stage.root_layer();
+            (
+                root.has_start_time_code().then(|| root.start_time_code()),
+                root.has_end_time_code().then(|| root.end_time_code()),
+            )
+        };
+        let info = StageInfo {
+            up_axis,
+            meters_per_unit,
+            start_time_code,
+            end_time_code,
+        };
+
+        // Default predicate (active, loaded, defined, non-abstract) as usd-core's Traverse(),
+        // descending into instances: a light inside an instanced asset lights the scene too.
+        let mut paths = Vec::new();
+        stage
+            .traverse(PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone()))
+            .map_err(e)?;
+        check_composition(path, &stage)?;
+
+        let mut lights = Vec::new();
+        for p in paths {
+            let prim = stage.prim(&p).map_err(|err| e(err.into()))?;
+            let usd_type = prim
+                .type_name()
+                .map_err(e)?
+                .map(|t| t.as_str().to_string())
+                .unwrap_or_default();
+            let applied_schemas: Vec<String> = prim
+                .api_schemas()
+                .map_err(e)?
+                .iter()
+                .map(|t| t.as_str().to_string())
+                .collect();
+            let light_api = if LIGHT_TYPES.contains(&usd_type.as_str()) {
+                None
+            } else {
+                match applied_schemas
+                    .iter()
+                    .find(|s| LIGHT_APIS.contains(&s.as_str()))
+                {
+                    Some(api) => Some(api.clone()),
+                    None => continue,
+                }
+            };
+            let applied: Vec<&str> = applied_schemas.iter().map(String::as_str).collect();
+            let attrs = schema::attrs_for(&usd_type, &applied);
+            lights.push(LightSite {
+                path: p.to_string(),
+                prim,
+                usd_type,
+                applied_schemas,
+                light_api,
+                attrs,
+            });
+        }
+        // Reading attributes can compose more (e.g. the prims an inherit arc names).
+        check_composition(path, &stage)?;
+        Ok(UsdStage {
+            file: path.to_path_buf(),
+            info,
+            lights,
+            _stage: stage,
+        })
+    }
+
+    pub fn info(&self) -> &StageInfo {
+        &self.info
+    }
+
+    /// The file the stage was opened from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// Every light prim, in traversal order, resolved at `time`.
+    pub fn lights_at(&self, time: Time) -> Result<Vec<LightPrim>> {
+        let tc = time.code();
+        let e = |err: openusd::Error| stage_error(&self.file, err);
+        let mut cache = XformCache::new(tc);
+        let mut out = Vec::with_capacity(self.lights.len());
+        for site in &self.lights {
+            let visible = match Imageable::from_prim(site.prim.clone()).map_err(e)? {
+                Some(img) => img.compute_visibility(tc).map_err(e)? != Visibility::Invisible,
+                // A light that is not imageable has no visibility to turn it off.
+                None => true,
+            };
+            let world: [[f64; 4]; 4] = cache
+                .local_to_world_transform(&site.prim)
+                .map_err(|err| LuxError::InvalidTransform {
+                    light: site.path.clone(),
+                    reason: format!("cannot be computed: {err}"),
+                })?
+                .into();
+            let mut inputs = Vec::with_capacity(site.attrs.len());
+            for a in &site.attrs {
+                inputs.push(self.input(site, a, tc)?);
+            }
+            out.push(LightPrim {
+                path: site.path.clone(),
+                usd_type: site.usd_type.clone(),
+                applied_schemas: site.applied_schemas.clone(),
+                light_api: site.light_api.clone(),
+                visible,
+                world,
+                inputs,
+            });
+        }
+        Ok(out)
+    }
+
+    /// One attribute at `tc`: its authored value converted to the kind of its table fallback,
+    /// or the table fallback when nothing is authored.
+    fn input(&self, site: &LightSite, a: &schema::SchemaAttr, tc: TimeCode) -> Result<Input> {
+        let e = |err: openusd::Error| stage_error(&self.file, err);
+        let attr = site.prim.attribute(a.name);
+        let authored = attr.has_authored_value().map_err(e)?;
+        let value = if authored {
+            // `None` here is a value block at this time: no opinion, so the fallback holds
+            // (usd-core reports no value at all there).
+            match attr.get_at::<sdf::Value>(tc).map_err(e)? {
+                Some(v) => convert(&site.path, a, v)?,
+                None => fallback_value(a.fallback),
+            }
+        } else {
+            fallback_value(a.fallback)
+        };
+        Ok(Input {
+            name: a.name.to_string(),
+            value,
+            authored,
+        })
+    }
+}
+
+/// The scene value of a schema fallback.
+pub fn fallback_value(f: Fallback) -> Value {
+    match f {
+        Fallback::Float(v) => Value::Float(v),
+        Fallback::Bool(v) => Value::Bool(v),
+        Fallback::Color(v) => Value::Color(v),
+        Fallback::Token(v) => Value::Token(v.to_string()),
+        Fallback::Asset => Value::Asset {
+            authored: String::new(),
+            resolved: None,
+        },
+    }
+}
+
+/// Converts an authored value to the kind the schema table gives the attribute. USD files do
+/// author other precisions than the schema's (a `double` intensity, a `color3d`), which
+/// usd-core reads as they are; numbers are widened to f64 exactly.
+fn convert(light: &str, a: &schema::SchemaAttr, v: sdf::Value) -> Result<Value> {
+    let shown = format!("{v:?}");
+    let bad = |want: &str| {
+        LuxError::attr(
+            light,
+            a.name,
+            &shown,
+            format!(
+                "expected a {want} value, as the {} schema declares",
+                a.schema
+            ),
+        )
+    };
+    Ok(match a.fallback {
+        Fallback::Float(_) => Value::Float(match v {
+            sdf::Value::Bool(_) => return Err(bad("floating-point")),
+            other => other.cast::<f64>().map_err(|_| bad("floating-point"))?,
+        }),
+        Fallback::Bool(_) => Value::Bool(match v {
+            sdf::Value::Bool(b) => b,
+            // usda allows 0/1 for bools; openusd coerces them already, this is a safety net.
+            other => match other.cast::<i64>() {
+                Ok(0) => false,
+                Ok(1) => true,
+                _ => return Err(bad("bool")),
+            },
+        }),
+        Fallback::Color(_) => Value::Color(v.cast::<[f64; 3]>().map_err(|_| bad("color3f"))?),
+        Fallback::Token(_) => Value::Token(match v {
+            sdf::Value::Token(t) => t.as_str().to_string(),
+            sdf::Value::String(s) => s,
+            _ => return Err(bad("token")),
+        }),
+        Fallback::Asset => match v {
+            sdf::Value::AssetPath(p) => Value::Asset {
+                authored: p.as_str().to_string(),
+                resolved: p.resolved_path().map(str::to_string),
+            },
+            _ => return Err(bad("asset")),
+        },
+    })
+}
+
+/// Layer-level composition failures are errors: a light rig whose reference did not load would
+/// otherwise be evaluated without its lights, silently. Other diagnostics (an arc to a prim the
+/// layer lacks, a variant selection naming no variant) compose as usd-core does, with a warning.
+fn check_composition(file: &Path, stage: &ousd::Stage) -> Result<()> {
+    use openusd::pcp::CompositionDiagnostic as D;
+    for d in stage.composition_errors() {
+        match d {
+            D::UnresolvedLayer {
+                asset_path,
+                arc,
+                introduced_by,
+                site_path,
+            } => {
+                return Err(LuxError::Io {
+                    path: anchored(&introduced_by, &asset_path),
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::NotFound,
+                        format!(
+                            "cannot open the {arc:?} layer @{asset_path}@ authored on {site_path} in {introduced_by}"
+                        ),
+                    ),
+                });
+            }
+            D::UnresolvedSublayer {
+                asset_path,
+                introduced_by,
+            } => {
+                return Err(LuxError::Io {
+                    path: anchored(&introduced_by, &asset_path),
+                    source: std::io::Error::new(
+                        std::io::ErrorKind::NotFound,
+                        format!("cannot open the sublayer @{asset_path}@ of {introduced_by}"),
+                    ),
+                });
+            }
+            D::MalformedLayer {
+                asset_path,
+                arc,
+                introduced_by,
+                site_path,
+                reason,
+            } => {
+                let (line, reason) = located(&reason);
+                return Err(LuxError::Format {
+                    path: anchored(&introduced_by, &asset_path),
+                    line,
+                    reason: format!(
+                        "{reason} (the {arc:?} layer authored on {site_path} in {introduced_by})"
+                    ),
+                });
+            }
+            D::MalformedSublayer {
+                asset_path,
+                introduced_by,
+                reason,
+            } => {
+                let (line, reason) = located(&reason);
+                return Err(LuxError::Format {
+                    path: anchored(&introduced_by, &asset_path),
+                    line,
+                    reason: format!("{reason} (a sublayer of {introduced_by})"),
+                });
+            }
+            other => log::warn!("{}: {other}", file.display()),
+        }
+    }
+    Ok(())
+}
+
+/// `asset` as a path: itself when absolute (openusd reports some resolved), else anchored to
+/// the directory of the filesystem layer `layer` (inside a package, the authored path as is).
+fn anchored(layer: &str, asset: &str) -> PathBuf {
+    let a = Path::new(asset);
+    if a.is_absolute() || layer.contains('[') {
+        return a.to_path_buf();
+    }
+    match Path::new(layer).parent() {
+        Some(dir) => dir.join(a),
+        None => a.to_path_buf(),
+    }
+}
+
+/// Splits openusd's rendered diagnostics (`error: why\n --> file:line:col\n | snippet`) into the
+/// line and a one-line reason.
+fn located(rendered: &str) -> (Option<usize>, String) {
+    let mut lines = rendered.lines();
+    let first = lines.next().unwrap_or_default();
+    let reason = first.strip_prefix("error: ").unwrap_or(first).to_string();
+    let line = rendered.lines().find_map(|l| {
+        let loc = l.trim_start().strip_prefix("--> ")?;
+        // `file:line:col`; the file may itself contain colons, so count from the right.
+        let mut parts = loc.rsplitn(3, ':');
+        let _col = parts.next()?;
+        parts.next()?.parse::<usize>().ok()
+    });
+    (line, reason)
+}
+
+/// Maps a failure to open the root layer.
+fn open_error(path: &Path, e: openusd::Error) -> LuxError {
+    use openusd::Error as E;
+    match e {
+        E::Io(source) => LuxError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        E::Format(sdf::FormatError::Io(source)) => LuxError::Io {
+            path: path.to_path_buf(),
+            source,
+        },
+        E::Parse(pe) => LuxError::Format {
+            path: path.to_path_buf(),
+            line: Some(pe.line()),
+            reason: located(&pe.to_string()).1,
+        },
+        E::Format(sdf::FormatError::Decode(inner)) => {
+            match inner.downcast_ref::<openusd::usda::ParseError>() {
+                Some(pe) => LuxError::Format {
+                    path: path.to_path_buf(),
+                    line: Some(pe.line()),
+                    reason: located(&pe.to_string()).1,
+                },
+                None => LuxError::Format {
+                    path: path.to_path_buf(),
+                    line: None,
+                    reason: inner.to_string(),
+                },
+            }
+        }
+        E::UnresolvedAsset(_) => LuxError::Io {
+            path: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "cannot resolve the file"),
+        },
+        E::UnsupportedFormat(_) => LuxError::Format {
+            path: path.to_path_buf(),
+            line: None,
+            reason: "not a USD file (expected .usda, .usdc or .usdz)".into(),
+        },
+        other => stage_error(path, other),
+    }
+}
+
+/// Any other openusd failure while reading the stage: the file's content is what is wrong.
+fn stage_error(path: &Path, e: openusd::Error) -> LuxError {
+    let rendered = e.to_string();
+    let (line, reason) = located(&rendered);
+    LuxError::Format {
+        path: path.to_path_buf(),
+        line,
+        reason,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn located_reads_line_and_reason() {
+        let (line, reason) = located(
+            "error: Expected a number\n --> /a/b:c.usda:5:30\n  |\n5 |  x = = 3\n  |      ^",
+        );
+        assert_eq!(line, Some(5));
+        assert_eq!(reason, "Expected a number");
+        assert_eq!(located("plain failure"), (None, "plain failure".into()));
+    }
+
+    #[test]
+    fn anchoring() {
+        assert_eq!(
+            anchored("/a/b/root.usda", "sub/x.usda"),
+            PathBuf::from("/a/b/sub/x.usda")
+        );
+        assert_eq!(
+            anchored("/a/root.usda", "/abs.usda"),
+            PathBuf::from("/abs.usda")
+        );
+        assert_eq!(
+            anchored("/a/p.usdz[root.usda]", "x.usda"),
+            PathBuf::from("x.usda")
+        );
+    }
+}
