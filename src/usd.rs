@@ -288,10 +288,14 @@ impl UsdStage {
         let attr = site.prim.attribute(a.name);
         let authored = attr.has_authored_value().map_err(e)?;
         let value = if authored {
-            // `None` here is a value block at this time: no opinion, so the fallback holds
-            // (usd-core reports no value at all there).
-            match attr.get_at::<sdf::Value>(tc).map_err(e)? {
+            let v = match attr.get_at::<sdf::Value>(tc).map_err(e)? {
+                Some(v) => Some(v),
+                None => held_before_block(&attr, tc).map_err(e)?,
+            };
+            match v {
                 Some(v) => convert(&site.path, a, v)?,
+                // A blocked value at this time: usd-core reports no value at all; luxeval has
+                // to evaluate something, and a block means "no opinion", so the fallback.
                 None => fallback_value(a.fallback),
             }
         } else {
@@ -303,6 +307,28 @@ impl UsdStage {
             authored,
         })
     }
+}
+
+/// usd-core's value where openusd 0.8 has none between two samples: when the upper bracketing
+/// sample is a block and the lower is not, usd-core holds the lower sample's value up to the
+/// block; openusd treats any blocked bracket as no value.
+fn held_before_block(attr: &ousd::Attribute, tc: TimeCode) -> openusd::Result<Option<sdf::Value>> {
+    if tc.is_earliest_time() {
+        return Ok(None);
+    }
+    let t = tc.value();
+    let Some(samples) = attr.time_samples()? else {
+        return Ok(None);
+    };
+    let Some(hi) = samples.iter().position(|(st, _)| *st > t) else {
+        return Ok(None);
+    };
+    if hi == 0 {
+        return Ok(None);
+    }
+    let (t0, lower) = &samples[hi - 1];
+    let blocked = |v: &sdf::Value| matches!(v, sdf::Value::ValueBlock | sdf::Value::None);
+    Ok((*t0 < t && !blocked(lower) && blocked(&samples[hi].1)).then(|| lower.clone()))
 }
 
 /// Whether `prim` has an orient op with time samples (which interpolate between samples).

@@ -343,6 +343,11 @@ def Xform "World"
         float inputs:width.timeSamples = {
             2: 1,
         }
+        float inputs:exposure.timeSamples = {
+            1: 1,
+            2: None,
+            3: 3,
+        }
         double3 xformOp:translate.timeSamples = {
             1: (0, 0, 0),
             3: (2, 4, 6),
