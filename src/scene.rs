@@ -264,6 +264,9 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
     let r = Reader { p };
     let path = &p.path;
     let ty = p.usd_type.as_str();
+    if let Some(why) = &p.transform_error {
+        return Err(why.clone());
+    }
     if let Some(api) = &p.light_api {
         return Err(format!(
             "{path}: {api} lights (on a {ty} prim) are not supported yet"
@@ -375,6 +378,7 @@ mod tests {
             usd_type: ty.to_string(),
             applied_schemas: applied.iter().map(|s| s.to_string()).collect(),
             light_api: None,
+            transform_error: None,
             visible: true,
             world: [
                 [1.0, 0.0, 0.0, 0.0],

@@ -88,8 +88,11 @@ pub struct LightPrim {
     pub light_api: Option<String>,
     /// False when `visibility` is `invisible` on the prim or an imageable ancestor.
     pub visible: bool,
-    /// Local-to-world, USD row-vector convention.
+    /// Local-to-world, USD row-vector convention; every entry NaN when it cannot be computed.
     pub world: [[f64; 4]; 4],
+    /// Why `world` cannot be computed (e.g. `!invert!` of a singular `transform` op), naming
+    /// the prim; the light is then listed but not evaluated.
+    pub transform_error: Option<String>,
     /// Every attribute of `schema::attrs_for(usd_type, applied_schemas)`, in that order.
     pub inputs: Vec<Input>,
 }
@@ -258,12 +261,18 @@ impl UsdStage {
                 false => cache.local_to_world_transform(&site.prim),
                 true => world_with_usd_slerp(&mut cache, &site.prim, tc),
             };
-            let world: [[f64; 4]; 4] = world
-                .map_err(|err| LuxError::InvalidTransform {
-                    light: site.path.clone(),
-                    reason: format!("cannot be computed: {err}"),
-                })?
-                .into();
+            // One broken transform must not hide the stage's other lights: it is reported
+            // with the light instead of failing the load.
+            let (world, transform_error) = match world {
+                Ok(m) => (m.into(), None),
+                Err(err) => (
+                    [[f64::NAN; 4]; 4],
+                    Some(format!(
+                        "{}: world transform cannot be computed: {err}",
+                        site.path
+                    )),
+                ),
+            };
             let mut inputs = Vec::with_capacity(site.attrs.len());
             for a in &site.attrs {
                 inputs.push(self.input(site, a, tc)?);
@@ -275,6 +284,7 @@ impl UsdStage {
                 light_api: site.light_api.clone(),
                 visible,
                 world,
+                transform_error,
                 inputs,
             });
         }
@@ -754,7 +764,9 @@ mod tests {
     /// bit: the float and half results depend on where C++ rounds to the scalar type.
     #[test]
     fn usd_slerp_matches_gf_slerp() {
-        let cases: &[(Precision, f64, [f64; 4], [f64; 4], [f64; 4])] = &[
+        // (precision, alpha, q0, q1, usd-core result), quaternions as [w, x, y, z].
+        type Case = (Precision, f64, [f64; 4], [f64; 4], [f64; 4]);
+        let cases: &[Case] = &[
             (
                 Precision::FLOAT,
                 0.125,

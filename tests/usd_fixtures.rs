@@ -500,6 +500,23 @@ fn missing_or_malformed_layers_name_the_layer() {
     }
 }
 
+#[test]
+fn a_broken_transform_is_a_warning_not_a_failed_load() {
+    let scene = Scene::load(&data().join("usd/errors/singular_invert.usda"), None).unwrap();
+    let broken = &scene.lights[0];
+    assert_eq!(broken.path, "/World/Broken");
+    assert!(broken.light.is_none());
+    let w = broken.warning.as_deref().unwrap();
+    assert!(
+        w.starts_with("/World/Broken") && w.contains("singular"),
+        "{w}"
+    );
+    assert!(scene.warnings().iter().any(|x| x == w));
+    let lights = scene.evaluable(&[]).unwrap();
+    assert_eq!(lights.len(), 1);
+    assert_eq!(lights[0].path, "/World/Fine");
+}
+
 /// The .ies files are LM-63 with CRLF line endings; git must not have normalised them.
 #[test]
 fn ies_bytes_survive() {

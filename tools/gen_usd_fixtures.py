@@ -603,6 +603,15 @@ ERRORS = {
         "#usda 1.0\n\ndef Xform \"World\" (\n    prepend references = @malformed.usda@</World>\n)\n{\n}\n"
     ),
     "not_usd.usda": "this is not a USD file\n",
+    # One light whose transform cannot be computed (the inverse of a singular matrix) beside a
+    # healthy one: the first is listed with a warning, the second still evaluates.
+    "singular_invert.usda": (
+        "#usda 1.0\n\ndef Xform \"World\"\n{\n"
+        "    def SphereLight \"Broken\"\n    {\n"
+        "        matrix4d xformOp:transform = ( (1, 0, 0, 0), (0, 0, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1) )\n"
+        "        uniform token[] xformOpOrder = [\"!invert!xformOp:transform\"]\n    }\n"
+        "    def SphereLight \"Fine\"\n    {\n    }\n}\n"
+    ),
 }
 
 
