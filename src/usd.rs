@@ -16,9 +16,7 @@ use std::path::{Path, PathBuf};
 use openusd::usd::{self as ousd, PrimPredicate, TimeCode};
 use openusd::{gf, sdf};
 use openusd_schemas::SchemaError;
-use openusd_schemas::geom::{
-    Imageable, ImageableExt, Visibility, XformCache, XformOp, XformOpKind, Xformable, XformableExt,
-};
+use openusd_schemas::geom::{Imageable, XformCache, XformOp, XformOpKind, Xformable, XformableExt};
 
 use crate::error::{LuxError, Result};
 use crate::scene::{Input, Value};
@@ -105,9 +103,9 @@ struct LightSite {
     applied_schemas: Vec<String>,
     light_api: Option<String>,
     attrs: Vec<schema::SchemaAttr>,
-    /// The prim or an ancestor has a time-sampled orient op, which openusd interpolates
-    /// differently from usd-core (see [`usd_slerp`]); its world matrix is composed here.
-    slerp_chain: bool,
+    /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
+    /// usd-core between samples (see [`needs_own_xform`]); its world matrix is composed here.
+    own_xform_chain: bool,
 }
 
 /// An open stage and its light prims.
@@ -174,7 +172,7 @@ impl UsdStage {
         check_composition(path, &stage)?;
 
         let mut lights = Vec::new();
-        let mut sampled_orient: HashMap<String, bool> = HashMap::new();
+        let mut own_xform: HashMap<String, bool> = HashMap::new();
         for p in paths {
             let prim = stage.prim(&p).map_err(|err| e(err.into()))?;
             let usd_type = prim
@@ -201,19 +199,19 @@ impl UsdStage {
             };
             let applied: Vec<&str> = applied_schemas.iter().map(String::as_str).collect();
             let attrs = schema::attrs_for(&usd_type, &applied);
-            let mut slerp_chain = false;
+            let mut own_xform_chain = false;
             let mut cur = Some(prim.clone());
             while let Some(q) = cur.filter(|q| !q.path().is_abs_root()) {
                 let key = q.path().to_string();
-                let sampled = match sampled_orient.get(&key) {
-                    Some(s) => *s,
+                let own = match own_xform.get(&key) {
+                    Some(own) => *own,
                     None => {
-                        let s = has_sampled_orient(&q).map_err(|err| xform_error(&p, err))?;
-                        sampled_orient.insert(key, s);
-                        s
+                        let own = needs_own_xform(&q).map_err(|err| xform_error(&p, err))?;
+                        own_xform.insert(key, own);
+                        own
                     }
                 };
-                slerp_chain |= sampled;
+                own_xform_chain |= own;
                 cur = q.parent();
             }
             lights.push(LightSite {
@@ -223,7 +221,7 @@ impl UsdStage {
                 applied_schemas,
                 light_api,
                 attrs,
-                slerp_chain,
+                own_xform_chain,
             });
         }
         // Reading attributes can compose more (e.g. the prims an inherit arc names).
@@ -252,14 +250,10 @@ impl UsdStage {
         let mut cache = XformCache::new(tc);
         let mut out = Vec::with_capacity(self.lights.len());
         for site in &self.lights {
-            let visible = match Imageable::from_prim(site.prim.clone()).map_err(e)? {
-                Some(img) => img.compute_visibility(tc).map_err(e)? != Visibility::Invisible,
-                // A light that is not imageable has no visibility to turn it off.
-                None => true,
-            };
-            let world = match site.slerp_chain {
+            let visible = visible_at(&site.prim, tc).map_err(e)?;
+            let world = match site.own_xform_chain {
                 false => cache.local_to_world_transform(&site.prim),
-                true => world_with_usd_slerp(&mut cache, &site.prim, tc),
+                true => world_as_usd_core(&mut cache, &site.prim, tc),
             };
             // One broken transform must not hide the stage's other lights: it is reported
             // with the light instead of failing the load.
@@ -298,11 +292,7 @@ impl UsdStage {
         let attr = site.prim.attribute(a.name);
         let authored = attr.has_authored_value().map_err(e)?;
         let value = if authored {
-            let v = match attr.get_at::<sdf::Value>(tc).map_err(e)? {
-                Some(v) => Some(v),
-                None => held_before_block(&attr, tc).map_err(e)?,
-            };
-            match v {
+            match value_at(&attr, tc).map_err(e)? {
                 Some(v) => convert(&site.path, a, v)?,
                 // A blocked value at this time: usd-core reports no value at all; luxeval has
                 // to evaluate something, and a block means "no opinion", so the fallback.
@@ -319,36 +309,68 @@ impl UsdStage {
     }
 }
 
-/// usd-core's value where openusd 0.8 has none between two samples: when the upper bracketing
-/// sample is a block and the lower is not, usd-core holds the lower sample's value up to the
-/// block; openusd treats any blocked bracket as no value.
-fn held_before_block(attr: &ousd::Attribute, tc: TimeCode) -> openusd::Result<Option<sdf::Value>> {
-    if tc.is_earliest_time() {
-        return Ok(None);
+/// `attr`'s value at `tc` as usd-core resolves it: openusd's, except where openusd has none
+/// and usd-core holds the sample before a block (see [`held_before_block`]). `None` where
+/// usd-core has no value either (a blocked value).
+fn value_at(attr: &ousd::Attribute, tc: TimeCode) -> openusd::Result<Option<sdf::Value>> {
+    if let Some(v) = attr.get_at::<sdf::Value>(tc)? {
+        return Ok(Some(v));
     }
-    let t = tc.value();
     let Some(samples) = attr.time_samples()? else {
         return Ok(None);
     };
-    let Some(hi) = samples.iter().position(|(st, _)| *st > t) else {
-        return Ok(None);
-    };
-    if hi == 0 {
-        return Ok(None);
-    }
-    let (t0, lower) = &samples[hi - 1];
-    let blocked = |v: &sdf::Value| matches!(v, sdf::Value::ValueBlock | sdf::Value::None);
-    Ok((*t0 < t && !blocked(lower) && blocked(&samples[hi].1)).then(|| lower.clone()))
+    Ok(held_before_block(&samples, tc).map(|i| samples[i].1.clone()))
 }
 
-/// Whether `prim` has an orient op with time samples (which interpolate between samples).
-fn has_sampled_orient(prim: &ousd::Prim) -> std::result::Result<bool, SchemaError> {
+fn is_blocked(v: &sdf::Value) -> bool {
+    matches!(v, sdf::Value::ValueBlock | sdf::Value::None)
+}
+
+/// The index of the sample usd-core holds at `tc` where openusd 0.8 has no value: `tc` lies
+/// strictly between two samples, the upper a block and the lower not. usd-core holds the lower
+/// sample up to the block; openusd treats any blocked bracket as no value.
+fn held_before_block(samples: &sdf::TimeSampleMap, tc: TimeCode) -> Option<usize> {
+    if tc.is_earliest_time() {
+        return None;
+    }
+    let t = tc.value();
+    let hi = samples.iter().position(|(st, _)| *st > t)?;
+    let lo = hi.checked_sub(1)?;
+    (samples[lo].0 < t && !is_blocked(&samples[lo].1) && is_blocked(&samples[hi].1)).then_some(lo)
+}
+
+/// `visibility` as usd-core's `UsdGeomImageable::ComputeVisibility` resolves it: invisible when
+/// the prim or any imageable ancestor reads `invisible` at `tc` (values read with
+/// [`value_at`], so a sample held before a block counts as usd-core counts it).
+fn visible_at(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<bool> {
+    let mut cur = Some(prim.clone());
+    while let Some(p) = cur.filter(|p| !p.path().is_abs_root()) {
+        // An opinion on a prim that is not imageable (an untyped prim) is ignored, as in C++.
+        if Imageable::from_prim(p.clone())?.is_some()
+            && let Some(v) = value_at(&p.attribute("visibility"), tc)?
+            && v.as_str() == Some("invisible")
+        {
+            return Ok(false);
+        }
+        cur = p.parent();
+    }
+    Ok(true)
+}
+
+/// Whether `prim` has an xformOp openusd 0.8 evaluates differently from usd-core between
+/// samples: a time-sampled orient (see [`usd_slerp`]), or any op with a blocked sample (see
+/// [`held_before_block`]).
+fn needs_own_xform(prim: &ousd::Prim) -> std::result::Result<bool, SchemaError> {
     let Some(x) = Xformable::from_prim(prim.clone())? else {
         return Ok(false);
     };
     let (ops, _) = x.ordered_xform_ops()?;
     for op in &ops {
-        if op.kind() == Some(XformOpKind::Orient) && op.attribute().num_time_samples()? > 1 {
+        let Some(samples) = op.attribute().time_samples()? else {
+            continue;
+        };
+        let orient = op.kind() == Some(XformOpKind::Orient) && samples.len() > 1;
+        if orient || samples.iter().any(|(_, v)| is_blocked(v)) {
             return Ok(true);
         }
     }
@@ -363,10 +385,10 @@ fn xform_error(path: &sdf::Path, err: impl std::fmt::Display) -> LuxError {
 }
 
 /// The local-to-world matrix of `prim` as usd-core's XformCache computes it, for a prim whose
-/// chain holds a time-sampled orient op: the local transforms of the chain composed as
+/// chain holds an op of [`needs_own_xform`]: the local transforms of the chain composed as
 /// openusd's XformCache does (row-vector, `local * parent`, stopping at `!resetXformStack!`),
-/// with the prims that own such an op evaluated by [`local_with_usd_slerp`].
-fn world_with_usd_slerp(
+/// with the prims that own such an op evaluated by [`local_as_usd_core`].
+fn world_as_usd_core(
     cache: &mut XformCache,
     prim: &ousd::Prim,
     tc: TimeCode,
@@ -374,8 +396,8 @@ fn world_with_usd_slerp(
     let mut world = gf::Matrix4d::IDENTITY;
     let mut cur = Some(prim.clone());
     while let Some(p) = cur.filter(|p| !p.path().is_abs_root()) {
-        let (local, resets) = match has_sampled_orient(&p)? {
-            true => local_with_usd_slerp(&p, tc)?,
+        let (local, resets) = match needs_own_xform(&p)? {
+            true => local_as_usd_core(&p, tc)?,
             false => cache.local_transformation(&p)?,
         };
         world = world * local;
@@ -389,8 +411,9 @@ fn world_with_usd_slerp(
 
 /// `prim`'s local transform at `tc`, op by op as openusd's XformQuery composes it (an op beside
 /// its own inverse is skipped with it), except that an orient op between two time samples is
-/// interpolated with [`usd_slerp`].
-fn local_with_usd_slerp(
+/// interpolated with [`usd_slerp`], and an op held before a blocked sample is evaluated at the
+/// held sample.
+fn local_as_usd_core(
     prim: &ousd::Prim,
     tc: TimeCode,
 ) -> std::result::Result<(gf::Matrix4d, bool), SchemaError> {
@@ -421,7 +444,13 @@ fn local_with_usd_slerp(
                 };
                 gf::Matrix4d::from_quat(rotation.quat())
             }
-            None => op.op_transform(tc)?,
+            None => match op.attribute().time_samples()? {
+                Some(samples) => match held_before_block(&samples, tc) {
+                    Some(i) => op.op_transform(TimeCode::new(samples[i].0))?,
+                    None => op.op_transform(tc)?,
+                },
+                None => op.op_transform(tc)?,
+            },
         };
         m = m * op_matrix;
     }

@@ -390,6 +390,21 @@ def Xform "World"
         }
     }
 
+    def SphereLight "Blocked"
+    {
+        double3 xformOp:translate.timeSamples = {
+            1: (1, 0, 0),
+            2: None,
+            3: (3, 0, 0),
+        }
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+        token visibility.timeSamples = {
+            1: "invisible",
+            2: None,
+            3: "inherited",
+        }
+    }
+
     def Xform "Hidden"
     {
         token visibility = "invisible"
