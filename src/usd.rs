@@ -199,6 +199,9 @@ impl UsdStage {
             };
             let applied: Vec<&str> = applied_schemas.iter().map(String::as_str).collect();
             let attrs = schema::attrs_for(&usd_type, &applied);
+            for a in &attrs {
+                reject_spline(&p, &prim.attribute(a.name))?;
+            }
             let mut own_xform_chain = false;
             let mut cur = Some(prim.clone());
             while let Some(q) = cur.filter(|q| !q.path().is_abs_root()) {
@@ -206,6 +209,13 @@ impl UsdStage {
                 let own = match own_xform.get(&key) {
                     Some(own) => *own,
                     None => {
+                        if let Some(x) = Xformable::from_prim(q.clone()).map_err(e)? {
+                            let (ops, _) =
+                                x.ordered_xform_ops().map_err(|err| xform_error(&p, err))?;
+                            for op in &ops {
+                                reject_spline(&p, op.attribute())?;
+                            }
+                        }
                         let own = needs_own_xform(&q).map_err(|err| xform_error(&p, err))?;
                         own_xform.insert(key, own);
                         own
@@ -307,6 +317,39 @@ impl UsdStage {
             authored,
         })
     }
+}
+
+/// openusd 0.8 parses a spline-valued attribute (`float x.spline = {...}`, USD 25.05+) but
+/// resolves it as unauthored, so its value would silently be the fallback; usd-core evaluates
+/// the spline. Refuse it, naming the light and attribute. (In a usdc file openusd cannot even
+/// decode the spline field, which is reported the same way.)
+fn reject_spline(light: &sdf::Path, attr: &ousd::Attribute) -> Result<()> {
+    let spline = match attr.has_authored_metadata("spline") {
+        Ok(spline) => spline,
+        Err(err) => {
+            // Only a spline field fails to decode this way; anything else is a real error.
+            let text = err.to_string();
+            if !format!("{err:?}").contains("\"spline\"") {
+                return Err(LuxError::InvalidAttribute {
+                    light: light.to_string(),
+                    attr: attr.name().to_string(),
+                    value: "?".into(),
+                    reason: format!("cannot be read: {text}"),
+                });
+            }
+            true
+        }
+    };
+    if spline {
+        return Err(LuxError::attr(
+            &light.to_string(),
+            attr.name(),
+            "(spline)",
+            "spline-valued attributes are not supported (openusd 0.8 does not evaluate them); \
+             bake the spline to timeSamples",
+        ));
+    }
+    Ok(())
 }
 
 /// `attr`'s value at `tc` as usd-core resolves it: openusd's, except where openusd has none

@@ -517,6 +517,39 @@ fn a_broken_transform_is_a_warning_not_a_failed_load() {
     assert_eq!(lights[0].path, "/World/Fine");
 }
 
+/// usd-core evaluates splines; openusd 0.8 reads them as unauthored, so they are refused with
+/// the light and attribute named rather than silently replaced by the fallback.
+#[test]
+fn splines_are_refused_naming_the_attribute() {
+    let errs = data().join("usd/errors");
+    for (file, attr) in [
+        ("spline_input.usda", "inputs:intensity"),
+        ("spline_input.usdc", "inputs:intensity"),
+        ("spline_xform.usda", "xformOp:rotateX"),
+    ] {
+        match Scene::load(&errs.join(file), None) {
+            Err(LuxError::InvalidAttribute {
+                light,
+                attr: a,
+                reason,
+                ..
+            }) => {
+                assert_eq!(
+                    light,
+                    if file.contains("xform") {
+                        "/Rig/L"
+                    } else {
+                        "/L"
+                    }
+                );
+                assert_eq!(a, attr, "{file}");
+                assert!(reason.contains("spline"), "{file}: {reason}");
+            }
+            other => panic!("{file}: {other:?}"),
+        }
+    }
+}
+
 /// The .ies files are LM-63 with CRLF line endings; git must not have normalised them.
 #[test]
 fn ies_bytes_survive() {

@@ -618,6 +618,17 @@ ERRORS = {
         "#usda 1.0\n\ndef Xform \"World\" (\n    prepend references = @malformed.usda@</World>\n)\n{\n}\n"
     ),
     "not_usd.usda": "this is not a USD file\n",
+    # Splines (USD 25.05+), which usd-core evaluates and openusd 0.8 does not.
+    "spline_input.usda": (
+        "#usda 1.0\n\ndef SphereLight \"L\"\n{\n    float inputs:intensity.spline = {\n"
+        "        bezier,\n        1: 10; post held,\n        3: 30,\n    }\n}\n"
+    ),
+    "spline_xform.usda": (
+        "#usda 1.0\n\ndef Xform \"Rig\"\n{\n    double xformOp:rotateX.spline = {\n"
+        "        bezier,\n        1: 0,\n        3: 90,\n    }\n"
+        "    uniform token[] xformOpOrder = [\"xformOp:rotateX\"]\n\n"
+        "    def SphereLight \"L\"\n    {\n    }\n}\n"
+    ),
     # One light whose transform cannot be computed (the inverse of a singular matrix) beside a
     # healthy one: the first is listed with a warning, the second still evaluates.
     "singular_invert.usda": (
@@ -711,6 +722,11 @@ def write_composition():
         shutil.rmtree(errs)
     for name, text in ERRORS.items():
         write(os.path.join(errs, name), text)
+    # The spline scene as usd-core's crate writer stores it (crate version 0.12).
+    if not Sdf.Layer.FindOrOpen(os.path.join(errs, "spline_input.usda")).Export(
+        os.path.join(errs, "spline_input.usdc")
+    ):
+        sys.exit("exporting spline_input.usdc failed")
 
 
 # ---------------------------------------------------------------------------------------------
