@@ -7,8 +7,17 @@
 //! means to luxeval is decided in [`crate::scene`].
 //!
 //! Value resolution and transforms are openusd's, checked against Pixar's usd-core in
-//! `tests/usd_fixtures.rs`. Fallbacks of unauthored attributes come from luxeval's schema table,
-//! not from openusd's registry, so there is exactly one table of them.
+//! `tests/usd_fixtures.rs`, except where openusd 0.8 gives other numbers than usd-core; there
+//! this module computes what usd-core does:
+//! - a time-sampled `orient` op between samples: usd-core's `GfSlerp` rounds to the
+//!   quaternion's scalar type ([`usd_slerp`]);
+//! - between a sample and a blocked one: usd-core holds the lower sample ([`held_before_block`]),
+//!   for inputs, xformOps and `visibility` alike;
+//! - spline-valued attributes, which openusd reads as unauthored, are refused
+//!   ([`reject_spline`]).
+//!
+//! Fallbacks of unauthored attributes come from luxeval's schema table, not from openusd's
+//! registry, so there is exactly one table of them.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -123,10 +132,18 @@ impl UsdStage {
     /// sublayer, reference or payload that cannot be found or read is an error naming that layer.
     pub fn open(path: &Path) -> Result<UsdStage> {
         // The filesystem's own error (not found, permission denied) is the clearest message.
-        std::fs::File::open(path).map_err(|source| LuxError::Io {
+        let io = |source| LuxError::Io {
             path: path.to_path_buf(),
             source,
-        })?;
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if meta.is_dir() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a directory, not a USD file",
+            )));
+        }
+        std::fs::File::open(path).map_err(io)?;
         let name = path.to_str().ok_or_else(|| LuxError::Format {
             path: path.to_path_buf(),
             line: None,

@@ -475,6 +475,12 @@ fn missing_file_is_an_io_error() {
 }
 
 #[test]
+fn a_directory_is_an_io_error() {
+    let dir = data().join("usd");
+    assert!(matches!(Scene::load(&dir, None), Err(LuxError::Io { path, .. }) if path == dir));
+}
+
+#[test]
 fn missing_or_malformed_layers_name_the_layer() {
     let errs = data().join("usd/errors");
     let e = Scene::load(&errs.join("missing_reference.usda"), None).unwrap_err();
@@ -553,15 +559,22 @@ fn splines_are_refused_naming_the_attribute() {
 /// The .ies files are LM-63 with CRLF line endings; git must not have normalised them.
 #[test]
 fn ies_bytes_survive() {
-    for (name, len) in [
-        ("luxtest/test_linear_vertical.ies", 329),
-        ("luxtest/test_stripes_uniform.ies", 3075),
-        (
-            "luxtest/test_vstripes_hquadrants_nonuniform_aimUp.ies",
-            2203,
-        ),
-    ] {
-        let bytes = std::fs::read(data().join(name)).unwrap();
+    // Sizes from research/data/README.md (the CRLF originals).
+    let luxtest = [
+        ("test_linear_vertical.ies", 329),
+        ("test_stripes_uniform.ies", 3075),
+        ("test_stripes_nonuniform.ies", 999),
+        ("test_vstripes_hquadrants_nonuniform.ies", 3356),
+        ("test_vstripes_hquadrants_nonuniform_aimDown.ies", 2202),
+        ("test_vstripes_hquadrants_nonuniform_aimUp.ies", 2203),
+    ];
+    let ours = ("usd/composition/ies/spot.ies".to_string(), 139);
+    for (name, len) in luxtest
+        .iter()
+        .map(|(n, l)| (format!("luxtest/{n}"), *l))
+        .chain([ours])
+    {
+        let bytes = std::fs::read(data().join(&name)).unwrap();
         assert_eq!(bytes.len(), len, "{name}");
         let lf = bytes.iter().filter(|&&b| b == b'\n').count();
         let crlf = bytes.windows(2).filter(|w| w == b"\r\n").count();
