@@ -98,14 +98,14 @@ impl Scene {
     /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
     /// else at USD's EarliestTime (DESIGN.md §2).
     pub fn load(path: &Path, time: Option<f64>) -> Result<Scene> {
+        if let Some(t) = time.filter(|t| !t.is_finite()) {
+            return Err(LuxError::input(
+                "--time",
+                format!("{t} is not a finite time code"),
+            ));
+        }
         let stage = UsdStage::open(path)?;
         let rule = match time {
-            Some(t) if !t.is_finite() => {
-                return Err(LuxError::input(
-                    "--time",
-                    format!("{t} is not a finite time code"),
-                ));
-            }
             Some(t) => TimeRule::Given(t),
             None => match stage.info().start_time_code {
                 Some(start) => TimeRule::StartTimeCode(start),
@@ -136,7 +136,19 @@ impl Scene {
     pub fn evaluable(&self, select: &[String]) -> Result<Vec<Light>> {
         for path in select {
             if !self.lights.iter().any(|l| &l.path == path) {
-                let known: Vec<&str> = self.lights.iter().map(|l| l.path.as_str()).collect();
+                // Name a few of the stage's lights to help spot a typo, not thousands.
+                const SHOWN: usize = 8;
+                let mut known: Vec<&str> = self
+                    .lights
+                    .iter()
+                    .take(SHOWN)
+                    .map(|l| l.path.as_str())
+                    .collect();
+                let more = self.lights.len().saturating_sub(SHOWN);
+                let more = format!("{more} more");
+                if self.lights.len() > SHOWN {
+                    known.push(&more);
+                }
                 return Err(LuxError::input(
                     "--light",
                     format!(
