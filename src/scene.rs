@@ -280,8 +280,12 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
         return Err(why.clone());
     }
     if let Some(api) = &p.light_api {
+        let on = match ty {
+            "" => "an untyped prim".to_string(),
+            ty => format!("a {ty} prim"),
+        };
         return Err(format!(
-            "{path}: {api} lights (on a {ty} prim) are not supported yet"
+            "{path}: {api} lights (on {on}) are not supported yet"
         ));
     }
     let kind = match ty {
