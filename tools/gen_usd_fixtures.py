@@ -29,9 +29,10 @@ import os
 import shutil
 import struct
 import sys
+import zipfile
 import zlib
 
-from pxr import Gf, Sdf, Usd, UsdGeom, UsdUtils, Vt
+from pxr import Sdf, Usd, UsdGeom, UsdUtils
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -657,6 +658,30 @@ def png_bytes(width, height, rgb):
     )
 
 
+def pin_zip_timestamps(path):
+    """Sets every entry's DOS modification time to 1980-01-01 00:00 in place, so that
+    regenerating a usdz gives the same bytes. Only the time/date fields change: sizes, offsets
+    and the 64-byte data alignment usdz requires stay as usd-core wrote them."""
+    with open(path, "r+b") as f:
+        data = bytearray(f.read())
+        infos = zipfile.ZipFile(path).infolist()
+        for info in infos:
+            o = info.header_offset
+            assert data[o:o + 4] == b"PK\x03\x04", path
+            data[o + 10:o + 14] = struct.pack("<HH", 0, 0x21)
+        eocd = data.rindex(b"PK\x05\x06")
+        count, _, cd = struct.unpack_from("<HII", data, eocd + 10)
+        assert count == len(infos), path
+        o = cd
+        for _ in range(count):
+            assert data[o:o + 4] == b"PK\x01\x02", path
+            data[o + 12:o + 16] = struct.pack("<HH", 0, 0x21)
+            n, m, k = struct.unpack_from("<HHH", data, o + 28)
+            o += 46 + n + m + k
+        f.seek(0)
+        f.write(data)
+
+
 def write(path, data):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     mode = "wb" if isinstance(data, bytes) else "w"
@@ -714,6 +739,8 @@ def write_composition():
         # profile it references from outside its folder, renaming paths as it sees fit.
         if not UsdUtils.CreateNewUsdzPackage(Sdf.AssetPath("rig/rig.usda"), "rig_packaged.usdz"):
             sys.exit("CreateNewUsdzPackage failed")
+        for pkg in ("scene.usdz", "rig_packaged.usdz"):
+            pin_zip_timestamps(pkg)
     finally:
         os.chdir(cwd)
 
