@@ -13,6 +13,7 @@
 //! - for radiance, a shape's silhouette: the hit point or the closest approach within `BAND` of
 //!   the boundary (as a fraction of the shape's size), grazing rays, and ray origins within
 //!   `BAND` of the surface.
+//!
 //! Everything else must be within tolerance.
 
 use glam::{DMat4, DQuat, DVec3};

@@ -28,6 +28,9 @@
 //! # Ok::<(), luxeval::LuxError>(())
 //! ```
 
+// Comparisons written `!(x > y)` reject NaN on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod check;
 pub mod cpu;
 pub mod error;
@@ -36,7 +39,9 @@ pub mod gpu;
 pub mod io;
 pub mod light;
 pub mod query;
+pub mod scene;
 pub mod schema;
+pub mod usd;
 
 /// Compiles and runs the README's examples as doctests.
 #[cfg(doctest)]
@@ -47,3 +52,4 @@ pub use cpu::TemperatureMode;
 pub use error::{LuxError, Result};
 pub use light::{Light, LightInputs, LightType, Shaping};
 pub use query::{Accumulate, Backend, Evaluator};
+pub use scene::Scene;

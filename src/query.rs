@@ -14,7 +14,7 @@ pub enum Backend {
     /// The f64 CPU reference (rayon-parallel), rounded to f32 on output.
     Cpu,
     /// A wgpu compute device.
-    Gpu(GpuContext),
+    Gpu(Box<GpuContext>),
 }
 
 /// Sum the lights per sample, or keep one row per (light, sample).
@@ -46,7 +46,7 @@ impl Evaluator {
     /// A GPU evaluator on the default adapter (see [`GpuContext::new`]).
     pub fn gpu() -> Result<Self> {
         Ok(Evaluator {
-            backend: Backend::Gpu(GpuContext::new()?),
+            backend: Backend::Gpu(Box::new(GpuContext::new()?)),
             temperature_mode: TemperatureMode::default(),
         })
     }
@@ -54,7 +54,7 @@ impl Evaluator {
     /// A GPU evaluator on an existing context.
     pub fn from_context(gpu: GpuContext) -> Self {
         Evaluator {
-            backend: Backend::Gpu(gpu),
+            backend: Backend::Gpu(Box::new(gpu)),
             temperature_mode: TemperatureMode::default(),
         }
     }

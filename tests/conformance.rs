@@ -16,7 +16,7 @@ use luxeval::{Accumulate, Evaluator, Light, TemperatureMode};
 #[test]
 fn gpu_matches_cpu_on_randomised_lights() {
     let Some(gpu) = common::gpu() else { return };
-    let device = format!("{}", gpu.adapter().name);
+    let device = gpu.adapter().name.to_string();
     let mut rng = Rng::new(0x1A7E_5EED);
     let lights = random_lights(&mut rng, 6); // 6 types × 7 transforms × 6 = 252 lights
     let samples_per_query = 200;

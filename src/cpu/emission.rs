@@ -178,6 +178,7 @@ mod tests {
     /// reference/luxtest.md §6 A4 as emission values: cone 30°, softness 0 / 0.5 / 1 and focus 2
     /// (tint black), I(θ)/I0 = S(θ); the table's E = I0·S(θ)·cos³θ/h² with h = 1.
     #[test]
+    #[allow(clippy::approx_constant)] // 0.785398 is the table's I0 = L·π·r², as printed there
     fn a4_cone_and_focus_factors() {
         let i0 = 0.785398;
         let rows: [(f64, [f64; 4]); 6] = [

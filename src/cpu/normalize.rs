@@ -95,6 +95,7 @@ pub fn ellipse_perimeter(a: f64, b: f64) -> f64 {
     8.0 * carlson_rg(0.0, a * a, b * b)
 }
 
+#[allow(clippy::needless_range_loop)] // index form mirrors the rotation formulas
 /// Singular values of a 3×3 matrix: square roots of the eigenvalues of `mᵀm` (cyclic Jacobi).
 pub fn singular_values(m: DMat3) -> DVec3 {
     let ata = m.transpose() * m;

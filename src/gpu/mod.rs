@@ -172,8 +172,10 @@ impl GpuContext {
 
     /// The largest number of samples one dispatch handles for `lights` lights.
     pub fn chunk_capacity(&self, lights: usize, per_light: bool) -> usize {
-        let binding =
-            (self.limits.max_storage_buffer_binding_size as u64).min(self.limits.max_buffer_size);
+        let binding = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
         // Keep each buffer at most 256 MiB so that host and device memory stay bounded.
         let budget = binding.min(256 << 20);
         let rows = if per_light { lights.max(1) as u64 } else { 1 };
@@ -201,7 +203,7 @@ impl GpuContext {
             return Ok(out);
         }
         let record_bytes = std::mem::size_of_val(records) as u64;
-        if record_bytes > self.limits.max_storage_buffer_binding_size as u64 {
+        if record_bytes > self.limits.max_storage_buffer_binding_size {
             return Err(LuxError::input(
                 "lights",
                 format!(
@@ -253,7 +255,7 @@ impl GpuContext {
         let out_bytes = (chunk * rows * 12) as u64;
         let light_buf = storage(
             "lights",
-            (lights * std::mem::size_of::<LightRecord>()) as u64,
+            std::mem::size_of_val(records) as u64,
             wgpu::BufferUsages::COPY_DST,
         );
         self.queue

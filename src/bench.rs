@@ -1,0 +1,145 @@
+//! `luxeval bench`: throughput of the GPU and CPU paths of every query, measured in one run so
+//! that the GPU/CPU ratio is meaningful on this machine. Times are end to end (upload, dispatch,
+//! readback for the GPU; the rayon-parallel f64 reference for the CPU).
+
+use std::time::{Duration, Instant};
+
+use clap::Args;
+
+use luxeval::check::{Rng, synthetic_lights};
+use luxeval::{Accumulate, Evaluator};
+
+use crate::{CliResult, Failure};
+
+#[derive(Args)]
+pub struct BenchArgs {
+    /// Samples per GPU run.
+    #[arg(long, default_value_t = 1 << 20)]
+    samples: usize,
+    /// Samples per CPU run (the reference is slower; throughput is per sample).
+    #[arg(long, default_value_t = 1 << 16)]
+    cpu_samples: usize,
+    /// Lights in the synthetic scene (a mix of every analytic type, shaped and not).
+    #[arg(long, default_value_t = 16)]
+    lights: usize,
+    /// Timed repetitions per measurement; the median is reported.
+    #[arg(long, default_value_t = 5)]
+    repeat: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(serde::Serialize)]
+struct Row {
+    query: &'static str,
+    device: String,
+    lights: usize,
+    samples: usize,
+    median_seconds: f64,
+    /// (light, sample) evaluations per second.
+    evals_per_second: f64,
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn time(repeat: usize, mut f: impl FnMut() -> luxeval::Result<()>) -> luxeval::Result<Duration> {
+    f()?; // warm-up: pipelines, allocations, caches
+    let mut times = Vec::with_capacity(repeat);
+    for _ in 0..repeat.max(1) {
+        let t = Instant::now();
+        f()?;
+        times.push(t.elapsed());
+    }
+    Ok(median(times))
+}
+
+pub fn run(args: BenchArgs) -> CliResult {
+    if args.samples == 0 || args.cpu_samples == 0 || args.lights == 0 {
+        return Err(Failure {
+            code: 2,
+            message: "--samples, --cpu-samples and --lights must be at least 1".into(),
+        });
+    }
+    let lights = synthetic_lights(args.lights);
+    let mut rng = Rng::new(7);
+    let n = args.samples.max(args.cpu_samples);
+    let dirs: Vec<[f32; 3]> = (0..n).map(|_| rng.unit().as_vec3().to_array()).collect();
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|_| (rng.unit() * rng.range(0.5, 6.0)).as_vec3().to_array())
+        .collect();
+
+    let mut evaluators = vec![(Evaluator::cpu(), args.cpu_samples)];
+    match Evaluator::gpu() {
+        Ok(g) => evaluators.insert(0, (g, args.samples)),
+        Err(e) => eprintln!("warning: no GPU ({e}); measuring the CPU only"),
+    }
+    let mut rows = Vec::new();
+    for (eval, m) in &evaluators {
+        let (d, p) = (&dirs[..*m], &points[..*m]);
+        for query in ["emission", "radiance"] {
+            let t = time(args.repeat, || {
+                match query {
+                    "emission" => eval.emission(&lights, d, Accumulate::Sum)?,
+                    _ => eval.radiance(&lights, p, d, Accumulate::Sum)?,
+                };
+                Ok(())
+            })?;
+            rows.push(Row {
+                query,
+                device: eval.device_name(),
+                lights: lights.len(),
+                samples: *m,
+                median_seconds: t.as_secs_f64(),
+                evals_per_second: (*m * lights.len()) as f64 / t.as_secs_f64(),
+            });
+        }
+    }
+    if args.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&rows).map_err(|e| Failure::runtime(e.to_string()))?
+        );
+        return Ok(());
+    }
+    outln!(
+        "{:<10} {:<44} {:>7} {:>9} {:>12} {:>16}",
+        "query",
+        "device",
+        "lights",
+        "samples",
+        "median s",
+        "evals/s"
+    );
+    for r in &rows {
+        outln!(
+            "{:<10} {:<44} {:>7} {:>9} {:>12.6} {:>16.4e}",
+            r.query,
+            r.device,
+            r.lights,
+            r.samples,
+            r.median_seconds,
+            r.evals_per_second
+        );
+    }
+    if evaluators.len() == 2 {
+        for query in ["emission", "radiance"] {
+            let g = rows
+                .iter()
+                .find(|r| r.query == query && !r.device.starts_with("cpu"));
+            let c = rows
+                .iter()
+                .find(|r| r.query == query && r.device.starts_with("cpu"));
+            if let (Some(g), Some(c)) = (g, c) {
+                outln!(
+                    "{query}: GPU/CPU throughput ratio {:.1}× (same run)",
+                    g.evals_per_second / c.evals_per_second
+                );
+            }
+        }
+    }
+    Ok(())
+}

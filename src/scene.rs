@@ -1,0 +1,606 @@
+//! The resolved scene: every light of a USD stage at one time, as plain data, and the subset
+//! luxeval evaluates as [`Light`]s.
+//!
+//! [`crate::usd`] reads the stage (it is the only module that sees openusd); this module decides
+//! what each light means to luxeval: which types it evaluates, which it lists with a warning, and
+//! which time the stage is read at (DESIGN.md §2 "Query time").
+
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use serde::Serialize;
+
+use crate::error::{LuxError, Result};
+use crate::light::{Light, LightInputs, LightType, Shaping};
+use crate::usd::{self, UsdStage};
+
+/// A resolved input value, typed as the schema table types its fallback.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Value {
+    Float(f64),
+    Bool(bool),
+    Color([f64; 3]),
+    Token(String),
+    /// An `asset` input: the path as authored (empty when unauthored) and the path it resolves
+    /// to, anchored to the layer that authored it (`/abs/pkg.usdz[inner/path]` inside a usdz);
+    /// `None` where it resolves to no existing file.
+    Asset {
+        authored: String,
+        resolved: Option<String>,
+    },
+}
+
+/// One input of a light: its resolved value and whether any layer authors it (a default or time
+/// samples); an unauthored input holds the schema fallback of [`crate::schema`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Input {
+    pub name: String,
+    pub value: Value,
+    pub authored: bool,
+}
+
+/// Which time the stage was read at.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "rule", content = "time", rename_all = "snake_case")]
+pub enum TimeRule {
+    /// `--time T`.
+    Given(f64),
+    /// The stage's authored `startTimeCode`, as usdview opens a stage.
+    StartTimeCode(f64),
+    /// USD's EarliestTime: each attribute at its earliest time sample, or its default when it has
+    /// none.
+    Earliest,
+}
+
+/// One light of the stage, listed whether or not luxeval evaluates it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SceneLight {
+    pub path: String,
+    /// The prim's USD type, e.g. `SphereLight`, `DomeLight_1`, or `Mesh` for a MeshLightAPI prim.
+    pub usd_type: String,
+    pub applied_schemas: Vec<String>,
+    pub visible: bool,
+    /// Local-to-world, USD row-vector convention (`world[3]` is the translation).
+    pub world: [[f64; 4]; 4],
+    /// Every attribute of [`crate::schema::attrs_for`] in its order.
+    pub inputs: Vec<Input>,
+    /// `Some` where luxeval evaluates the light (also when it is invisible). Serialized as the
+    /// boolean `evaluable`.
+    #[serde(rename = "evaluable", serialize_with = "serialize_is_some")]
+    pub light: Option<Light>,
+    /// Why the light is not evaluated, or a caveat about how it is; names the prim.
+    pub warning: Option<String>,
+}
+
+fn serialize_is_some<S: serde::Serializer>(
+    light: &Option<Light>,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    s.serialize_bool(light.is_some())
+}
+
+/// A stage's lights at one time.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Scene {
+    pub file: PathBuf,
+    /// `Y` or `Z`; `Y` when the stage does not author it, as USD does.
+    pub up_axis: String,
+    /// 0.01 when the stage does not author it, as USD does.
+    pub meters_per_unit: f64,
+    pub time: TimeRule,
+    /// In stage traversal order (depth-first, USD child order).
+    pub lights: Vec<SceneLight>,
+}
+
+/// Prints a value that came from a USD `float` as that float's shortest form (0.95, not
+/// 0.949999988079071); genuine doubles print in full.
+struct Short(f64);
+
+impl std::fmt::Display for Short {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let single = self.0 as f32;
+        if single as f64 == self.0 {
+            write!(f, "{single}")
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
+impl std::fmt::Display for Value {
+    /// The value as `luxeval lights` prints it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Value::Float(v) => write!(f, "{}", Short(*v)),
+            Value::Bool(v) => write!(f, "{v}"),
+            Value::Color([r, g, b]) => write!(f, "({}, {}, {})", Short(*r), Short(*g), Short(*b)),
+            Value::Token(t) => write!(f, "{t:?}"),
+            Value::Asset { authored, .. } if authored.is_empty() => write!(f, "@@"),
+            Value::Asset {
+                authored,
+                resolved: Some(r),
+            } => write!(f, "@{authored}@ -> {r}"),
+            Value::Asset {
+                authored,
+                resolved: None,
+            } => write!(f, "@{authored}@ (unresolved)"),
+        }
+    }
+}
+
+impl std::fmt::Display for TimeRule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TimeRule::Given(t) => write!(f, "{t} (--time)"),
+            TimeRule::StartTimeCode(t) => write!(f, "{t} (the stage's startTimeCode)"),
+            TimeRule::Earliest => write!(f, "earliest (each attribute's earliest time sample)"),
+        }
+    }
+}
+
+impl Scene {
+    /// Opens `path` (`.usda`, `.usdc`, `.usdz`) with every composition arc and payload loaded and
+    /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
+    /// else at USD's EarliestTime (DESIGN.md §2).
+    pub fn load(path: &Path, time: Option<f64>) -> Result<Scene> {
+        if let Some(t) = time.filter(|t| !t.is_finite()) {
+            return Err(LuxError::input(
+                "--time",
+                format!("{t} is not a finite time code"),
+            ));
+        }
+        let stage = UsdStage::open(path)?;
+        let rule = match time {
+            Some(t) => TimeRule::Given(t),
+            None => match stage.info().start_time_code {
+                Some(start) => TimeRule::StartTimeCode(start),
+                None => TimeRule::Earliest,
+            },
+        };
+        let at = match rule {
+            TimeRule::Given(t) | TimeRule::StartTimeCode(t) => usd::Time::Code(t),
+            TimeRule::Earliest => usd::Time::Earliest,
+        };
+        let lights = stage
+            .lights_at(at)?
+            .into_iter()
+            .map(SceneLight::from_prim)
+            .collect();
+        let info = stage.info();
+        Ok(Scene {
+            file: path.to_path_buf(),
+            up_axis: info.up_axis.clone(),
+            meters_per_unit: info.meters_per_unit,
+            time: rule,
+            lights,
+        })
+    }
+
+    /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
+    /// non-empty, and a selected path that is not a light of the stage is an error naming it.
+    pub fn evaluable(&self, select: &[String]) -> Result<Vec<Light>> {
+        for path in select {
+            if !self.lights.iter().any(|l| &l.path == path) {
+                // Name a few of the stage's lights to help spot a typo, not thousands.
+                const SHOWN: usize = 8;
+                let mut known: Vec<&str> = self
+                    .lights
+                    .iter()
+                    .take(SHOWN)
+                    .map(|l| l.path.as_str())
+                    .collect();
+                let more = self.lights.len().saturating_sub(SHOWN);
+                let more = format!("{more} more");
+                if self.lights.len() > SHOWN {
+                    known.push(&more);
+                }
+                return Err(LuxError::input(
+                    "--light",
+                    format!(
+                        "{path} is not a light of {} (its lights: {})",
+                        self.file.display(),
+                        if known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(self
+            .lights
+            .iter()
+            .filter(|l| select.is_empty() || select.contains(&l.path))
+            .filter(|l| l.visible)
+            .filter_map(|l| l.light.clone())
+            .collect())
+    }
+
+    /// One line per light that is listed but skipped by the queries (unsupported type or
+    /// feature, invisible), naming the prim.
+    pub fn warnings(&self) -> Vec<String> {
+        self.lights
+            .iter()
+            .filter_map(|l| match (&l.light, &l.warning) {
+                (None, Some(w)) => Some(w.clone()),
+                (None, None) => Some(format!("{}: not evaluated", l.path)),
+                (Some(_), _) if !l.visible => Some(format!(
+                    "{}: invisible at {}, skipped",
+                    l.path,
+                    describe_time(self.time)
+                )),
+                _ => None,
+            })
+            .collect()
+    }
+}
+
+fn describe_time(rule: TimeRule) -> String {
+    match rule {
+        TimeRule::Given(t) => format!("time {t}"),
+        TimeRule::StartTimeCode(t) => format!("time {t} (the stage's startTimeCode)"),
+        TimeRule::Earliest => "the earliest time".to_string(),
+    }
+}
+
+impl SceneLight {
+    fn from_prim(p: usd::LightPrim) -> SceneLight {
+        let (light, warning) = match convert(&p) {
+            Ok((light, caveat)) => (Some(light), caveat),
+            Err(why) => (None, Some(why)),
+        };
+        SceneLight {
+            path: p.path,
+            usd_type: p.usd_type,
+            applied_schemas: p.applied_schemas,
+            visible: p.visible,
+            world: p.world,
+            inputs: p.inputs,
+            light,
+            warning,
+        }
+    }
+
+    /// The input called `name`, if the light's schema has it.
+    pub fn input(&self, name: &str) -> Option<&Input> {
+        self.inputs.iter().find(|i| i.name == name)
+    }
+}
+
+/// Reads typed inputs of one light; a missing input (the schema table lacks it) or a value of the
+/// wrong kind becomes the reason the light is not evaluated, rather than a panic.
+struct Reader<'a> {
+    p: &'a usd::LightPrim,
+}
+
+impl Reader<'_> {
+    fn get(&self, name: &str) -> std::result::Result<&Value, String> {
+        self.p
+            .inputs
+            .iter()
+            .find(|i| i.name == name)
+            .map(|i| &i.value)
+            .ok_or_else(|| format!("{}: {} has no input {name}", self.p.path, self.p.usd_type))
+    }
+    fn float(&self, name: &str) -> std::result::Result<f64, String> {
+        match self.get(name)? {
+            Value::Float(v) => Ok(*v),
+            other => Err(self.kind(name, "float", other)),
+        }
+    }
+    fn bool(&self, name: &str) -> std::result::Result<bool, String> {
+        match self.get(name)? {
+            Value::Bool(v) => Ok(*v),
+            other => Err(self.kind(name, "bool", other)),
+        }
+    }
+    fn color(&self, name: &str) -> std::result::Result<DVec3, String> {
+        match self.get(name)? {
+            Value::Color(v) => Ok(DVec3::from_array(*v)),
+            other => Err(self.kind(name, "color", other)),
+        }
+    }
+    /// The authored asset path of `name`, `None` when empty or when the schema lacks it.
+    fn asset(&self, name: &str) -> Option<&str> {
+        match self.get(name) {
+            Ok(Value::Asset { authored, .. }) if !authored.is_empty() => Some(authored),
+            _ => None,
+        }
+    }
+    fn kind(&self, name: &str, want: &str, got: &Value) -> String {
+        format!(
+            "{}: {name} holds {got:?}, expected a {want} (schema table mismatch)",
+            self.p.path
+        )
+    }
+}
+
+/// The light luxeval evaluates for `p`, with an optional caveat; or why it is not evaluated.
+fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), String> {
+    let r = Reader { p };
+    let path = &p.path;
+    let ty = p.usd_type.as_str();
+    if let Some(why) = &p.transform_error {
+        return Err(why.clone());
+    }
+    if let Some(api) = &p.light_api {
+        let on = match ty {
+            "" => "an untyped prim".to_string(),
+            ty => format!("a {ty} prim"),
+        };
+        return Err(format!(
+            "{path}: {api} lights (on {on}) are not supported yet"
+        ));
+    }
+    let kind = match ty {
+        "DistantLight" => LightType::Distant {
+            angle: r.float("inputs:angle")?,
+        },
+        "SphereLight" => LightType::Sphere {
+            radius: r.float("inputs:radius")?,
+            treat_as_point: r.bool("treatAsPoint")?,
+        },
+        "DiskLight" => LightType::Disk {
+            radius: r.float("inputs:radius")?,
+        },
+        "RectLight" => {
+            if let Some(file) = r.asset("inputs:texture:file") {
+                return Err(format!(
+                    "{path}: RectLight texture:file is not supported yet (@{file}@)"
+                ));
+            }
+            LightType::Rect {
+                width: r.float("inputs:width")?,
+                height: r.float("inputs:height")?,
+            }
+        }
+        "CylinderLight" => LightType::Cylinder {
+            length: r.float("inputs:length")?,
+            radius: r.float("inputs:radius")?,
+            treat_as_line: r.bool("treatAsLine")?,
+        },
+        "DomeLight" | "DomeLight_1" => {
+            if let Some(file) = r.asset("inputs:texture:file") {
+                return Err(format!(
+                    "{path}: {ty} texture:file is not supported yet (@{file}@)"
+                ));
+            }
+            LightType::Dome
+        }
+        "PortalLight" => {
+            return Err(format!(
+                "{path}: PortalLight is not supported yet (it shapes a dome light's emission)"
+            ));
+        }
+        "GeometryLight" => {
+            return Err(format!(
+                "{path}: GeometryLight is not supported (deprecated schema; use MeshLightAPI)"
+            ));
+        }
+        "PluginLight" => {
+            return Err(format!(
+                "{path}: PluginLight is not supported (its emission is defined by a renderer plugin)"
+            ));
+        }
+        other => return Err(format!("{path}: {other} is not a light type luxeval knows")),
+    };
+    let shaped = p.applied_schemas.iter().any(|s| s == "ShapingAPI");
+    if shaped && let Some(file) = r.asset("inputs:shaping:ies:file") {
+        return Err(format!(
+            "{path}: ShapingAPI ies:file is not supported yet (@{file}@)"
+        ));
+    }
+    let inputs = LightInputs {
+        intensity: r.float("inputs:intensity")?,
+        exposure: r.float("inputs:exposure")?,
+        color: r.color("inputs:color")?,
+        enable_color_temperature: r.bool("inputs:enableColorTemperature")?,
+        color_temperature: r.float("inputs:colorTemperature")?,
+        normalize: r.bool("inputs:normalize")?,
+        diffuse: r.float("inputs:diffuse")?,
+        specular: r.float("inputs:specular")?,
+    };
+    let shaping = if shaped {
+        Some(Shaping {
+            focus: r.float("inputs:shaping:focus")?,
+            focus_tint: r.color("inputs:shaping:focusTint")?,
+            cone_angle: r.float("inputs:shaping:cone:angle")?,
+            cone_softness: r.float("inputs:shaping:cone:softness")?,
+        })
+    } else {
+        None
+    };
+    let caveat = (shaped && !kind.is_shapeable())
+        .then(|| format!("{path}: ShapingAPI has no effect on a {ty} (DESIGN.md §2), ignored"));
+    let mut light = Light::new(kind).with_path(path.clone());
+    light.inputs = inputs;
+    light.shaping = shaping;
+    Ok((light.with_usd_matrix(p.world), caveat))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::schema;
+
+    /// A light prim as `crate::usd` would return it, every input at its table fallback.
+    fn prim(ty: &str, applied: &[&str]) -> usd::LightPrim {
+        let inputs = schema::attrs_for(ty, applied)
+            .into_iter()
+            .map(|a| Input {
+                name: a.name.to_string(),
+                value: usd::fallback_value(a.fallback),
+                authored: false,
+            })
+            .collect();
+        usd::LightPrim {
+            path: format!("/Lights/{ty}"),
+            usd_type: ty.to_string(),
+            applied_schemas: applied.iter().map(|s| s.to_string()).collect(),
+            light_api: None,
+            transform_error: None,
+            visible: true,
+            world: [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+                [1.0, 2.0, 3.0, 1.0],
+            ],
+            inputs,
+        }
+    }
+
+    fn set(p: &mut usd::LightPrim, name: &str, value: Value) {
+        let i = p.inputs.iter_mut().find(|i| i.name == name).unwrap();
+        i.value = value;
+        i.authored = true;
+    }
+
+    #[test]
+    fn fallback_lights_convert_to_the_model_fallbacks() {
+        for ty in [
+            "DistantLight",
+            "SphereLight",
+            "DiskLight",
+            "RectLight",
+            "CylinderLight",
+            "DomeLight",
+            "DomeLight_1",
+        ] {
+            let (light, caveat) = convert(&prim(ty, &[])).unwrap();
+            assert_eq!(caveat, None);
+            let expected = Light::new(LightType::fallback(ty).unwrap())
+                .with_path(format!("/Lights/{ty}"))
+                .with_usd_matrix(prim(ty, &[]).world);
+            assert_eq!(light, expected, "{ty}");
+            assert_eq!(light.origin(), DVec3::new(1.0, 2.0, 3.0));
+        }
+    }
+
+    #[test]
+    fn shaping_only_where_applied() {
+        let (plain, _) = convert(&prim("DiskLight", &[])).unwrap();
+        assert_eq!(plain.shaping, None);
+        let mut p = prim("DiskLight", &["ShapingAPI"]);
+        let (defaults, _) = convert(&p).unwrap();
+        assert_eq!(defaults.shaping, Some(Shaping::default()));
+        set(&mut p, "inputs:shaping:cone:angle", Value::Float(30.0));
+        set(
+            &mut p,
+            "inputs:shaping:focusTint",
+            Value::Color([1.0, 0.5, 0.0]),
+        );
+        let (authored, _) = convert(&p).unwrap();
+        let s = authored.shaping.unwrap();
+        assert_eq!(s.cone_angle, 30.0);
+        assert_eq!(s.focus_tint, DVec3::new(1.0, 0.5, 0.0));
+    }
+
+    #[test]
+    fn unsupported_features_name_the_prim_and_feature() {
+        let mut rect = prim("RectLight", &[]);
+        set(
+            &mut rect,
+            "inputs:texture:file",
+            Value::Asset {
+                authored: "tex.png".into(),
+                resolved: None,
+            },
+        );
+        let e = convert(&rect).unwrap_err();
+        assert!(
+            e.contains("/Lights/RectLight") && e.contains("texture:file"),
+            "{e}"
+        );
+
+        let mut ies = prim("SphereLight", &["ShapingAPI"]);
+        set(
+            &mut ies,
+            "inputs:shaping:ies:file",
+            Value::Asset {
+                authored: "a.ies".into(),
+                resolved: None,
+            },
+        );
+        let e = convert(&ies).unwrap_err();
+        assert!(e.contains("ies:file"), "{e}");
+
+        // An authored but empty asset path is no texture.
+        let mut empty = prim("DomeLight", &[]);
+        set(
+            &mut empty,
+            "inputs:texture:file",
+            Value::Asset {
+                authored: String::new(),
+                resolved: None,
+            },
+        );
+        assert!(convert(&empty).is_ok());
+
+        for ty in ["PortalLight", "GeometryLight", "PluginLight"] {
+            let e = convert(&prim(ty, &[])).unwrap_err();
+            assert!(e.contains(ty) && e.contains("/Lights/"), "{e}");
+        }
+        let mut mesh = prim("Mesh", &["MeshLightAPI"]);
+        mesh.light_api = Some("MeshLightAPI".into());
+        let e = convert(&mesh).unwrap_err();
+        assert!(e.contains("MeshLightAPI"), "{e}");
+    }
+
+    #[test]
+    fn shaping_on_distant_is_a_caveat() {
+        let (light, caveat) = convert(&prim("DistantLight", &["ShapingAPI"])).unwrap();
+        assert!(light.shaping.is_some());
+        assert!(caveat.unwrap().contains("no effect"));
+    }
+
+    #[test]
+    fn evaluable_filters_and_rejects_unknown_selection() {
+        let mut hidden = SceneLight::from_prim(prim("SphereLight", &[]));
+        hidden.path = "/Lights/Hidden".into();
+        hidden.visible = false;
+        let scene = Scene {
+            file: "x.usda".into(),
+            up_axis: "Y".into(),
+            meters_per_unit: 0.01,
+            time: TimeRule::Earliest,
+            lights: vec![
+                SceneLight::from_prim(prim("DiskLight", &[])),
+                SceneLight::from_prim(prim("PortalLight", &[])),
+                hidden,
+            ],
+        };
+        let all = scene.evaluable(&[]).unwrap();
+        assert_eq!(all.len(), 1);
+        assert_eq!(all[0].path, "/Lights/DiskLight");
+        assert!(
+            scene
+                .evaluable(&["/Lights/Hidden".into()])
+                .unwrap()
+                .is_empty()
+        );
+        let e = scene.evaluable(&["/Nope".into()]).unwrap_err().to_string();
+        assert!(e.contains("/Nope") && e.contains("x.usda"), "{e}");
+        let w = scene.warnings();
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(w[0].contains("/Lights/PortalLight"));
+        assert!(w[1].contains("/Lights/Hidden") && w[1].contains("invisible"));
+    }
+
+    #[test]
+    fn json_shape() {
+        let l = SceneLight::from_prim(prim("SphereLight", &[]));
+        let v = serde_json::to_value(&l).unwrap();
+        assert_eq!(v["evaluable"], serde_json::json!(true));
+        assert_eq!(v["inputs"][0]["value"], serde_json::json!(1.0));
+        let t = serde_json::to_value(TimeRule::StartTimeCode(1.0)).unwrap();
+        assert_eq!(
+            t,
+            serde_json::json!({"rule": "start_time_code", "time": 1.0})
+        );
+        let t = serde_json::to_value(TimeRule::Earliest).unwrap();
+        assert_eq!(t, serde_json::json!({"rule": "earliest"}));
+    }
+}

@@ -1,0 +1,271 @@
+//! Command-line integration tests (DESIGN.md §4): outputs equal the library's results, exit
+//! codes and messages for bad input, and no partial output file after a failure.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use luxeval::io::npy;
+use luxeval::scene::Scene;
+use luxeval::{Accumulate, Evaluator};
+
+fn luxeval(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_luxeval"))
+        .args(args)
+        .output()
+        .expect("run luxeval")
+}
+
+fn asset(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn read_npy_f32(path: &Path) -> (Vec<u64>, Vec<f32>) {
+    let bytes = std::fs::read(path).unwrap();
+    let f = npyz::NpyFile::new(&bytes[..]).unwrap();
+    let shape = f.shape().to_vec();
+    (shape, f.into_vec::<f32>().unwrap())
+}
+
+fn no_stray_files(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect()
+}
+
+#[test]
+fn emission_on_the_bundled_scene_equals_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e.npy");
+    let o = luxeval(&[
+        "emission",
+        &asset("studio.usda"),
+        "--dirs",
+        &asset("dirs.npy"),
+        "-o",
+        out.to_str().unwrap(),
+        "--device",
+        "cpu",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (shape, values) = read_npy_f32(&out);
+    assert_eq!(shape, vec![4096, 3]);
+    let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
+    let lights = scene.evaluable(&[]).unwrap();
+    let dirs = npy::read_vec3(Path::new(&asset("dirs.npy"))).unwrap();
+    let want = Evaluator::cpu()
+        .emission(&lights, &dirs, Accumulate::Sum)
+        .unwrap();
+    let flat: Vec<f32> = want.iter().flatten().copied().collect();
+    assert_eq!(values, flat);
+
+    // Per light: (L, N, 3) in `lights` order, and each row matches the single-light result.
+    let out = dir.path().join("p.npy");
+    let o = luxeval(&[
+        "emission",
+        &asset("studio.usda"),
+        "--dirs",
+        &asset("dirs.npy"),
+        "-o",
+        out.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--per-light",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (shape, values) = read_npy_f32(&out);
+    assert_eq!(shape, vec![lights.len() as u64, 4096, 3]);
+    let want = Evaluator::cpu()
+        .emission(&lights, &dirs, Accumulate::PerLight)
+        .unwrap();
+    assert_eq!(values, want.iter().flatten().copied().collect::<Vec<f32>>());
+}
+
+#[test]
+fn gpu_emission_and_radiance_match_the_cpu_through_the_cli() {
+    let Some(_gpu) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    for (query, extra) in [
+        ("emission", vec!["--dirs", "dirs.npy"]),
+        (
+            "radiance",
+            vec!["--points", "floor_points.npy", "--dirs", "floor_up.npy"],
+        ),
+    ] {
+        let mut files = vec![];
+        for device in ["gpu", "cpu"] {
+            let out = dir.path().join(format!("{query}_{device}.npy"));
+            let mut args = vec![query.to_string(), asset("studio.usda")];
+            for (k, a) in extra.iter().enumerate() {
+                args.push(if k % 2 == 1 { asset(a) } else { a.to_string() });
+            }
+            args.extend([
+                "-o".into(),
+                out.to_string_lossy().into_owned(),
+                "--device".into(),
+                device.into(),
+            ]);
+            let o = Command::new(env!("CARGO_BIN_EXE_luxeval"))
+                .args(&args)
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{query} {device}: {}", stderr(&o));
+            files.push(read_npy_f32(&out).1);
+        }
+        let (g, c) = (&files[0], &files[1]);
+        for (k, (a, b)) in g.chunks(3).zip(c.chunks(3)).enumerate() {
+            let scale = b.iter().fold(0f32, |m, v| m.max(v.abs()));
+            let diff = a.iter().zip(b).fold(0f32, |m, (x, y)| m.max((x - y).abs()));
+            assert!(
+                diff <= 1e-4 * scale.max(1e-30) || diff == 0.0,
+                "{query} row {k}: gpu {a:?} cpu {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn bad_inputs_exit_2_with_a_useful_message_and_leave_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.npy");
+    let o_str = out.to_str().unwrap();
+    // Malformed .usda: names the file and the line.
+    let bad = dir.path().join("bad.usda");
+    std::fs::write(
+        &bad,
+        "#usda 1.0\n\ndef SphereLight \"s\"\n{\n    float inputs:intensity = \n}\n",
+    )
+    .unwrap();
+    let o = luxeval(&[
+        "emission",
+        bad.to_str().unwrap(),
+        "--dirs",
+        &asset("dirs.npy"),
+        "-o",
+        o_str,
+        "--device",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("bad.usda"), "{}", stderr(&o));
+    // Missing scene.
+    let o = luxeval(&[
+        "emission",
+        "/nonexistent/scene.usda",
+        "--dirs",
+        &asset("dirs.npy"),
+        "-o",
+        o_str,
+        "--device",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("/nonexistent/scene.usda"),
+        "{}",
+        stderr(&o)
+    );
+    // Wrongly shaped .npy.
+    let npy_bad = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/npy/dirs_shape_4x2.npy");
+    let o = luxeval(&[
+        "emission",
+        &asset("studio.usda"),
+        "--dirs",
+        npy_bad.to_str().unwrap(),
+        "-o",
+        o_str,
+        "--device",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("dirs_shape_4x2.npy") && stderr(&o).contains("(N, 3)"),
+        "{}",
+        stderr(&o)
+    );
+    // Mismatched points/directions.
+    let o = luxeval(&[
+        "radiance",
+        &asset("studio.usda"),
+        "--points",
+        &asset("floor_points.npy"),
+        "--dirs",
+        npy_bad.to_str().unwrap(),
+        "-o",
+        o_str,
+        "--device",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    // A light that is not in the stage.
+    let o = luxeval(&[
+        "emission",
+        &asset("studio.usda"),
+        "--dirs",
+        &asset("dirs.npy"),
+        "-o",
+        o_str,
+        "--device",
+        "cpu",
+        "--light",
+        "/lights/nope",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("/lights/nope"), "{}", stderr(&o));
+    // Nothing was written, not even a temporary.
+    assert_eq!(no_stray_files(dir.path()), vec![bad]);
+}
+
+#[test]
+fn lights_json_lists_every_input_and_whether_authored() {
+    let o = luxeval(&["lights", &asset("studio.usda"), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let lights = v["lights"].as_array().unwrap();
+    assert_eq!(lights.len(), 6);
+    let key = lights.iter().find(|l| l["path"] == "/lights/key").unwrap();
+    let inputs = key["inputs"].as_array().unwrap();
+    let width = inputs.iter().find(|i| i["name"] == "inputs:width").unwrap();
+    assert_eq!(width["authored"], true);
+    let diffuse = inputs
+        .iter()
+        .find(|i| i["name"] == "inputs:diffuse")
+        .unwrap();
+    assert_eq!(diffuse["authored"], false);
+}
+
+#[test]
+fn help_explains_every_subcommand() {
+    let o = luxeval(&["--help"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    for sub in ["info", "lights", "emission", "radiance", "check", "bench"] {
+        assert!(text.contains(sub), "--help lacks {sub}");
+        let o = luxeval(&[sub, "--help"]);
+        assert!(o.status.success(), "{sub} --help");
+    }
+}
+
+#[test]
+fn check_passes_on_the_bundled_scene() {
+    let Some(_gpu) = common::gpu() else { return };
+    let o = luxeval(&["check", &asset("studio.usda"), "--samples", "500", "--json"]);
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        stderr(&o)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["samples"].as_u64().unwrap() >= 500 * 6);
+}

@@ -1,0 +1,583 @@
+//! The USD loader against Pixar's usd-core: every light of every fixture scene, at every time
+//! code it authors and under the EarliestTime rule, must resolve to what usd-core resolved
+//! (tests/data/usd/expected/*.json, written by tools/gen_usd_fixtures.py).
+
+use std::path::{Path, PathBuf};
+
+use luxeval::scene::{TimeRule, Value};
+use luxeval::usd::{LightPrim, Time, UsdStage};
+use luxeval::{LightType, LuxError, Scene};
+use serde_json::Value as Json;
+
+fn data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+fn expected(name: &str) -> Json {
+    let path = data().join("usd/expected").join(format!("{name}.json"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A resolved path as the fixtures spell it: relative to tests/data.
+fn relative(resolved: &str) -> String {
+    let prefix = format!("{}/", data().display());
+    resolved
+        .strip_prefix(&prefix)
+        .unwrap_or(resolved)
+        .to_string()
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    a == b || (a - b).abs() <= rel * b.abs().max(a.abs()).max(1e-30)
+}
+
+/// Compares one light with usd-core's record of it; returns every mismatch, each naming the
+/// scene, time, prim and attribute.
+fn compare(ctx: &str, ours: &LightPrim, exp: &Json, problems: &mut Vec<String>) {
+    let mut bad = |what: String| problems.push(format!("{ctx} {}: {what}", ours.path));
+    if ours.path != exp["path"] {
+        bad(format!("path, usd-core has {}", exp["path"]));
+        return;
+    }
+    if ours.usd_type != exp["type"] {
+        bad(format!(
+            "type {} vs usd-core {}",
+            ours.usd_type, exp["type"]
+        ));
+    }
+    // usd-core's GetAppliedSchemas() drops authored names no registered schema declares;
+    // ours lists them after the known ones (see luxeval::usd::LightPrim::applied_schemas).
+    let mut applied: Vec<String> = exp["applied_schemas"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_str().unwrap().to_string())
+        .collect();
+    for s in exp["authored_api_schemas"].as_array().unwrap() {
+        let s = s.as_str().unwrap().to_string();
+        if !applied.contains(&s) {
+            applied.push(s);
+        }
+    }
+    if ours.applied_schemas != applied {
+        bad(format!(
+            "applied schemas {:?} vs usd-core {:?}",
+            ours.applied_schemas, applied
+        ));
+    }
+    if ours.visible != exp["visible"].as_bool().unwrap() {
+        bad(format!(
+            "visible {} vs usd-core {}",
+            ours.visible, exp["visible"]
+        ));
+    }
+    for r in 0..4 {
+        for c in 0..4 {
+            let want = exp["world"][r][c].as_f64().unwrap();
+            let got = ours.world[r][c];
+            if (got - want).abs() > 1e-9 * want.abs().max(1.0) {
+                bad(format!("world[{r}][{c}] {got:e} vs usd-core {want:e}"));
+            }
+        }
+    }
+    let exp_inputs = exp["inputs"].as_array().unwrap();
+    for input in &ours.inputs {
+        let Some(e) = exp_inputs.iter().find(|e| e["name"] == input.name.as_str()) else {
+            bad(format!("{}: usd-core has no such attribute", input.name));
+            continue;
+        };
+        if input.authored != e["authored"].as_bool().unwrap() {
+            bad(format!(
+                "{}: authored {} vs usd-core {}",
+                input.name, input.authored, e["authored"]
+            ));
+        }
+        let v = &e["value"];
+        // usd-core has no value at all where a blocked sample answers; luxeval reports the
+        // schema fallback there (see luxeval::usd), so that is what to expect.
+        let fallback;
+        let v = if v.is_null() && !matches!(input.value, Value::Asset { .. }) {
+            let applied: Vec<&str> = ours.applied_schemas.iter().map(String::as_str).collect();
+            fallback = match luxeval::schema::fallback(&ours.usd_type, &applied, &input.name) {
+                Some(luxeval::schema::Fallback::Float(f)) => serde_json::json!(f),
+                Some(luxeval::schema::Fallback::Bool(b)) => serde_json::json!(b),
+                Some(luxeval::schema::Fallback::Color(c)) => serde_json::json!(c),
+                Some(luxeval::schema::Fallback::Token(t)) => serde_json::json!(t),
+                other => panic!(
+                    "{ctx} {}: no fallback for {} ({other:?})",
+                    ours.path, input.name
+                ),
+            };
+            &fallback
+        } else {
+            v
+        };
+        // USD stores these inputs as f32; usd-core and openusd may round an interpolated
+        // value differently, and the table holds fallbacks as decimal f64 (0.53, not f32 0.53).
+        let ok = match &input.value {
+            Value::Float(x) => v.as_f64().is_some_and(|w| close(*x, w, 1e-6)),
+            Value::Bool(b) => v.as_bool() == Some(*b),
+            Value::Color(c) => v.as_array().is_some_and(|w| {
+                w.len() == 3 && (0..3).all(|i| w[i].as_f64().is_some_and(|w| close(c[i], w, 1e-6)))
+            }),
+            Value::Token(t) => v.as_str() == Some(t.as_str()),
+            Value::Asset { authored, resolved } => {
+                if v.is_null() {
+                    authored.is_empty() && resolved.is_none()
+                } else {
+                    v["authored"].as_str() == Some(authored.as_str())
+                        && v["resolved"].as_str().map(str::to_string)
+                            == resolved.as_deref().map(relative)
+                }
+            }
+        };
+        if !ok {
+            bad(format!(
+                "{} = {:?} vs usd-core {v}",
+                input.name, input.value
+            ));
+        }
+    }
+}
+
+/// Opens `scene` (relative to tests/data) and checks every light at every recorded time.
+fn check_scene(fixture: &str) {
+    let exp = expected(fixture);
+    let path = data().join(exp["scene"].as_str().unwrap());
+    let stage = UsdStage::open(&path).unwrap_or_else(|e| panic!("{fixture}: {e}"));
+    let info = stage.info();
+    assert_eq!(info.up_axis, exp["up_axis"].as_str().unwrap(), "{fixture}");
+    assert_eq!(
+        info.meters_per_unit,
+        exp["meters_per_unit"].as_f64().unwrap(),
+        "{fixture}"
+    );
+    assert_eq!(
+        info.start_time_code,
+        exp["start_time_code"].as_f64(),
+        "{fixture}"
+    );
+    assert_eq!(
+        info.end_time_code,
+        exp["end_time_code"].as_f64(),
+        "{fixture}"
+    );
+
+    let mut problems = Vec::new();
+    let samples = exp["samples"].as_array().unwrap();
+    assert!(!samples.is_empty());
+    for sample in samples {
+        let time = match sample["time"].as_f64() {
+            Some(t) => Time::Code(t),
+            None => Time::Earliest,
+        };
+        let ctx = format!("{fixture} @ {time:?}");
+        let ours = stage
+            .lights_at(time)
+            .unwrap_or_else(|e| panic!("{ctx}: {e}"));
+        let theirs = sample["lights"].as_array().unwrap();
+        let ours_paths: Vec<&str> = ours.iter().map(|l| l.path.as_str()).collect();
+        let their_paths: Vec<&str> = theirs.iter().map(|l| l["path"].as_str().unwrap()).collect();
+        if ours_paths != their_paths {
+            problems.push(format!(
+                "{ctx}: lights {ours_paths:?} vs usd-core {their_paths:?}"
+            ));
+            continue;
+        }
+        for (o, t) in ours.iter().zip(theirs) {
+            compare(&ctx, o, t, &mut problems);
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "{} mismatches with usd-core:\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
+}
+
+#[test]
+fn luxtest_scenes_match_usd_core() {
+    for name in [
+        "cylinder",
+        "disk",
+        "distant",
+        "dome",
+        "iesDown",
+        "iesLibPreview",
+        "iesTest",
+        "iesUp",
+        "rect",
+        "sphere",
+        "visibleRect",
+    ] {
+        check_scene(&format!("luxtest_{name}"));
+    }
+}
+
+#[test]
+fn composition_usda_matches_usd_core() {
+    check_scene("composition_root_usda");
+}
+
+#[test]
+fn composition_usdc_matches_usd_core() {
+    check_scene("composition_root_usdc");
+}
+
+#[test]
+fn composition_usdz_matches_usd_core() {
+    check_scene("composition_scene_usdz");
+    check_scene("composition_rig_packaged_usdz");
+}
+
+/// The same scene as text, as Pixar's binary crate and packed in a usdz resolves to the same
+/// lights; only asset paths differ, the usdz's resolving inside the package.
+#[test]
+fn usda_usdc_usdz_are_identical() {
+    let dir = data().join("usd/composition");
+    for time in [None, Some(0.0), Some(1.5), Some(3.0), Some(10.0)] {
+        let a = Scene::load(&dir.join("root.usda"), time).unwrap();
+        let c = Scene::load(&dir.join("root.usdc"), time).unwrap();
+        let z = Scene::load(&dir.join("scene.usdz"), time).unwrap();
+        assert_eq!(a.lights, c.lights, "usda vs usdc at {time:?}");
+        assert_eq!(
+            (&a.up_axis, a.meters_per_unit, a.time),
+            (&c.up_axis, c.meters_per_unit, c.time)
+        );
+        assert_eq!(
+            (&a.up_axis, a.meters_per_unit, a.time),
+            (&z.up_axis, z.meters_per_unit, z.time)
+        );
+        assert_eq!(a.lights.len(), z.lights.len());
+        let mut assets_checked = 0;
+        for (la, lz) in a.lights.iter().zip(&z.lights) {
+            let mut lz = lz.clone();
+            for (ia, iz) in la.inputs.iter().zip(lz.inputs.iter_mut()) {
+                if let (
+                    Value::Asset {
+                        authored: aa,
+                        resolved: ra,
+                    },
+                    Value::Asset {
+                        authored: az,
+                        resolved: rz,
+                    },
+                ) = (&ia.value, &mut iz.value)
+                {
+                    assert_eq!(aa, az);
+                    // <dir>/x/y.ies in the folder is <dir>/scene.usdz[x/y.ies] in the package.
+                    let want = ra.as_ref().map(|r| {
+                        let inner = r.strip_prefix(&format!("{}/", dir.display())).unwrap();
+                        format!("{}[{inner}]", dir.join("scene.usdz").display())
+                    });
+                    assert_eq!(*rz, want, "{} {}", la.path, ia.name);
+                    assets_checked += usize::from(want.is_some());
+                    *rz = ra.clone();
+                }
+            }
+            assert_eq!(*la, lz, "usda vs usdz at {time:?}");
+        }
+        assert!(assets_checked >= 4, "{assets_checked}");
+    }
+}
+
+#[test]
+fn packaged_assets_are_readable() {
+    // What a later IES or texture reader needs: the resolved path opens through openusd's
+    // resolver... and at least names the package and the inner file.
+    let dir = data().join("usd/composition");
+    let scene = Scene::load(&dir.join("rig_packaged.usdz"), None).unwrap();
+    let spot = scene.lights.iter().find(|l| l.path == "/Rig/Spot").unwrap();
+    let Some(Value::Asset { authored, resolved }) = spot
+        .input("inputs:shaping:ies:file")
+        .map(|i| i.value.clone())
+    else {
+        panic!("no ies:file");
+    };
+    assert_eq!(authored, "0/spot.ies");
+    assert_eq!(
+        resolved.as_deref(),
+        Some(format!("{}[0/spot.ies]", dir.join("rig_packaged.usdz").display()).as_str())
+    );
+}
+
+#[test]
+fn time_rules() {
+    let comp = data().join("usd/composition/root.usda");
+    let sphere = data().join("luxtest/usd/sphere.usda");
+    assert_eq!(Scene::load(&comp, None).unwrap().time, TimeRule::Earliest);
+    assert_eq!(
+        Scene::load(&sphere, None).unwrap().time,
+        TimeRule::StartTimeCode(1.0)
+    );
+    assert_eq!(
+        Scene::load(&sphere, Some(7.0)).unwrap().time,
+        TimeRule::Given(7.0)
+    );
+    let e = Scene::load(&sphere, Some(f64::NAN)).unwrap_err();
+    assert!(e.to_string().contains("--time"), "{e}");
+
+    // Interpolation: /World/Anim intensity 10 @1 → 30 @3 (linear), normalize 0 @1, 1 @2 (held).
+    let at = |t: f64| Scene::load(&comp, Some(t)).unwrap();
+    let intensity = |s: &Scene| {
+        let l = s.lights.iter().find(|l| l.path == "/World/Anim").unwrap();
+        (
+            l.input("inputs:intensity").unwrap().value.clone(),
+            l.input("inputs:normalize").unwrap().value.clone(),
+        )
+    };
+    assert_eq!(
+        intensity(&at(1.5)),
+        (Value::Float(15.0), Value::Bool(false))
+    );
+    assert_eq!(intensity(&at(2.5)), (Value::Float(25.0), Value::Bool(true)));
+    // The earliest rule and the stage's default rule agree on a stage without startTimeCode.
+    assert_eq!(
+        intensity(&Scene::load(&comp, None).unwrap()),
+        (Value::Float(10.0), Value::Bool(false))
+    );
+}
+
+#[test]
+fn scene_lights_and_warnings() {
+    let scene = Scene::load(&data().join("usd/composition/root.usda"), Some(0.0)).unwrap();
+    assert_eq!(scene.up_axis, "Z");
+    assert_eq!(scene.meters_per_unit, 0.5);
+    let get = |p: &str| {
+        scene
+            .lights
+            .iter()
+            .find(|l| l.path == p)
+            .unwrap_or_else(|| panic!("{p}"))
+    };
+
+    // Reference + variant selection authored in the referencing layer.
+    let fill = get("/World/Rig/Fill").light.clone().unwrap();
+    assert_eq!(
+        fill.kind,
+        LightType::Rect {
+            width: 2.0,
+            height: 0.5
+        }
+    );
+    assert!(fill.inputs.enable_color_temperature && fill.inputs.normalize);
+    assert_eq!(fill.inputs.color_temperature, 8000.0);
+    // Every unauthored type gets the model's fallbacks.
+    let disk = get("/World/Defaults/Disk").light.clone().unwrap();
+    assert_eq!(disk.kind, LightType::fallback("DiskLight").unwrap());
+    assert_eq!(disk.inputs, luxeval::LightInputs::default());
+    let distant = get("/World/Defaults/Distant").light.clone().unwrap();
+    assert_eq!(distant.inputs.intensity, 50000.0);
+    // ShapingAPI applied, nothing authored: the schema fallbacks.
+    let shaped = get("/World/Defaults/ShapedDefaults").light.clone().unwrap();
+    assert_eq!(shaped.shaping, Some(luxeval::Shaping::default()));
+    let cone = get("/World/Shaped/Cone")
+        .light
+        .clone()
+        .unwrap()
+        .shaping
+        .unwrap();
+    assert!((cone.cone_angle - 35.0).abs() < 1e-6 && (cone.cone_softness - 0.3).abs() < 1e-6);
+    // A negative radius passes through; validate() names it.
+    let neg = get("/World/NegativeRadius").light.clone().unwrap();
+    let e = neg.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("/World/NegativeRadius") && e.contains("inputs:radius"),
+        "{e}"
+    );
+    // The world matrix reaches the light model (row-vector USD → column-vector glam).
+    let all_ops = get("/World/OpsA/OpsB/OpsC/AllOps");
+    assert_eq!(all_ops.light.as_ref().unwrap().usd_matrix(), all_ops.world);
+
+    let evaluable = scene.evaluable(&[]).unwrap();
+    let paths: Vec<&str> = evaluable.iter().map(|l| l.path.as_str()).collect();
+    for skipped in [
+        "/World/Hidden/HiddenByParent",
+        "/World/HiddenSelf",
+        "/World/Blink", // invisible at 0, visible from 2
+        "/World/Defaults/Portal",
+        "/World/Defaults/MeshLight",
+        "/World/Shaped/Textured",
+        "/World/Shaped/Ies",
+        "/World/Env/Sky",
+    ] {
+        assert!(!paths.contains(&skipped), "{skipped} evaluated");
+        assert!(
+            scene.warnings().iter().any(|w| w.starts_with(skipped)),
+            "no warning for {skipped}: {:#?}",
+            scene.warnings()
+        );
+    }
+    for kept in [
+        "/World/Env/Uniform",
+        "/World/Untyped/UnderUntyped",
+        "/World/Shaped/Cone",
+        "/World/Instanced/Fill",
+    ] {
+        assert!(paths.contains(&kept), "{kept} not evaluated");
+    }
+    let later = Scene::load(&data().join("usd/composition/root.usda"), Some(2.0)).unwrap();
+    assert!(later.evaluable(&["/World/Blink".into()]).unwrap().len() == 1);
+
+    let selected = scene
+        .evaluable(&["/World/Shaped/Cone".into(), "/World/Rig/Fill".into()])
+        .unwrap();
+    // Traversal order, not selection order.
+    let order: Vec<&str> = selected.iter().map(|l| l.path.as_str()).collect();
+    assert_eq!(order, ["/World/Shaped/Cone", "/World/Rig/Fill"]);
+    let e = scene.evaluable(&["/World/NotALight".into()]).unwrap_err();
+    assert!(e.to_string().contains("/World/NotALight"), "{e}");
+}
+
+#[test]
+fn malformed_usda_is_a_format_error_with_line() {
+    let path = data().join("usd/errors/malformed.usda");
+    match Scene::load(&path, None) {
+        Err(LuxError::Format {
+            path: p,
+            line,
+            reason,
+        }) => {
+            assert_eq!(p, path);
+            assert_eq!(line, Some(5));
+            assert!(!reason.is_empty() && !reason.contains('\n'), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let e = Scene::load(&path, None).unwrap_err().to_string();
+    assert!(e.contains("malformed.usda:5:"), "{e}");
+
+    let not_usd = data().join("usd/errors/not_usd.usda");
+    assert!(matches!(
+        Scene::load(&not_usd, None),
+        Err(LuxError::Format { line: Some(1), .. })
+    ));
+    let ies = data().join("luxtest/test_linear_vertical.ies");
+    assert!(
+        matches!(Scene::load(&ies, None), Err(LuxError::Format { .. })),
+        "{:?}",
+        Scene::load(&ies, None).err()
+    );
+}
+
+#[test]
+fn missing_file_is_an_io_error() {
+    let path = data().join("usd/errors/no_such_file.usda");
+    match Scene::load(&path, None) {
+        Err(LuxError::Io { path: p, source }) => {
+            assert_eq!(p, path);
+            assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn a_directory_is_an_io_error() {
+    let dir = data().join("usd");
+    assert!(matches!(Scene::load(&dir, None), Err(LuxError::Io { path, .. }) if path == dir));
+}
+
+#[test]
+fn missing_or_malformed_layers_name_the_layer() {
+    let errs = data().join("usd/errors");
+    let e = Scene::load(&errs.join("missing_reference.usda"), None).unwrap_err();
+    assert!(e.is_bad_input());
+    let msg = e.to_string();
+    assert!(
+        msg.contains("missing_layer.usda") && msg.contains("/World/Broken"),
+        "{msg}"
+    );
+
+    let msg = Scene::load(&errs.join("missing_sublayer.usda"), None)
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("missing_sublayer_target.usda"), "{msg}");
+
+    match Scene::load(&errs.join("malformed_reference.usda"), None) {
+        Err(LuxError::Format { path, line, reason }) => {
+            assert_eq!(path, errs.join("malformed.usda"));
+            assert_eq!(line, Some(5));
+            assert!(reason.contains("malformed_reference.usda"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn a_broken_transform_is_a_warning_not_a_failed_load() {
+    let scene = Scene::load(&data().join("usd/errors/singular_invert.usda"), None).unwrap();
+    let broken = &scene.lights[0];
+    assert_eq!(broken.path, "/World/Broken");
+    assert!(broken.light.is_none());
+    let w = broken.warning.as_deref().unwrap();
+    assert!(
+        w.starts_with("/World/Broken") && w.contains("singular"),
+        "{w}"
+    );
+    assert!(scene.warnings().iter().any(|x| x == w));
+    let lights = scene.evaluable(&[]).unwrap();
+    assert_eq!(lights.len(), 1);
+    assert_eq!(lights[0].path, "/World/Fine");
+}
+
+/// usd-core evaluates splines; openusd 0.8 reads them as unauthored, so they are refused with
+/// the light and attribute named rather than silently replaced by the fallback.
+#[test]
+fn splines_are_refused_naming_the_attribute() {
+    let errs = data().join("usd/errors");
+    for (file, attr) in [
+        ("spline_input.usda", "inputs:intensity"),
+        ("spline_input.usdc", "inputs:intensity"),
+        ("spline_xform.usda", "xformOp:rotateX"),
+    ] {
+        match Scene::load(&errs.join(file), None) {
+            Err(LuxError::InvalidAttribute {
+                light,
+                attr: a,
+                reason,
+                ..
+            }) => {
+                assert_eq!(
+                    light,
+                    if file.contains("xform") {
+                        "/Rig/L"
+                    } else {
+                        "/L"
+                    }
+                );
+                assert_eq!(a, attr, "{file}");
+                assert!(reason.contains("spline"), "{file}: {reason}");
+            }
+            other => panic!("{file}: {other:?}"),
+        }
+    }
+}
+
+/// The .ies files are LM-63 with CRLF line endings; git must not have normalised them.
+#[test]
+fn ies_bytes_survive() {
+    // Sizes from research/data/README.md (the CRLF originals).
+    let luxtest = [
+        ("test_linear_vertical.ies", 329),
+        ("test_stripes_uniform.ies", 3075),
+        ("test_stripes_nonuniform.ies", 999),
+        ("test_vstripes_hquadrants_nonuniform.ies", 3356),
+        ("test_vstripes_hquadrants_nonuniform_aimDown.ies", 2202),
+        ("test_vstripes_hquadrants_nonuniform_aimUp.ies", 2203),
+    ];
+    let ours = ("usd/composition/ies/spot.ies".to_string(), 139);
+    for (name, len) in luxtest
+        .iter()
+        .map(|(n, l)| (format!("luxtest/{n}"), *l))
+        .chain([ours])
+    {
+        let bytes = std::fs::read(data().join(&name)).unwrap();
+        assert_eq!(bytes.len(), len, "{name}");
+        let lf = bytes.iter().filter(|&&b| b == b'\n').count();
+        let crlf = bytes.windows(2).filter(|w| w == b"\r\n").count();
+        assert!(lf > 0 && lf == crlf, "{name}: {lf} LF, {crlf} CRLF");
+    }
+}

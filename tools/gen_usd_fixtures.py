@@ -1,0 +1,890 @@
+#!/usr/bin/env python3
+"""Generate the USD fixtures luxeval's loader is tested against (tests/usd_fixtures.rs).
+
+Run with Pixar's usd-core (the tests themselves never need Python):
+
+    /opt/usdvenv/bin/python tools/gen_usd_fixtures.py [--luxtest-src DIR]
+
+What it writes, all under tests/data/:
+- luxtest/: the luxtest scenes (pmolodo/luxtest @ 9d555a66d0a6, CC-BY-4.0) copied byte for byte,
+  with the synthetic test_*.ies files they reference (``../test_*.ies`` from usd/) and the licence.
+  Every copied file is checked against the sha256 recorded in research/data/README.md.
+- usd/composition/: a scene of our own that uses every composition arc (sublayer with a layer
+  offset, reference with a layer offset, payload, variant sets with authored selections, inherits,
+  specializes, instancing), every xformOp kind, time samples on inputs and transforms, invisible
+  lights, an unauthored light of every UsdLux type, ShapingAPI with and without authored values,
+  blocked values, and assets (an IES profile, a PNG) resolved relative to the layer that authored
+  them. ``root.usdc`` is the root layer saved by usd-core's crate writer; ``scene.usdz`` is the whole
+  scene packed by ``UsdUtils.CreateNewUsdzPackage`` (assets included).
+- usd/errors/: broken scenes (malformed text, missing references and sublayers).
+- usd/expected/*.json: what usd-core resolves for every light of every scene above, at every time
+  code the scene authors and under the EarliestTime rule: type, applied schemas, visibility, world
+  matrix, and every scalar input with its value, authored flag and resolved asset path.
+"""
+
+import argparse
+import hashlib
+import json
+import os
+import shutil
+import struct
+import sys
+import zipfile
+import zlib
+
+from pxr import Sdf, Usd, UsdGeom, UsdUtils
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+REPO = os.path.dirname(HERE)
+DATA = os.path.join(REPO, "tests", "data")
+
+# sha256 of every luxtest file we copy (from research/data/README.md).
+LUXTEST_FILES = {
+    "LICENSE.md": "0baf4d60c8b2b107cbdb959e0f6d0bded6244de5e7e2e2ccb88869d6555ca9ad",
+    "test_linear_vertical.ies": "a89db7bb18ede3709a53409884389410eb43a04b2ae7b7f1f9973db7beda2a19",
+    "test_stripes_uniform.ies": "f26c8381dbc007e8c1271329f547976180b9c57537cfa2332bf33261ff0adc3d",
+    "test_stripes_nonuniform.ies": "647c0fd6a35f11d7a53f1340236046781f2ce61b1f1b954086b84fa1d0dd8bf7",
+    "test_vstripes_hquadrants_nonuniform.ies": "66582367293165edfc53a68ca8a486adc8ed06cd257533d91cd2e1d350dba981",
+    "test_vstripes_hquadrants_nonuniform_aimDown.ies": "b4f238da7f9ddbfea22bc69b2fbb8bdc3a2daf2b2d920a2bbc7209bc6f04e648",
+    "test_vstripes_hquadrants_nonuniform_aimUp.ies": "d8079b1a8874229746da49e3a229505e8869355ae91e65d242b2fb17900dd3ba",
+    "usd/rect.usda": "d0fc8c543b93bd8f021e329181006d86ac9de7e4ac8db201f06964acf91d995a",
+    "usd/sphere.usda": "25f00c53306a2f28ba62fd4916ebf7b733320e6bb6bb2b3f83bdb12ee4776269",
+    "usd/disk.usda": "f67f08d24de4b6efb9895e4c32e59f60c961e11c3b5295fcab931d4baf8552a2",
+    "usd/cylinder.usda": "da50b181bc0c0f7a7c1577baf7a8169f16c288fb2190a933fa04fe66889e5773",
+    "usd/distant.usda": "259453c5cf09bc3d7d142b17cc4f32fe9b58104371a386c94cec79ddd5dbf5bf",
+    "usd/dome.usda": "c3263bd2bb4285aa7ae4dbbd328ce49238b09ae322f2f52ad2c02502cb64303a",
+    "usd/visibleRect.usda": "032db623e42047f91ecab6d09b7a28ddc04f74425bbfad3d59d5c8ae555f2d99",
+    "usd/iesTest.usda": "0de2cd5b72fe510ebe9e36a868bcc1fb0423c97c8a70a33629a4f91aa2b7b821",
+    "usd/iesLibPreview.usda": "f958c24dd943dfecd9e64298fdf734c1a092f7ab0a24f5d8c7dfd4d6aa10cc3d",
+    "usd/iesUp.usda": "8b172d30b23e6e2a16b0739403e643a2d6c683caf51c1d80e228f1a14bae9b72",
+    "usd/iesDown.usda": "f327120dab7aecc42d142c25df700238494ebfd6e51579fda81ed11c2392e0c8",
+    "usd/shapes/sphere50x50.usda": "84d905cc33fb2c411629096a99bc7e35aac899162cdab2c13387f5c4be536e81",
+}
+
+LUXTEST_README = """\
+# luxtest scenes (third-party test data)
+
+Copied byte for byte from github.com/pmolodo/luxtest @ 9d555a66d0a6 (branch `pmolodo`,
+2024-10-07), licensed CC-BY-4.0 (full text in LICENSE.md beside this file). Copied by
+tools/gen_usd_fixtures.py, which checks every file's sha256.
+
+- `usd/*.usda`, `usd/shapes/sphere50x50.usda`: the light test scenes.
+- `test_*.ies`: the synthetic IES profiles the scenes reference as `../test_*.ies`. They have CRLF
+  line endings on purpose (LM-63); `.gitattributes` keeps git from normalising them.
+
+Not copied (the scenes reference them, so they resolve to nothing here): `../bega_omni002_4777lm.ies`,
+`../04f377f94ce81cd7b5101fffdf571454.ies` (BEGA photometry, CC BY-ND 4.0) and `../dome_grid_2k.exr`.
+"""
+
+LIGHT_TYPES = {
+    "DistantLight", "SphereLight", "DiskLight", "RectLight", "CylinderLight", "DomeLight",
+    "DomeLight_1", "PortalLight", "GeometryLight", "PluginLight",
+}
+LIGHT_APIS = ("MeshLightAPI", "VolumeLightAPI")
+
+# ---------------------------------------------------------------------------------------------
+# The composition scene. Written as text so that a reader sees exactly what is authored.
+
+ROOT_USDA = """\
+#usda 1.0
+(
+    doc = "luxeval composition fixture, generated by tools/gen_usd_fixtures.py: every composition arc, every xformOp kind, time samples, visibility, fallbacks"
+    metersPerUnit = 0.5
+    upAxis = "Z"
+    subLayers = [
+        @layers/sublayer.usda@ (offset = 2; scale = 0.5)
+    ]
+)
+
+class "_LightClass"
+{
+    float inputs:exposure = 2
+    color3f inputs:color = (1, 0.5, 0.25)
+}
+
+class Xform "_AbstractRig"
+{
+    def SphereLight "NotListed"
+    {
+    }
+}
+
+def Xform "World"
+{
+    double3 xformOp:translate = (0, 0, 1)
+    float xformOp:rotateZ = 90
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateZ"]
+
+    def Scope "Defaults"
+    {
+        def DistantLight "Distant"
+        {
+        }
+        def SphereLight "Sphere"
+        {
+        }
+        def DiskLight "Disk"
+        {
+        }
+        def RectLight "Rect"
+        {
+        }
+        def CylinderLight "Cylinder"
+        {
+        }
+        def DomeLight "Dome"
+        {
+        }
+        def DomeLight_1 "Dome1"
+        {
+        }
+        def PortalLight "Portal"
+        {
+        }
+        def GeometryLight "Geometry"
+        {
+        }
+        def PluginLight "Plugin"
+        {
+        }
+        def Mesh "MeshLight" (
+            prepend apiSchemas = ["MeshLightAPI"]
+        )
+        {
+        }
+        def Volume "VolumeLight" (
+            prepend apiSchemas = ["VolumeLightAPI"]
+        )
+        {
+        }
+        def DiskLight "ShapedDefaults" (
+            prepend apiSchemas = ["ShapingAPI", "ShadowAPI"]
+        )
+        {
+        }
+    }
+
+    def Xform "Rig" (
+        prepend references = @rig/rig.usda@</Rig> (offset = 1; scale = 2)
+        variants = {
+            string mood = "cool"
+        }
+    )
+    {
+        over "Spot"
+        {
+            float inputs:specular = 0.25
+            float inputs:diffuse = None
+        }
+    }
+
+    def Xform "Instanced" (
+        instanceable = true
+        prepend references = @rig/rig.usda@</Rig>
+    )
+    {
+        double3 xformOp:translate = (10, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+
+    def Xform "Env" (
+        prepend payload = @env/env.usda@</Env>
+    )
+    {
+    }
+
+    def Xform "Switch" (
+        variants = {
+            string shape = "disk"
+        }
+        prepend variantSets = "shape"
+    )
+    {
+        variantSet "shape" = {
+            "disk" {
+                def DiskLight "Light"
+                {
+                    float inputs:radius = 0.25
+                    float inputs:intensity = 7
+                }
+            }
+            "rect" {
+                def RectLight "Light"
+                {
+                    float inputs:width = 3
+                }
+            }
+        }
+    }
+
+    def SphereLight "Inherited" (
+        prepend inherits = </_LightClass>
+    )
+    {
+        float inputs:intensity = 3
+    }
+
+    def DiskLight "Specialized" (
+        prepend specializes = </_LightClass>
+    )
+    {
+        float inputs:exposure = 1
+    }
+
+    def Xform "Shaped"
+    {
+        def DiskLight "Cone" (
+            prepend apiSchemas = ["ShapingAPI"]
+        )
+        {
+            float inputs:intensity = 40
+            float inputs:shaping:cone:angle = 35
+            float inputs:shaping:cone:softness = 0.3
+            float inputs:shaping:focus = 1.5
+            color3f inputs:shaping:focusTint = (0.2, 0.4, 0.6)
+            asset inputs:shaping:ies:file = @@
+        }
+        def SphereLight "Ies" (
+            prepend apiSchemas = ["ShapingAPI"]
+        )
+        {
+            asset inputs:shaping:ies:file = @ies/spot.ies@
+            float inputs:shaping:ies:angleScale = -0.5
+        }
+        def RectLight "Textured"
+        {
+            asset inputs:texture:file = @env/sky.png@
+        }
+        def RectLight "MissingTexture"
+        {
+            asset inputs:texture:file = @env/does_not_exist.png@
+        }
+    }
+
+    def Xform "OpsA"
+    {
+        double3 xformOp:translate = (1, 2, 3)
+        double xformOp:translateX = 0.5
+        float xformOp:translateY = -0.25
+        half xformOp:translateZ = 0.125
+        float3 xformOp:scale = (1, 2, 0.5)
+        double xformOp:scaleX = 1.5
+        float xformOp:scaleY = 0.75
+        half xformOp:scaleZ = 2
+        float xformOp:rotateX = 30
+        double xformOp:rotateY = -45
+        half xformOp:rotateZ = 60
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:translateX", "xformOp:translateY", "xformOp:translateZ", "xformOp:scale", "xformOp:scaleX", "xformOp:scaleY", "xformOp:scaleZ", "xformOp:rotateX", "xformOp:rotateY", "xformOp:rotateZ"]
+
+        def Xform "OpsB"
+        {
+            float3 xformOp:rotateXYZ = (10, 20, 30)
+            double3 xformOp:rotateXZY = (-15, 25, 35)
+            half3 xformOp:rotateYXZ = (5, 10, 15)
+            float3 xformOp:rotateYZX = (40, -30, 20)
+            float3 xformOp:rotateZXY = (12, 34, 56)
+            double3 xformOp:rotateZYX = (-60, 45, -30)
+            uniform token[] xformOpOrder = ["xformOp:rotateXYZ", "xformOp:rotateXZY", "xformOp:rotateYXZ", "xformOp:rotateYZX", "xformOp:rotateZXY", "xformOp:rotateZYX"]
+
+            def Xform "OpsC"
+            {
+                double3 xformOp:translate:pivot = (0.1, 0.2, 0.3)
+                quatf xformOp:orient = (0.9238795, 0, 0.3826834, 0)
+                quatd xformOp:orient:exact = (0.5, 0.5, 0.5, 0.5)
+                matrix4d xformOp:transform = ( (1, 0.2, 0, 0), (0, 1, 0.3, 0), (0.1, 0, 1, 0), (4, 5, 6, 1) )
+                float xformOp:rotateX:undo = 20
+                uniform token[] xformOpOrder = ["xformOp:translate:pivot", "xformOp:orient", "xformOp:orient:exact", "xformOp:transform", "xformOp:rotateX:undo", "!invert!xformOp:rotateX:undo", "!invert!xformOp:translate:pivot"]
+
+                def RectLight "AllOps"
+                {
+                    float inputs:width = 2
+                    float inputs:height = 3
+                    double3 xformOp:translate = (0, 0, -1)
+                    uniform token[] xformOpOrder = ["xformOp:translate"]
+                }
+
+                def SphereLight "Reset"
+                {
+                    double3 xformOp:translate = (7, 8, 9)
+                    uniform token[] xformOpOrder = ["!resetXformStack!", "xformOp:translate"]
+                }
+
+                def Xform "InvertedMatrix"
+                {
+                    matrix4d xformOp:transform = ( (2, 0, 0, 0), (0, 4, 0, 0), (0, 0, 0.5, 0), (1, 2, 3, 1) )
+                    uniform token[] xformOpOrder = ["!invert!xformOp:transform"]
+
+                    def CylinderLight "Child"
+                    {
+                    }
+                }
+            }
+        }
+    }
+
+    def RectLight "Anim"
+    {
+        float inputs:intensity.timeSamples = {
+            1: 10,
+            3: 30,
+        }
+        color3f inputs:color.timeSamples = {
+            1: (1, 0, 0),
+            3: (0, 0, 1),
+        }
+        bool inputs:normalize.timeSamples = {
+            1: 0,
+            2: 1,
+        }
+        asset inputs:texture:file.timeSamples = {
+            1: @@,
+            3: @env/sky.png@,
+        }
+        float inputs:width = 5
+        float inputs:width.timeSamples = {
+            2: 1,
+        }
+        float inputs:exposure.timeSamples = {
+            1: 1,
+            2: None,
+            3: 3,
+        }
+        double3 xformOp:translate.timeSamples = {
+            1: (0, 0, 0),
+            3: (2, 4, 6),
+        }
+        float3 xformOp:rotateXYZ.timeSamples = {
+            1: (0, 0, 0),
+            3: (90, 45, 30),
+        }
+        matrix4d xformOp:transform.timeSamples = {
+            1: ( (1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1) ),
+            3: ( (2, 0, 0, 0), (0, 1, 0, 0), (0, 0.5, 1, 0), (1, 1, 1, 1) ),
+        }
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ", "xformOp:transform"]
+    }
+
+    def Xform "QuatD"
+    {
+        quatd xformOp:orient.timeSamples = {
+            0: (0.9238795325112867, 0.3826834323650898, 0, 0),
+            4: (0.5, -0.5, 0.5, 0.5),
+        }
+        uniform token[] xformOpOrder = ["xformOp:orient"]
+
+        def SphereLight "Child"
+        {
+        }
+    }
+
+    def Xform "QuatH"
+    {
+        half3 xformOp:translate = (1, 0, 0)
+        quath xformOp:orient.timeSamples = {
+            0: (1, 0, 0, 0),
+            4: (0.70703125, 0, 0, 0.70703125),
+        }
+        uniform token[] xformOpOrder = ["xformOp:translate", "!invert!xformOp:orient"]
+
+        def DiskLight "Child"
+        {
+        }
+    }
+
+    def SphereLight "Blocked"
+    {
+        double3 xformOp:translate.timeSamples = {
+            1: (1, 0, 0),
+            2: None,
+            3: (3, 0, 0),
+        }
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+        token visibility.timeSamples = {
+            1: "invisible",
+            2: None,
+            3: "inherited",
+        }
+    }
+
+    def Xform "Hidden"
+    {
+        token visibility = "invisible"
+
+        def SphereLight "HiddenByParent"
+        {
+        }
+    }
+
+    def SphereLight "HiddenSelf"
+    {
+        token visibility = "invisible"
+    }
+
+    def DistantLight "Blink"
+    {
+        token visibility.timeSamples = {
+            0: "invisible",
+            2: "inherited",
+        }
+    }
+
+    def "Untyped"
+    {
+        token visibility = "invisible"
+
+        def SphereLight "UnderUntyped"
+        {
+        }
+    }
+
+    def Xform "Inactive" (
+        active = false
+    )
+    {
+        def SphereLight "Off"
+        {
+        }
+    }
+
+    def DiskLight "NegativeRadius"
+    {
+        float inputs:radius = -1
+    }
+
+    def SphereLight "DoubleTyped"
+    {
+        double inputs:intensity = 2.5
+    }
+}
+"""
+
+SUBLAYER_USDA = """\
+#usda 1.0
+(
+    doc = "Sublayer of root.usda (offset 2, scale 0.5): weaker opinions and its own lights"
+)
+
+over "World"
+{
+    def DistantLight "Sun"
+    {
+        float inputs:angle.timeSamples = {
+            0: 1,
+            10: 3,
+        }
+        float inputs:intensity = 10
+        float xformOp:rotateX = -45
+        uniform token[] xformOpOrder = ["xformOp:rotateX"]
+    }
+
+    def SphereLight "SubSpot" (
+        prepend apiSchemas = ["ShapingAPI"]
+    )
+    {
+        asset inputs:shaping:ies:file = @../ies/spot.ies@
+    }
+
+    over "Shaped"
+    {
+        over "Cone"
+        {
+            float inputs:intensity = 999
+            float inputs:specular = 0.5
+        }
+    }
+}
+"""
+
+RIG_USDA = """\
+#usda 1.0
+(
+    defaultPrim = "Rig"
+)
+
+def Xform "Rig" (
+    variants = {
+        string mood = "warm"
+    }
+    prepend variantSets = "mood"
+)
+{
+    double3 xformOp:translate = (0, 1, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def SphereLight "Spot" (
+        prepend apiSchemas = ["ShapingAPI"]
+    )
+    {
+        float inputs:intensity.timeSamples = {
+            0: 100,
+            4: 500,
+        }
+        float inputs:diffuse = 0.5
+        float inputs:radius = 0.1
+        float inputs:shaping:cone:angle = 30
+        float inputs:shaping:cone:softness = 0.25
+        float inputs:shaping:focus = 2
+        color3f inputs:shaping:focusTint = (1, 0.5, 0)
+        asset inputs:shaping:ies:file = @../ies/spot.ies@
+        float inputs:shaping:ies:angleScale = 0.5
+        bool inputs:shaping:ies:normalize = 1
+        quatf xformOp:orient.timeSamples = {
+            0: (1, 0, 0, 0),
+            4: (0, 0, 1, 0),
+        }
+        uniform token[] xformOpOrder = ["xformOp:orient"]
+    }
+
+    def RectLight "Fill"
+    {
+        float inputs:width = 2
+        float inputs:height = 0.5
+        bool inputs:normalize = 1
+    }
+
+    variantSet "mood" = {
+        "cool" {
+            over "Fill"
+            {
+                color3f inputs:color = (0.6, 0.8, 1)
+                bool inputs:enableColorTemperature = 1
+                float inputs:colorTemperature = 8000
+            }
+        }
+        "warm" {
+            over "Fill"
+            {
+                color3f inputs:color = (1, 0.8, 0.6)
+            }
+        }
+    }
+}
+"""
+
+ENV_USDA = """\
+#usda 1.0
+(
+    defaultPrim = "Env"
+)
+
+def Xform "Env"
+{
+    def DomeLight "Sky"
+    {
+        asset inputs:texture:file = @sky.png@
+        token inputs:texture:format.timeSamples = {
+            0: "latlong",
+            5: "angular",
+        }
+        float inputs:intensity = 0.5
+    }
+
+    def DomeLight_1 "Uniform"
+    {
+        uniform token poleAxis = "Z"
+        float inputs:intensity = 2
+        float guideRadius = 50
+        float xformOp:rotateY = 30
+        uniform token[] xformOpOrder = ["xformOp:rotateY"]
+    }
+}
+"""
+
+# A small, valid LM-63-2002 Type C profile, CRLF as the standard asks.
+SPOT_IES = (
+    "IESNA:LM-63-2002\r\n"
+    "[TEST] luxeval composition fixture\r\n"
+    "[MANUFAC] luxeval\r\n"
+    "TILT=NONE\r\n"
+    "1 1000 1 3 1 1 2 0 0 0\r\n"
+    "1 1 10\r\n"
+    "0 45 90\r\n"
+    "0\r\n"
+    "100 80 10\r\n"
+)
+
+ERRORS = {
+    # Line 5 is where the parser meets the stray token.
+    "malformed.usda": "#usda 1.0\n\ndef Xform \"World\"\n{\n    float inputs:intensity = = 3\n}\n",
+    "missing_reference.usda": (
+        "#usda 1.0\n\ndef Xform \"World\"\n{\n"
+        "    def SphereLight \"Ok\"\n    {\n    }\n"
+        "    def Xform \"Broken\" (\n        prepend references = @missing_layer.usda@</Rig>\n    )\n    {\n    }\n}\n"
+    ),
+    "missing_sublayer.usda": (
+        "#usda 1.0\n(\n    subLayers = [\n        @missing_sublayer_target.usda@\n    ]\n)\n\n"
+        "def SphereLight \"Ok\"\n{\n}\n"
+    ),
+    "malformed_reference.usda": (
+        "#usda 1.0\n\ndef Xform \"World\" (\n    prepend references = @malformed.usda@</World>\n)\n{\n}\n"
+    ),
+    "not_usd.usda": "this is not a USD file\n",
+    # Splines (USD 25.05+), which usd-core evaluates and openusd 0.8 does not.
+    "spline_input.usda": (
+        "#usda 1.0\n\ndef SphereLight \"L\"\n{\n    float inputs:intensity.spline = {\n"
+        "        bezier,\n        1: 10; post held,\n        3: 30,\n    }\n}\n"
+    ),
+    "spline_xform.usda": (
+        "#usda 1.0\n\ndef Xform \"Rig\"\n{\n    double xformOp:rotateX.spline = {\n"
+        "        bezier,\n        1: 0,\n        3: 90,\n    }\n"
+        "    uniform token[] xformOpOrder = [\"xformOp:rotateX\"]\n\n"
+        "    def SphereLight \"L\"\n    {\n    }\n}\n"
+    ),
+    # One light whose transform cannot be computed (the inverse of a singular matrix) beside a
+    # healthy one: the first is listed with a warning, the second still evaluates.
+    "singular_invert.usda": (
+        "#usda 1.0\n\ndef Xform \"World\"\n{\n"
+        "    def SphereLight \"Broken\"\n    {\n"
+        "        matrix4d xformOp:transform = ( (1, 0, 0, 0), (0, 0, 0, 0), (0, 0, 1, 0), (0, 0, 0, 1) )\n"
+        "        uniform token[] xformOpOrder = [\"!invert!xformOp:transform\"]\n    }\n"
+        "    def SphereLight \"Fine\"\n    {\n    }\n}\n"
+    ),
+}
+
+
+def png_bytes(width, height, rgb):
+    """A minimal 8-bit RGB PNG (stdlib only), so the dome texture is our own file."""
+
+    def chunk(kind, payload):
+        body = kind + payload
+        return struct.pack(">I", len(payload)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+
+    raw = b"".join(b"\x00" + bytes(rgb[y * width * 3:(y + 1) * width * 3]) for y in range(height))
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0))
+        + chunk(b"IDAT", zlib.compress(raw, 9))
+        + chunk(b"IEND", b"")
+    )
+
+
+def pin_zip_timestamps(path):
+    """Sets every entry's DOS modification time to 1980-01-01 00:00 in place, so that
+    regenerating a usdz gives the same bytes. Only the time/date fields change: sizes, offsets
+    and the 64-byte data alignment usdz requires stay as usd-core wrote them."""
+    with open(path, "r+b") as f:
+        data = bytearray(f.read())
+        infos = zipfile.ZipFile(path).infolist()
+        for info in infos:
+            o = info.header_offset
+            assert data[o:o + 4] == b"PK\x03\x04", path
+            data[o + 10:o + 14] = struct.pack("<HH", 0, 0x21)
+        eocd = data.rindex(b"PK\x05\x06")
+        count, _, cd = struct.unpack_from("<HII", data, eocd + 10)
+        assert count == len(infos), path
+        o = cd
+        for _ in range(count):
+            assert data[o:o + 4] == b"PK\x01\x02", path
+            data[o + 12:o + 16] = struct.pack("<HH", 0, 0x21)
+            n, m, k = struct.unpack_from("<HHH", data, o + 28)
+            o += 46 + n + m + k
+        f.seek(0)
+        f.write(data)
+
+
+def write(path, data):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    mode = "wb" if isinstance(data, bytes) else "w"
+    with open(path, mode, **({} if mode == "wb" else {"newline": ""})) as f:
+        f.write(data)
+
+
+def sha256(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def copy_luxtest(src):
+    dst = os.path.join(DATA, "luxtest")
+    for rel, digest in sorted(LUXTEST_FILES.items()):
+        s = os.path.join(src, rel)
+        got = sha256(s)
+        if got != digest:
+            sys.exit(f"{s}: sha256 {got} does not match the recorded {digest}")
+        d = os.path.join(dst, rel)
+        os.makedirs(os.path.dirname(d), exist_ok=True)
+        shutil.copyfile(s, d)
+        os.chmod(d, 0o644)
+    write(os.path.join(dst, "README.md"), LUXTEST_README)
+
+
+def write_composition():
+    comp = os.path.join(DATA, "usd", "composition")
+    if os.path.isdir(comp):
+        shutil.rmtree(comp)
+    write(os.path.join(comp, "root.usda"), ROOT_USDA)
+    write(os.path.join(comp, "layers", "sublayer.usda"), SUBLAYER_USDA)
+    write(os.path.join(comp, "rig", "rig.usda"), RIG_USDA)
+    write(os.path.join(comp, "env", "env.usda"), ENV_USDA)
+    write(os.path.join(comp, "ies", "spot.ies"), SPOT_IES.encode("ascii"))
+    # 4 × 2 lat-long: top row warm, bottom row cool.
+    write(
+        os.path.join(comp, "env", "sky.png"),
+        png_bytes(4, 2, [255, 200, 120] * 4 + [40, 60, 120] * 4),
+    )
+    # The same root layer written by usd-core's crate (binary) writer.
+    root = Sdf.Layer.FindOrOpen(os.path.join(comp, "root.usda"))
+    if not root.Export(os.path.join(comp, "root.usdc")):
+        sys.exit("exporting root.usdc failed")
+    # The whole scene packed with its layers and assets in the same relative layout, root layer
+    # first as the usdz spec requires, so every authored path means the same inside the package.
+    cwd = os.getcwd()
+    os.chdir(comp)
+    try:
+        with Sdf.ZipFileWriter.CreateNew("scene.usdz") as zw:
+            for rel in ("root.usda", "layers/sublayer.usda", "rig/rig.usda", "env/env.usda",
+                        "env/sky.png", "ies/spot.ies"):
+                zw.AddFile(rel, rel)
+        # A package made the way most usdz files are: UsdUtils collects the rig and the IES
+        # profile it references from outside its folder, renaming paths as it sees fit.
+        if not UsdUtils.CreateNewUsdzPackage(Sdf.AssetPath("rig/rig.usda"), "rig_packaged.usdz"):
+            sys.exit("CreateNewUsdzPackage failed")
+        for pkg in ("scene.usdz", "rig_packaged.usdz"):
+            pin_zip_timestamps(pkg)
+    finally:
+        os.chdir(cwd)
+
+    errs = os.path.join(DATA, "usd", "errors")
+    if os.path.isdir(errs):
+        shutil.rmtree(errs)
+    for name, text in ERRORS.items():
+        write(os.path.join(errs, name), text)
+    # The spline scene as usd-core's crate writer stores it (crate version 0.12).
+    if not Sdf.Layer.FindOrOpen(os.path.join(errs, "spline_input.usda")).Export(
+        os.path.join(errs, "spline_input.usdc")
+    ):
+        sys.exit("exporting spline_input.usdc failed")
+
+
+# ---------------------------------------------------------------------------------------------
+# Expectations
+
+
+def rel_resolved(resolved):
+    """A resolved path relative to tests/data (the fixtures must not hold this machine's paths)."""
+    if not resolved:
+        return None
+    prefix = DATA + os.sep
+    if resolved.startswith(prefix):
+        return resolved[len(prefix):].replace(os.sep, "/")
+    return resolved
+
+
+def value_json(v, type_name):
+    t = str(type_name)
+    if v is None:
+        return None
+    if t in ("float", "double", "half"):
+        return float(v)
+    if t == "bool":
+        return bool(v)
+    if t in ("color3f", "float3", "double3", "color3d"):
+        return [float(x) for x in v]
+    if t == "token" or t == "string":
+        return str(v)
+    if t == "asset":
+        return {"authored": v.path, "resolved": rel_resolved(v.resolvedPath)}
+    raise TypeError(f"unexpected attribute type {t}")
+
+
+SCALAR_TYPES = {"float", "double", "half", "bool", "color3f", "color3d", "float3", "double3", "token", "asset", "string"}
+
+
+def light_record(prim, time, xf_cache):
+    applied = [str(s) for s in prim.GetAppliedSchemas()]
+    authored_api = [str(s) for s in prim.GetPrimTypeInfo().GetAppliedAPISchemas()]
+    img = UsdGeom.Imageable(prim)
+    visible = (img.ComputeVisibility(time) != UsdGeom.Tokens.invisible) if img else True
+    m = xf_cache.GetLocalToWorldTransform(prim)
+    inputs = []
+    for attr in prim.GetAttributes():
+        name = attr.GetName()
+        t = str(attr.GetTypeName())
+        if t not in SCALAR_TYPES:
+            continue
+        if not (name.startswith("inputs:") or name in ("treatAsPoint", "treatAsLine", "guideRadius", "poleAxis")):
+            continue
+        inputs.append({
+            "name": name,
+            "type": t,
+            "value": value_json(attr.Get(time), t),
+            "authored": bool(attr.HasAuthoredValue()),
+        })
+    return {
+        "path": str(prim.GetPath()),
+        "type": str(prim.GetTypeName()),
+        "applied_schemas": applied,
+        "authored_api_schemas": authored_api,
+        "visible": bool(visible),
+        "world": [[float(m[r][c]) for c in range(4)] for r in range(4)],
+        "inputs": inputs,
+    }
+
+
+def is_light(prim):
+    if str(prim.GetTypeName()) in LIGHT_TYPES:
+        return True
+    return any(str(s) in LIGHT_APIS for s in prim.GetAppliedSchemas())
+
+
+def dump(scene_rel, out_name, times):
+    path = os.path.join(DATA, scene_rel)
+    stage = Usd.Stage.Open(path)
+    if stage is None:
+        sys.exit(f"cannot open {path}")
+    lights = [p for p in stage.Traverse(Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)) if is_light(p)]
+    layer = stage.GetRootLayer()
+    start = layer.startTimeCode if layer.HasStartTimeCode() else None
+    end = layer.endTimeCode if layer.HasEndTimeCode() else None
+    if times is None:
+        # Every integer frame the scene authors.
+        times = list(range(int(start), int(end) + 1))
+    samples = []
+    for t in [None] + list(times):
+        tc = Usd.TimeCode.EarliestTime() if t is None else Usd.TimeCode(t)
+        cache = UsdGeom.XformCache(tc)
+        samples.append({"time": t, "lights": [light_record(p, tc, cache) for p in lights]})
+    out = {
+        "generator": "tools/gen_usd_fixtures.py",
+        "usd_version": ".".join(str(x) for x in Usd.GetVersion()),
+        "scene": scene_rel,
+        "up_axis": str(UsdGeom.GetStageUpAxis(stage)),
+        "meters_per_unit": float(UsdGeom.GetStageMetersPerUnit(stage)),
+        "start_time_code": start,
+        "end_time_code": end,
+        "samples": samples,
+    }
+    dst = os.path.join(DATA, "usd", "expected", out_name + ".json")
+    os.makedirs(os.path.dirname(dst), exist_ok=True)
+    with open(dst, "w") as f:
+        json.dump(out, f, indent=None, separators=(",", ":"))
+        f.write("\n")
+    print(f"{dst}: {len(lights)} lights x {len(samples)} times")
+
+
+COMPOSITION_TIMES = [-1, 0, 1, 1.5, 2, 2.25, 3, 4.5, 7, 10]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--luxtest-src", default="/work/shared/data/luxtest", help="the research/data/luxtest copy")
+    args = ap.parse_args()
+
+    copy_luxtest(args.luxtest_src)
+    write_composition()
+
+    exp = os.path.join(DATA, "usd", "expected")
+    if os.path.isdir(exp):
+        shutil.rmtree(exp)
+    for rel in sorted(LUXTEST_FILES):
+        if rel.startswith("usd/") and not rel.startswith("usd/shapes/"):
+            name = os.path.splitext(os.path.basename(rel))[0]
+            dump("luxtest/" + rel, "luxtest_" + name, None)
+    for ext in ("usda", "usdc"):
+        dump(f"usd/composition/root.{ext}", f"composition_root_{ext}", COMPOSITION_TIMES)
+    dump("usd/composition/scene.usdz", "composition_scene_usdz", COMPOSITION_TIMES)
+    dump("usd/composition/rig_packaged.usdz", "composition_rig_packaged_usdz", COMPOSITION_TIMES)
+
+
+if __name__ == "__main__":
+    main()
