@@ -264,6 +264,15 @@ fn run(cli: Cli) -> CliResult {
     }
 }
 
+/// An error about a light of `scene`, prefixed with the stage's path.
+fn in_scene(scene: &Path, e: LuxError) -> Failure {
+    let f = Failure::from(e);
+    Failure {
+        code: f.code,
+        message: format!("{}: {}", scene.display(), f.message),
+    }
+}
+
 fn accumulate(c: &Common) -> Accumulate {
     if c.per_light {
         Accumulate::PerLight
@@ -279,6 +288,10 @@ fn open(c: &Common) -> CliResult<(Evaluator, Vec<Light>)> {
         eprintln!("warning: {w}");
     }
     let lights = scene.evaluable(&c.lights)?;
+    // Validate here so that an invalid attribute is reported with the stage it comes from.
+    for l in &lights {
+        l.validate().map_err(|e| in_scene(&c.scene, e))?;
+    }
     if lights.is_empty() {
         eprintln!(
             "warning: {}: no light to evaluate; the output is all zeros",
@@ -459,7 +472,7 @@ fn check_cmd(
         );
         return Ok(());
     }
-    let prepared = luxeval::cpu::prepare(&lights, mode)?;
+    let prepared = luxeval::cpu::prepare(&lights, mode).map_err(|e| in_scene(path, e))?;
     let gpu = GpuContext::new()
         .map_err(|e| Failure::runtime(format!("check compares against a GPU: {e}")))?;
     let device = format!("{} ({})", gpu.adapter().name, gpu.adapter().backend);

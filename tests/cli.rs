@@ -157,7 +157,36 @@ fn bad_inputs_exit_2_with_a_useful_message_and_leave_no_file() {
         "cpu",
     ]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("bad.usda"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("bad.usda:5") || stderr(&o).contains("bad.usda:6"),
+        "{}",
+        stderr(&o)
+    );
+    // An invalid attribute value: names the stage, the prim and the attribute.
+    let neg = dir.path().join("neg.usda");
+    std::fs::write(
+        &neg,
+        "#usda 1.0\n\ndef SphereLight \"s\"\n{\n    float inputs:radius = -1\n}\n",
+    )
+    .unwrap();
+    let o = luxeval(&[
+        "emission",
+        neg.to_str().unwrap(),
+        "--dirs",
+        &asset("dirs.npy"),
+        "-o",
+        o_str,
+        "--device",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("neg.usda")
+            && stderr(&o).contains("/s")
+            && stderr(&o).contains("inputs:radius"),
+        "{}",
+        stderr(&o)
+    );
     // Missing scene.
     let o = luxeval(&[
         "emission",
@@ -223,7 +252,9 @@ fn bad_inputs_exit_2_with_a_useful_message_and_leave_no_file() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("/lights/nope"), "{}", stderr(&o));
     // Nothing was written, not even a temporary.
-    assert_eq!(no_stray_files(dir.path()), vec![bad]);
+    let mut left = no_stray_files(dir.path());
+    left.sort();
+    assert_eq!(left, vec![bad, neg]);
 }
 
 #[test]
