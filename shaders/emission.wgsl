@@ -50,14 +50,7 @@ fn emission_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let e = normalize(load3(false, i));
     var sum = vec3<f32>(0.0);
     for (var l = 0u; l < params.light_count; l++) {
-        let v = emission_of(lights[l], e);
-        if params.per_light != 0u {
-            store3(l * params.count + i, v);
-        } else {
-            sum += v;
-        }
+        add(i, l, emission_of(lights[l], e), &sum);
     }
-    if params.per_light == 0u {
-        store3(i, sum);
-    }
+    finish(i, sum);
 }

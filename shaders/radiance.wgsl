@@ -50,14 +50,7 @@ fn radiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let w = normalize(load3(true, i));
     var sum = vec3<f32>(0.0);
     for (var l = 0u; l < params.light_count; l++) {
-        let v = radiance_of(lights[l], x, w);
-        if params.per_light != 0u {
-            store3(l * params.count + i, v);
-        } else {
-            sum += v;
-        }
+        add(i, l, radiance_of(lights[l], x, w), &sum);
     }
-    if params.per_light == 0u {
-        store3(i, sum);
-    }
+    finish(i, sum);
 }

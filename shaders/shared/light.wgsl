@@ -68,6 +68,22 @@ fn store3(row: u32, v: vec3<f32>) {
     out_rgb[3u * row + 2u] = v.z;
 }
 
+// Every kernel loops over the lights for its sample i: `add` stores light l's value to its own
+// row (per_light) or adds it to the running sum, and `finish` stores the sum.
+fn add(i: u32, l: u32, v: vec3<f32>, sum: ptr<function, vec3<f32>>) {
+    if params.per_light != 0u {
+        store3(l * params.count + i, v);
+    } else {
+        *sum += v;
+    }
+}
+
+fn finish(i: u32, sum: vec3<f32>) {
+    if params.per_light == 0u {
+        store3(i, sum);
+    }
+}
+
 fn has_flag(light: Light, flag: u32) -> bool {
     return (light.flags & flag) != 0u;
 }
