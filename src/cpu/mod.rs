@@ -1,13 +1,16 @@
 //! The CPU reference: every query in f64, written for clarity (DESIGN.md §1).
 //!
 //! Each module that implements a concept evaluated per direction has a WGSL twin of the same
-//! name under `shaders/` (`emission`, `radiance`, `shared/shaping`, `shared/shapes`). The
-//! per-light constants (`blackbody`, `normalize`) are computed here once in f64 for both paths
-//! and have no WGSL twin.
+//! name under `shaders/` (`emission`, `radiance`, `irradiance`, `shared/shaping`,
+//! `shared/shapes`). The per-light constants (`blackbody`, `normalize`) are computed here once in
+//! f64 for both paths and have no WGSL twin; `quadrature` holds the rules (the GPU's fixed
+//! Gauss–Legendre nodes reach WGSL through the generated prelude).
 
 pub mod blackbody;
 pub mod emission;
+pub mod irradiance;
 pub mod normalize;
+pub mod quadrature;
 pub mod radiance;
 pub mod shapes;
 pub mod shaping;
@@ -131,5 +134,17 @@ pub fn radiance_batch(
 ) -> Vec<DVec3> {
     batch(lights, dirs.len(), per_light, |l, i| {
         radiance::radiance(l, dvec(points[i]), dvec(dirs[i]))
+    })
+}
+
+/// irradiance(x, n) for every light and (point, normal) pair (see [`irradiance::irradiance`]).
+pub fn irradiance_batch(
+    lights: &[PreparedLight],
+    points: &[[f32; 3]],
+    normals: &[[f32; 3]],
+    per_light: bool,
+) -> Vec<DVec3> {
+    batch(lights, points.len(), per_light, |l, i| {
+        irradiance::irradiance(l, dvec(points[i]), dvec(normals[i]))
     })
 }
