@@ -26,6 +26,8 @@ pub use blackbody::TemperatureMode;
 /// packer so that both evaluate the same numbers.
 #[derive(Clone, Debug)]
 pub struct PreparedLight {
+    /// The light as evaluated: the input, except that a ShapingAPI whose factor is 1 everywhere
+    /// is dropped (see [`shaping_is_identity`]).
     pub light: Light,
     /// `intensity · 2^exposure · color ⊙ temperature(T) / sizeFactor` (DESIGN.md §2 "Emission").
     pub base: DVec3,
@@ -66,8 +68,12 @@ impl PreparedLight {
                 format!("intensity · 2^exposure · color overflows ({base})"),
             ));
         }
+        let mut evaluated = light.clone();
+        if evaluated.shaping.as_ref().is_some_and(shaping_is_identity) {
+            evaluated.shaping = None;
+        }
         Ok(PreparedLight {
-            light: light.clone(),
+            light: evaluated,
             base,
             size_factor,
             origin: light.origin(),
@@ -80,6 +86,16 @@ impl PreparedLight {
     pub fn kind(&self) -> &LightType {
         &self.light.kind
     }
+}
+
+/// Whether ShapingAPI's factor is exactly 1 along every direction: no focus (or a white tint) and
+/// a cone whose smoothstep starts at or beyond 180° (luxtest authors cone 180, softness 0, to mean
+/// "no cone"). Such a ShapingAPI is dropped from [`PreparedLight::light`]: the values are the
+/// same, and irradiance can use its closed forms.
+pub fn shaping_is_identity(s: &crate::light::Shaping) -> bool {
+    let no_focus = s.focus <= 0.0 || s.focus_tint == DVec3::ONE;
+    let start_deg = (1.0 - s.cone_softness.clamp(0.0, 1.0)) * s.cone_angle;
+    no_focus && start_deg >= 180.0
 }
 
 /// Prepares every light, failing on the first invalid one.
@@ -147,4 +163,44 @@ pub fn irradiance_batch(
     batch(lights, points.len(), per_light, |l, i| {
         irradiance::irradiance(l, dvec(points[i]), dvec(normals[i]))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::check::Rng;
+    use crate::light::Shaping;
+
+    #[test]
+    fn identity_shaping_is_dropped_without_changing_values() {
+        let cone180 = Shaping {
+            cone_angle: 180.0,
+            ..Shaping::default()
+        };
+        assert!(shaping_is_identity(&cone180));
+        assert!(shaping_is_identity(&Shaping {
+            focus: 3.0,
+            focus_tint: DVec3::ONE,
+            ..cone180.clone()
+        }));
+        assert!(!shaping_is_identity(&Shaping::default())); // the 90° fallback cone
+        assert!(!shaping_is_identity(&Shaping {
+            cone_softness: 0.1,
+            ..cone180.clone()
+        }));
+        assert!(!shaping_is_identity(&Shaping {
+            focus: 1.0,
+            ..cone180.clone()
+        }));
+        let light = Light::sphere(0.5).with_shaping(cone180.clone());
+        let p = PreparedLight::new(&light, TemperatureMode::Spec).unwrap();
+        assert!(p.light.shaping.is_none());
+        let mut rng = Rng::new(5);
+        for _ in 0..1000 {
+            let e = rng.unit();
+            let s = shaping::shaping(&cone180, p.axis, e);
+            assert_eq!(s, DVec3::ONE, "{e}");
+            assert_eq!(emission::emission(&p, e), p.base);
+        }
+    }
 }
