@@ -49,7 +49,7 @@ fn emission_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let e = normalize(load3(false, i));
     var sum = vec3<f32>(0.0);
-    for (var l = 0u; l < params.light_count; l++) {
+    for (var l = params.light_first; l < params.light_end; l++) {
         add(i, l, emission_of(lights[l], e), &sum);
     }
     finish(i, sum);

@@ -49,7 +49,7 @@ fn radiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let x = load3(false, i);
     let w = normalize(load3(true, i));
     var sum = vec3<f32>(0.0);
-    for (var l = 0u; l < params.light_count; l++) {
+    for (var l = params.light_first; l < params.light_end; l++) {
         add(i, l, radiance_of(lights[l], x, w), &sum);
     }
     finish(i, sum);

@@ -12,7 +12,9 @@
 //! - within [`CONE_BAND`]·θcone of a ShapingAPI cone edge, hard or soft (see its docs);
 //! - for radiance, a shape's silhouette: the hit point or the closest approach within `BAND` of
 //!   the boundary (as a fraction of the shape's size), grazing rays, and ray origins within
-//!   `BAND` of the surface.
+//!   `BAND` of the surface;
+//! - for irradiance, receivers that see only a sliver of the light (at the receiver's horizon,
+//!   at the light's own plane, at a cone edge) or sit on the light: see [`irradiance_margin`].
 //!
 //! Everything else must be within tolerance.
 
@@ -20,7 +22,7 @@ use glam::{DMat4, DQuat, DVec3};
 
 use crate::cpu::normalize::distant_half_angle;
 use crate::cpu::shaping::off_axis_angle;
-use crate::cpu::{PreparedLight, emission, radiance};
+use crate::cpu::{PreparedLight, emission, irradiance, radiance};
 use crate::error::Result;
 use crate::gpu::{GpuContext, Kernel, pack};
 use crate::light::{Light, LightType, Shaping};
@@ -44,6 +46,7 @@ pub const CONE_BAND: f64 = 4e-3;
 pub enum Query {
     Emission,
     Radiance,
+    Irradiance,
 }
 
 /// One light's result for one query.
@@ -66,9 +69,9 @@ pub struct QueryReport {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Worst {
     pub index: usize,
-    /// Direction (emission) or point (radiance).
+    /// Direction (emission) or point (radiance, irradiance).
     pub a: [f32; 3],
-    /// Direction (radiance).
+    /// Direction (radiance) or receiver normal (irradiance).
     pub b: Option<[f32; 3]>,
     pub cpu: [f64; 3],
     pub gpu: [f32; 3],
@@ -347,6 +350,282 @@ pub fn radiance_margin(p: &PreparedLight, x: DVec3, w: DVec3) -> f64 {
     m_emit.min(m_shape)
 }
 
+/// Irradiance receivers for one light: points around the light as for radiance (1.05–6 sizes
+/// from its centre, mostly on the emitting side of rects and disks, half of them inside a
+/// shaped light's cone), normals half uniform and half toward the light (perturbed); for
+/// distant and dome lights, points in a box and normals around the direction of the light.
+pub fn irradiance_samples(
+    p: &PreparedLight,
+    n: usize,
+    rng: &mut Rng,
+) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let l = &p.light;
+    let ext = local_extent(l);
+    let size = ext.max_element().max(1e-3);
+    let mut points = Vec::with_capacity(n);
+    let mut normals = Vec::with_capacity(n);
+    for i in 0..n {
+        let (x, toward) = match l.kind {
+            LightType::Distant { .. } | LightType::Dome => (
+                DVec3::new(
+                    rng.range(-5.0, 5.0),
+                    rng.range(-5.0, 5.0),
+                    rng.range(-5.0, 5.0),
+                ),
+                -p.axis,
+            ),
+            _ => {
+                let mut o = match &l.shaping {
+                    // Inside (or around) the cone, in light space: −Z is the axis.
+                    Some(s) if i % 2 == 0 => {
+                        let cone =
+                            (1.2 * s.cone_angle.to_radians()).clamp(0.05, std::f64::consts::PI);
+                        rng.cone(DVec3::NEG_Z, cone)
+                    }
+                    _ => rng.unit(),
+                } * size
+                    * rng.range(1.05, 6.0);
+                if matches!(l.kind, LightType::Rect { .. } | LightType::Disk { .. })
+                    && rng.chance(0.9)
+                {
+                    o.z = -o.z.abs();
+                }
+                let x = l.world.transform_point3(o);
+                (x, (p.origin - x).normalize())
+            }
+        };
+        let nrm = if i % 4 < 2 {
+            rng.unit()
+        } else {
+            (toward + rng.unit() * rng.range(0.0, 1.2)).normalize()
+        };
+        points.push(f32x3(x));
+        normals.push(f32x3(if nrm.is_finite() { nrm } else { DVec3::Z }));
+    }
+    (points, normals)
+}
+
+/// Irradiance slivers (see [`irradiance_margin`]) narrower than this many times η, the angular
+/// resolution of the light's f32 geometry seen from the receiver, are excluded. A sliver of
+/// angular thickness t has irradiance ∝ t^k: k = 2 for a straight edge (area ∝ t, cosine ∝ t),
+/// k = 5/2 for a curved outline (a circle's segment has area ∝ t^{3/2}). Moving the geometry by
+/// η changes it by k·η/t relative, so 5e4 keeps that at 1e-4/2 for k = 5/2 (a sphere seen
+/// 0.07 radii from its surface, behind the receiver, measured 3e-4 at 1.3e4·η on lavapipe).
+pub const IRRADIANCE_SLIVER_FACTOR: f64 = 5e4;
+
+/// Half of f32's machine epsilon: the relative rounding of one f32 coordinate.
+pub const F32_ROUNDING: f64 = f32::EPSILON as f64 / 2.0;
+
+/// World-space points on the outline of what x sees of the light (the boundary of its solid
+/// angle): rect edges, disk rim, the sphere's contact ellipse, the cylinder's front patch
+/// (tangent generators and front arcs of the end rings); the origin of a point light and the
+/// ends of a line light. Empty when x sees nothing (inside a sphere or a cylinder's tube).
+pub fn irradiance_outline(p: &PreparedLight, x: DVec3) -> Vec<DVec3> {
+    let m = p.light.linear();
+    let o = p.origin;
+    let xl = p.to_local * (x - o);
+    let k = 64;
+    let ring = |c: DVec3, u: DVec3, v: DVec3, t0: f64, t1: f64| -> Vec<DVec3> {
+        (0..=k)
+            .map(|j| {
+                let t = t0 + (t1 - t0) * j as f64 / k as f64;
+                o + m * (c + u * t.cos() + v * t.sin())
+            })
+            .collect()
+    };
+    match p.light.kind {
+        LightType::Rect { width, height } => {
+            let (hw, hh) = (width / 2.0, height / 2.0);
+            let c = [(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)];
+            let mut out = Vec::new();
+            for e in 0..4 {
+                let (a, b) = (c[e], c[(e + 1) % 4]);
+                for j in 0..k {
+                    let t = j as f64 / k as f64;
+                    out.push(o + m * DVec3::new(a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1), 0.0));
+                }
+            }
+            out
+        }
+        LightType::Disk { radius } => ring(
+            DVec3::ZERO,
+            DVec3::X * radius,
+            DVec3::Y * radius,
+            0.0,
+            std::f64::consts::TAU,
+        ),
+        LightType::Sphere {
+            treat_as_point: true,
+            ..
+        } => vec![o],
+        LightType::Sphere { radius, .. } => {
+            let rho = xl.length();
+            if !(rho > radius) {
+                return vec![];
+            }
+            let kk = (rho - radius) * (rho + radius);
+            let (u, v) = (xl / rho).any_orthonormal_pair();
+            let rc = radius * kk.sqrt() / rho;
+            ring(
+                xl * (radius * radius / (rho * rho)),
+                u * rc,
+                v * rc,
+                0.0,
+                std::f64::consts::TAU,
+            )
+        }
+        LightType::Cylinder {
+            length,
+            treat_as_line: true,
+            ..
+        } => vec![
+            o + m * DVec3::X * (length / 2.0),
+            o - m * DVec3::X * (length / 2.0),
+        ],
+        LightType::Cylinder { length, radius, .. } => {
+            let hl = length / 2.0;
+            let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+            if !(rho > radius) {
+                return vec![];
+            }
+            let tx = xl.z.atan2(xl.y);
+            let half = (radius / rho).acos();
+            let mut out = ring(
+                DVec3::X * hl,
+                DVec3::Y * radius,
+                DVec3::Z * radius,
+                tx - half,
+                tx + half,
+            );
+            out.extend(ring(
+                -DVec3::X * hl,
+                DVec3::Y * radius,
+                DVec3::Z * radius,
+                tx - half,
+                tx + half,
+            ));
+            for t in [tx - half, tx + half] {
+                for j in 0..=k {
+                    let a = -hl + 2.0 * hl * j as f64 / k as f64;
+                    out.push(o + m * DVec3::new(a, radius * t.cos(), radius * t.sin()));
+                }
+            }
+            out
+        }
+        LightType::Distant { .. } | LightType::Dome => vec![],
+    }
+}
+
+/// Distance of an irradiance receiver from the places where f32 legitimately cannot resolve the
+/// answer to 1e-4 (dimensionless, compared with [`BAND`]).
+///
+/// The GPU sees the light through f32 coordinates: its position and shape move by about
+/// `F32_ROUNDING·(|x| + |o| + size)`, which x sees as an angle η (that length over the distance
+/// to the nearest point of the light; at least `F32_ROUNDING` for distant lights, whose axis is
+/// rounded). Where x sees only a sliver of the light, the sliver's thickness t changes by ~η and
+/// the irradiance by ~η/t relative. The bands, each scaled to reach `BAND` at its edge:
+/// - the receiver's horizon passing within `IRRADIANCE_SLIVER_FACTOR·η` of the top of what x
+///   sees (only a sliver above the horizon), or of a distant cone's top;
+/// - a rect or disk seen within `IRRADIANCE_SLIVER_FACTOR·η` of its own plane (x near the plane;
+///   this includes x on the light);
+/// - x within `BAND` (relative) of a sphere's or cylinder's surface;
+/// - a ShapingAPI cone edge (hard or soft) within max([`CONE_BAND`]·θcone,
+///   `IRRADIANCE_SLIVER_FACTOR·η`) of the smallest emission angle at which x sees the light
+///   (x in the outer sliver of the penumbra, where the lit part of the light is a sliver and
+///   the factor vanishes there).
+pub fn irradiance_margin(p: &PreparedLight, x: DVec3, n: DVec3) -> f64 {
+    let n = n.normalize();
+    let scale = |v: f64, band: f64| v.abs() / band * BAND;
+    let mut m = f64::INFINITY;
+    let xl = p.to_local * (x - p.origin);
+    match p.light.kind {
+        LightType::Dome => return f64::INFINITY,
+        LightType::Distant { angle } => {
+            let band = IRRADIANCE_SLIVER_FACTOR * 2.0 * F32_ROUNDING;
+            let top = n.dot(-p.axis).clamp(-1.0, 1.0).asin() + distant_half_angle(angle);
+            return scale(top, band);
+        }
+        LightType::Sphere {
+            radius,
+            treat_as_point: false,
+        } => {
+            m = m.min(scale((xl.length() - radius) / radius, BAND));
+        }
+        LightType::Cylinder {
+            radius,
+            treat_as_line: false,
+            ..
+        } => {
+            let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+            m = m.min(scale((rho - radius) / radius, BAND));
+        }
+        _ => {}
+    }
+    let outline = irradiance_outline(p, x);
+    if outline.is_empty() {
+        return m;
+    }
+    let lin = p.light.linear();
+    let size = (lin * local_extent(&p.light)).length()
+        + lin
+            .x_axis
+            .length()
+            .max(lin.y_axis.length())
+            .max(lin.z_axis.length())
+            * local_extent(&p.light).max_element();
+    let nearest = outline
+        .iter()
+        .map(|q| (*q - x).length())
+        .fold(f64::INFINITY, f64::min);
+    let eta = F32_ROUNDING * (x.length() + p.origin.length() + size) / nearest;
+    let band = IRRADIANCE_SLIVER_FACTOR * eta;
+    // Receiver horizon: the highest elevation of the outline above it.
+    let top = outline
+        .iter()
+        .map(|q| n.dot((*q - x).normalize()).clamp(-1.0, 1.0).asin())
+        .fold(f64::NEG_INFINITY, f64::max);
+    m = m.min(scale(top, band));
+    // A rect's or disk's own plane: the largest elevation of x above it seen from the outline.
+    if matches!(
+        p.light.kind,
+        LightType::Rect { .. } | LightType::Disk { .. }
+    ) {
+        let h = (x - p.origin).dot(p.normal);
+        let elev = outline
+            .iter()
+            .map(|q| (h / (x - *q).length()).clamp(-1.0, 1.0).asin().abs())
+            .fold(0.0, f64::max);
+        m = m.min(scale(elev, band));
+    }
+    // The cone edge: the smallest emission angle at which x sees the light.
+    if let Some(s) = &p.light.shaping {
+        let cone = s.cone_angle.to_radians();
+        if cone > 0.0 && cone < std::f64::consts::PI {
+            let sees_axis = match p.light.kind {
+                LightType::Sphere {
+                    treat_as_point: true,
+                    ..
+                }
+                | LightType::Cylinder {
+                    treat_as_line: true,
+                    ..
+                } => false,
+                _ => radiance::hits_emitting_surface(p, x, -p.axis),
+            };
+            let theta_min = if sees_axis {
+                0.0
+            } else {
+                outline
+                    .iter()
+                    .map(|q| off_axis_angle(p.axis, (x - *q).normalize()))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            m = m.min(scale(theta_min - cone, (CONE_BAND * cone).max(band)));
+        }
+    }
+    m
+}
+
 /// Relative error of one sample (see the module docs).
 pub fn rel_error(cpu: DVec3, gpu: [f32; 3]) -> f64 {
     let g = DVec3::new(gpu[0] as f64, gpu[1] as f64, gpu[2] as f64);
@@ -361,7 +640,27 @@ pub fn rel_error(cpu: DVec3, gpu: [f32; 3]) -> f64 {
     }
 }
 
-/// Compares GPU and CPU on `samples` emission directions and `samples` radiance rays per light.
+/// Samples per light and query.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Samples {
+    pub emission: usize,
+    pub radiance: usize,
+    pub irradiance: usize,
+}
+
+impl Samples {
+    /// `n` emission directions and radiance rays, and `n/4` (rounded up) irradiance receivers:
+    /// each irradiance sample is a quadrature on both sides, ~100× the cost of the others.
+    pub fn per_query(n: usize) -> Self {
+        Samples {
+            emission: n,
+            radiance: n,
+            irradiance: n.div_ceil(4),
+        }
+    }
+}
+
+/// Compares GPU and CPU on [`Samples::per_query`]`(samples)` per light.
 pub fn check(
     gpu: &GpuContext,
     device: &str,
@@ -369,11 +668,24 @@ pub fn check(
     samples: usize,
     seed: u64,
 ) -> Result<CheckReport> {
+    check_with(gpu, device, lights, Samples::per_query(samples), seed)
+}
+
+/// Compares GPU and CPU on the given number of samples per light and query (a query with 0
+/// samples is skipped).
+pub fn check_with(
+    gpu: &GpuContext,
+    device: &str,
+    lights: &[PreparedLight],
+    counts: Samples,
+    seed: u64,
+) -> Result<CheckReport> {
     let mut rng = Rng::new(seed);
     let mut rows = Vec::new();
     for p in lights {
         let rec = [pack::pack(p)];
         // Emission.
+        let samples = counts.emission;
         let dirs = emission_samples(p, samples, &mut rng);
         let got = gpu.run(Kernel::Emission, &rec, &dirs, None, false)?;
         rows.push(compare(p, Query::Emission, samples, |i| {
@@ -387,6 +699,7 @@ pub fn check(
             )
         }));
         // Radiance.
+        let samples = counts.radiance;
         let (pts, dirs) = radiance_samples(p, samples, &mut rng);
         let got = gpu.run(Kernel::Radiance, &rec, &pts, Some(&dirs), false)?;
         rows.push(compare(p, Query::Radiance, samples, |i| {
@@ -399,7 +712,28 @@ pub fn check(
                 Some(dirs[i]),
             )
         }));
+        // Irradiance: the CPU values (quadratures) are computed in parallel.
+        let ni = counts.irradiance;
+        let (pts, nrms) = irradiance_samples(p, ni, &mut rng);
+        let got = gpu.run(Kernel::Irradiance, &rec, &pts, Some(&nrms), false)?;
+        let cpu: Vec<(DVec3, f64)> = {
+            use rayon::prelude::*;
+            (0..ni)
+                .into_par_iter()
+                .map(|i| {
+                    let (x, nn) = (crate::cpu::dvec(pts[i]), crate::cpu::dvec(nrms[i]));
+                    (
+                        irradiance::irradiance(p, x, nn),
+                        irradiance_margin(p, x, nn),
+                    )
+                })
+                .collect()
+        };
+        rows.push(compare(p, Query::Irradiance, ni, |i| {
+            (cpu[i].0, cpu[i].1, got[i], pts[i], Some(nrms[i]))
+        }));
     }
+    rows.retain(|r| r.samples > 0);
     Ok(CheckReport {
         device: device.to_string(),
         tolerance: TOLERANCE,

@@ -138,6 +138,45 @@ impl Evaluator {
     }
 }
 
+impl Evaluator {
+    /// irradiance(x, n) for every (point, receiver normal) pair (DESIGN.md §3): the
+    /// diffuse-weighted irradiance `diffuse · ∫ radiance(x, ω) max(0, n·ω) dω`.
+    pub fn irradiance(
+        &self,
+        lights: &[Light],
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_points("points", points)?;
+        check_directions("normals", normals)?;
+        if points.len() != normals.len() {
+            return Err(LuxError::input(
+                "points/normals",
+                format!(
+                    "{} points but {} normals; they pair up row by row",
+                    points.len(),
+                    normals.len()
+                ),
+            ));
+        }
+        let prepared = self.prepare(lights)?;
+        let per_light = acc == Accumulate::PerLight;
+        match &self.backend {
+            Backend::Cpu => Ok(to_f32(cpu::irradiance_batch(
+                &prepared, points, normals, per_light,
+            ))),
+            Backend::Gpu(g) => g.run(
+                Kernel::Irradiance,
+                &records(&prepared),
+                points,
+                Some(normals),
+                per_light,
+            ),
+        }
+    }
+}
+
 fn records(prepared: &[PreparedLight]) -> Vec<gpu::LightRecord> {
     prepared.iter().map(gpu::pack::pack).collect()
 }

@@ -9,9 +9,9 @@
 mod common;
 
 use glam::DVec3;
-use luxeval::check::{self, Rng, random_lights};
+use luxeval::check::{self, Rng, TRANSFORMS, random_light, random_lights};
 use luxeval::cpu::{self, PreparedLight};
-use luxeval::{Accumulate, Evaluator, Light, TemperatureMode};
+use luxeval::{Accumulate, Evaluator, Light, LightType, TemperatureMode};
 
 #[test]
 fn gpu_matches_cpu_on_randomised_lights() {
@@ -35,7 +35,14 @@ fn gpu_matches_cpu_on_randomised_lights() {
             .iter()
             .map(|l| PreparedLight::new(l, mode).expect("valid light"))
             .collect();
-        let report = check::check(&gpu, &device, &prepared, samples_per_query, 7 + k as u64)
+        // Irradiance depends on the temperature mode only through the base radiance: a few
+        // receivers per light under the spec mode here; tests below cover it in depth.
+        let counts = check::Samples {
+            emission: samples_per_query,
+            radiance: samples_per_query,
+            irradiance: if k == 0 { 12 } else { 0 },
+        };
+        let report = check::check_with(&gpu, &device, &prepared, counts, 7 + k as u64)
             .expect("GPU check runs");
         total += report.samples;
         excluded += report.excluded;
@@ -149,4 +156,167 @@ fn summed_and_per_light_batches_agree() {
         }
         assert!(compared > n / 2, "{query}: only {compared} rows compared");
     }
+}
+
+/// Irradiance, GPU against the CPU reference, on every light type (including treatAsPoint and
+/// treatAsLine, shaped or not) under every transform kind: 40 receivers per light, points
+/// around the light and normals random or toward it (check::irradiance_samples), within
+/// check::TOLERANCE outside the excluded band (check::irradiance_margin).
+#[test]
+fn irradiance_matches_cpu_on_every_type_and_transform() {
+    let Some(gpu) = common::gpu() else { return };
+    let device = gpu.adapter().name.to_string();
+    let mut rng = Rng::new(0x1AAD_1A4C);
+    let mut lights = random_lights(&mut rng, 2); // 84 lights
+    for (i, xf) in TRANSFORMS.iter().enumerate() {
+        for shaped in [false, true] {
+            let mut p = random_light(1, xf, &mut rng, 1000 + 2 * i);
+            p.kind = LightType::Sphere {
+                radius: rng.range(0.05, 1.0),
+                treat_as_point: true,
+            };
+            let mut c = random_light(4, xf, &mut rng, 1001 + 2 * i);
+            c.kind = LightType::Cylinder {
+                length: rng.range(0.2, 2.0),
+                radius: rng.range(0.05, 0.5),
+                treat_as_line: true,
+            };
+            for mut l in [p, c] {
+                if !shaped {
+                    l.shaping = None;
+                }
+                lights.push(l);
+            }
+        }
+    }
+    let prepared: Vec<PreparedLight> = lights
+        .iter()
+        .map(|l| PreparedLight::new(l, TemperatureMode::Spec).expect("valid light"))
+        .collect();
+    let counts = check::Samples {
+        emission: 0,
+        radiance: 0,
+        irradiance: 40,
+    };
+    let report = check::check_with(&gpu, &device, &prepared, counts, 11).expect("GPU check runs");
+    let mut rows = report.rows.clone();
+    rows.sort_by(|a, b| b.max_rel_error.total_cmp(&a.max_rel_error));
+    let nonzero: usize = rows.iter().map(|r| r.nonzero).sum();
+    println!(
+        "irradiance conformance on {device}: {} receivers over {} lights; {} excluded; {nonzero} compared with non-zero CPU value",
+        report.samples,
+        lights.len(),
+        report.excluded
+    );
+    for r in rows.iter().take(6) {
+        println!(
+            "  {:>10.3e}  {:>14} {}  worst {:?}",
+            r.max_rel_error, r.light_type, r.light, r.worst
+        );
+    }
+    for ty in [
+        "DistantLight",
+        "SphereLight",
+        "DiskLight",
+        "RectLight",
+        "CylinderLight",
+        "DomeLight",
+    ] {
+        assert!(
+            rows.iter().any(|r| r.light_type == ty && r.nonzero > 0),
+            "{ty} not covered"
+        );
+    }
+    assert!(
+        report.excluded * 50 < report.samples,
+        "excluded band swallowed {} of {}",
+        report.excluded,
+        report.samples
+    );
+    assert!(nonzero * 2 > report.samples, "only {nonzero} non-zero");
+    let failures: Vec<_> = rows.iter().filter(|r| !r.pass).collect();
+    assert!(
+        failures.is_empty(),
+        "{} lights over tolerance {}; worst {:?}",
+        failures.len(),
+        check::TOLERANCE,
+        failures.first()
+    );
+}
+
+/// Irradiance through the public Evaluator on both backends, many lights at once: the GPU sum
+/// equals the CPU sum, and per-light rows add up to the summed rows.
+#[test]
+fn irradiance_summed_and_per_light_agree() {
+    let Some(gpu) = common::gpu() else { return };
+    let gpu = Evaluator::from_context(gpu);
+    let cpu = Evaluator::cpu();
+    let mut rng = Rng::new(4242);
+    let lights = random_lights(&mut rng, 1); // 42 lights
+    let prepared = cpu::prepare(&lights, TemperatureMode::Spec).unwrap();
+    let n = 40;
+    let mut points = Vec::new();
+    let mut normals = Vec::new();
+    for _ in 0..n {
+        let x = DVec3::new(
+            rng.range(-6.0, 6.0),
+            rng.range(-6.0, 6.0),
+            rng.range(-6.0, 6.0),
+        );
+        points.push(x.as_vec3().to_array());
+        normals.push((-x.normalize() + rng.unit() * 0.8).as_vec3().to_array());
+    }
+    let gs = gpu
+        .irradiance(&lights, &points, &normals, Accumulate::Sum)
+        .unwrap();
+    let gp = gpu
+        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let cs = cpu
+        .irradiance(&lights, &points, &normals, Accumulate::Sum)
+        .unwrap();
+    let cp = cpu
+        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    assert_eq!((gs.len(), gp.len()), (n, n * lights.len()));
+    let mut compared = 0;
+    for i in 0..n {
+        let x = glam::Vec3::from_array(points[i]).as_dvec3();
+        let nn = glam::Vec3::from_array(normals[i]).as_dvec3();
+        for (sum, per) in [(&gs, &gp), (&cs, &cp)] {
+            let s: glam::Vec3 = (0..lights.len())
+                .map(|l| glam::Vec3::from_array(per[l * n + i]))
+                .sum();
+            assert!(
+                (s - glam::Vec3::from_array(sum[i])).abs().max_element()
+                    <= 1e-5 * s.abs().max_element().max(1e-30),
+                "row {i}"
+            );
+        }
+        if prepared
+            .iter()
+            .any(|p| check::irradiance_margin(p, x, nn) < check::BAND)
+        {
+            continue;
+        }
+        compared += 1;
+        let c = glam::Vec3::from_array(cs[i]).as_dvec3();
+        let err = check::rel_error(c, gs[i]);
+        if err > check::TOLERANCE {
+            // Name the lights whose own rows disagree.
+            let culprits: Vec<String> = (0..lights.len())
+                .filter_map(|l| {
+                    let (g, c) = (gp[l * n + i], cp[l * n + i]);
+                    let e = check::rel_error(glam::Vec3::from_array(c).as_dvec3(), g);
+                    (e > check::TOLERANCE)
+                        .then(|| format!("{} {:?}: cpu {c:?} gpu {g:?}", l, lights[l].kind))
+                })
+                .collect();
+            panic!(
+                "row {i}: cpu {c} gpu {:?} err {err:e}; lights {culprits:#?}",
+                gs[i]
+            );
+        }
+    }
+    assert!(compared > n / 2, "only {compared} rows compared");
 }

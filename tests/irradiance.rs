@@ -978,3 +978,44 @@ fn point_and_line_sources() {
     );
     assert!(rel(got, want) < 1e-6, "{got} vs {want}");
 }
+
+/// The GPU kernel's quadrature (fixed Gauss–Legendre outer rule, adaptive inner halving), run in
+/// f64 on the CPU, against the adaptive reference over random lights and receivers: its own
+/// error must leave room for f32 rounding within the 1e-4 GPU tolerance.
+#[test]
+fn kernel_rule_in_f64_is_within_1e_5_of_the_reference() {
+    use luxeval::check::{Rng, irradiance_samples, random_lights};
+    use luxeval::cpu::irradiance::{Rule, irradiance_with};
+    use luxeval::gpu::pack::{IRR_GL_INNER, IRR_GL_OUTER};
+    let mut rng = Rng::new(0xF1_7ED);
+    let lights = random_lights(&mut rng, 2);
+    let rule = Rule::Fixed {
+        outer: IRR_GL_OUTER,
+        inner: IRR_GL_INNER,
+    };
+    let mut worst = (0.0f64, String::new());
+    let mut compared = 0;
+    for l in &lights {
+        let p = luxeval::cpu::PreparedLight::new(l, luxeval::TemperatureMode::Spec).unwrap();
+        let (pts, nrms) = irradiance_samples(&p, 30, &mut rng);
+        for (x, n) in pts.iter().zip(&nrms) {
+            let (x, n) = (luxeval::cpu::dvec(*x), luxeval::cpu::dvec(*n));
+            let a = irradiance_with(&p, x, n, Rule::Adaptive);
+            if a.max_element() <= 0.0 {
+                continue;
+            }
+            compared += 1;
+            let f = irradiance_with(&p, x, n, rule);
+            let e = (f - a).abs().max_element() / a.abs().max_element();
+            if e > worst.0 {
+                worst = (e, format!("{} at x {x} n {n}: {f} vs {a}", l.path));
+            }
+        }
+    }
+    println!(
+        "kernel rule in f64: {compared} receivers, worst {:.3e} {}",
+        worst.0, worst.1
+    );
+    assert!(compared > 1000, "only {compared} receivers");
+    assert!(worst.0 <= 1e-5, "worst {:.3e}: {}", worst.0, worst.1);
+}

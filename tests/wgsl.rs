@@ -74,6 +74,10 @@ fn light_record_layout_matches_naga() {
         ("focus_tint", offset_of!(LightRecord, focus_tint)),
         ("cone", offset_of!(LightRecord, cone)),
         ("size", offset_of!(LightRecord, size)),
+        ("world_x", offset_of!(LightRecord, world)),
+        ("world_y", offset_of!(LightRecord, world) + 16),
+        ("world_z", offset_of!(LightRecord, world) + 32),
+        ("irr", offset_of!(LightRecord, irr)),
         ("kind", offset_of!(LightRecord, kind)),
         ("flags", offset_of!(LightRecord, flags)),
         ("pad0", offset_of!(LightRecord, pad)),
@@ -93,10 +97,15 @@ fn params_layout_matches_naga() {
     assert_eq!(size as usize, size_of::<Params>());
     let rust = [
         ("count", offset_of!(Params, count)),
-        ("light_count", offset_of!(Params, light_count)),
+        ("light_first", offset_of!(Params, light_first)),
+        ("light_end", offset_of!(Params, light_end)),
         ("per_light", offset_of!(Params, per_light)),
         ("row_stride", offset_of!(Params, row_stride)),
+        ("accumulate", offset_of!(Params, accumulate)),
+        ("pad0", offset_of!(Params, pad)),
+        ("pad1", offset_of!(Params, pad) + 4),
     ];
+    assert_eq!(members.len(), rust.len(), "member count: {members:?}");
     for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
         assert_eq!((wname.as_str(), *woff as usize), (rname, roff));
     }
@@ -111,4 +120,27 @@ fn validation_rejects_a_type_error() {
         compose(Kernel::Emission)
     );
     assert!(naga::front::wgsl::parse_str(&src).is_err());
+}
+
+/// The irradiance kernel writes its inner Gauss–Legendre rule out node by node (a loop there
+/// would spend llvmpipe's loop budget): as many nodes as `IRR_GL_INNER` says.
+#[test]
+fn inner_rule_is_written_out_with_every_node() {
+    let src = luxeval::gpu::shaders::SOURCES
+        .iter()
+        .find(|(name, _)| *name == "irradiance.wgsl")
+        .unwrap()
+        .1;
+    let body = &src[src.find("fn inner_rule(").unwrap()..];
+    let body = &body[..body.find("\n}").unwrap()];
+    for k in 0..luxeval::gpu::pack::IRR_GL_INNER {
+        assert!(
+            body.contains(&format!("h, {k}u)")),
+            "node {k} missing from inner_rule"
+        );
+    }
+    assert_eq!(
+        body.matches("inner_node(").count(),
+        luxeval::gpu::pack::IRR_GL_INNER
+    );
 }

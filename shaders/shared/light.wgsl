@@ -25,6 +25,12 @@ struct Light {
     cone: vec4<f32>,
     // rect: (width/2, height/2); disk, sphere: (radius); cylinder: (length/2, radius).
     size: vec4<f32>,
+    // Columns of the local-to-world linear map M (images of local X, Y, Z); w: world origin.
+    world_x: vec4<f32>,
+    world_y: vec4<f32>,
+    world_z: vec4<f32>,
+    // Irradiance: (diffuse, |det M|, cos θ of kink A, cos θ of kink B) (FLAG_KINK_A/B).
+    irr: vec4<f32>,
     kind: u32,
     flags: u32,
     pad0: u32,
@@ -34,18 +40,25 @@ struct Light {
 struct Params {
     // Samples in this dispatch.
     count: u32,
-    light_count: u32,
+    // This dispatch evaluates lights [light_first, light_end) of the light buffer (the host
+    // splits the lights into groups; see `GpuContext::lights_per_dispatch`).
+    light_first: u32,
+    light_end: u32,
     // 1: write (light, sample) rows; 0: write the sum over lights.
     per_light: u32,
     // Invocations per row of the 2D dispatch grid (workgroups_x · WORKGROUP_SIZE).
     row_stride: u32,
+    // Summed mode, not the first group: add this group's sum to the row already written.
+    accumulate: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
-// Float triples: directions (emission) or points (radiance).
+// Float triples: directions (emission) or points (radiance, irradiance).
 @group(0) @binding(2) var<storage, read> in_a: array<f32>;
-// Float triples: directions (radiance); unused by emission.
+// Float triples: directions (radiance) or receiver normals (irradiance); unused by emission.
 @group(0) @binding(3) var<storage, read> in_b: array<f32>;
 @group(0) @binding(4) var<storage, read_write> out_rgb: array<f32>;
 
@@ -80,7 +93,11 @@ fn add(i: u32, l: u32, v: vec3<f32>, sum: ptr<function, vec3<f32>>) {
 
 fn finish(i: u32, sum: vec3<f32>) {
     if params.per_light == 0u {
-        store3(i, sum);
+        var total = sum;
+        if params.accumulate != 0u {
+            total += vec3<f32>(out_rgb[3u * i], out_rgb[3u * i + 1u], out_rgb[3u * i + 2u]);
+        }
+        store3(i, total);
     }
 }
 
@@ -98,4 +115,13 @@ fn to_local_point(light: Light, p: vec3<f32>) -> vec3<f32> {
 
 fn to_local_dir(light: Light, v: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(light.to_local0.xyz, v), dot(light.to_local1.xyz, v), dot(light.to_local2.xyz, v));
+}
+
+// The local-to-world linear map applied to a local vector.
+fn to_world_dir(light: Light, v: vec3<f32>) -> vec3<f32> {
+    return light.world_x.xyz * v.x + light.world_y.xyz * v.y + light.world_z.xyz * v.z;
+}
+
+fn world_origin(light: Light) -> vec3<f32> {
+    return vec3<f32>(light.world_x.w, light.world_y.w, light.world_z.w);
 }

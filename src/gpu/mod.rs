@@ -120,7 +120,19 @@ impl GpuContext {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("luxeval queries"),
             entries: &[
-                layout_entry(0, wgpu::BufferBindingType::Uniform),
+                // One Params block per light group, selected by a dynamic offset.
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<Params>() as u64
+                        ),
+                    },
+                    count: None,
+                },
                 layout_entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
                 layout_entry(2, wgpu::BufferBindingType::Storage { read_only: true }),
                 layout_entry(3, wgpu::BufferBindingType::Storage { read_only: true }),
@@ -168,6 +180,29 @@ impl GpuContext {
 
     pub fn limits(&self) -> &wgpu::Limits {
         &self.limits
+    }
+
+    /// Whether this is Mesa's llvmpipe (lavapipe), the CPU Vulkan driver of CI.
+    pub fn is_llvmpipe(&self) -> bool {
+        self.info.name.to_lowercase().contains("llvmpipe")
+    }
+
+    /// How many lights one dispatch of `kernel` evaluates; larger sets run as several
+    /// dispatches over light groups (summed mode accumulates into the same rows).
+    ///
+    /// Why: llvmpipe (Mesa 22.x, gallivm) caps the loop iterations of one invocation at 65535
+    /// *in total over all loops*, counted per SIMD vector of lanes, and silently leaves the loop
+    /// after that (measured: a loop of 4×30000 iterations stops at 65535). The emission and
+    /// radiance kernels loop once per light; an irradiance quadrature loops thousands of times
+    /// per light, so there each dispatch takes one light. Elsewhere, groups bound the time of
+    /// one dispatch (an OS watchdog resets a GPU that is busy for seconds).
+    pub fn lights_per_dispatch(&self, kernel: Kernel) -> usize {
+        match (kernel, self.is_llvmpipe()) {
+            (Kernel::Irradiance, true) => 1,
+            (Kernel::Irradiance, false) => 64,
+            (_, true) => 16384,
+            (_, false) => usize::MAX,
+        }
     }
 
     /// The largest number of samples one dispatch handles for `lights` lights.
@@ -269,9 +304,17 @@ impl GpuContext {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        // Light groups, and one Params block per group at the uniform offset alignment.
+        let per_group = self.lights_per_dispatch(kernel).max(1);
+        let groups: Vec<(usize, usize)> = (0..lights)
+            .step_by(per_group)
+            .map(|g| (g, (g + per_group).min(lights)))
+            .collect();
+        let align = (self.limits.min_uniform_buffer_offset_alignment as usize)
+            .max(std::mem::size_of::<Params>());
         let params_buf = dev.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
-            size: std::mem::size_of::<Params>() as u64,
+            size: (groups.len() * align) as u64,
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -279,7 +322,14 @@ impl GpuContext {
             label: Some("luxeval queries"),
             layout: &self.layout,
             entries: &[
-                entry(0, &params_buf),
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params_buf,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                    }),
+                },
                 entry(1, &light_buf),
                 entry(2, &buf_a),
                 // Emission reads no second input; bind the first again (read-only aliasing).
@@ -299,27 +349,35 @@ impl GpuContext {
                 self.queue
                     .write_buffer(buf, 0, bytemuck::cast_slice(&b[start..start + count]));
             }
-            let groups = (count as u32).div_ceil(pack::WORKGROUP_SIZE);
-            let gx = groups.min(max_groups);
-            let gy = groups.div_ceil(gx);
-            let params = Params {
-                count: count as u32,
-                light_count: lights as u32,
-                per_light: per_light as u32,
-                row_stride: gx * pack::WORKGROUP_SIZE,
-            };
-            self.queue
-                .write_buffer(&params_buf, 0, bytemuck::bytes_of(&params));
+            let wg = (count as u32).div_ceil(pack::WORKGROUP_SIZE);
+            let gx = wg.min(max_groups);
+            let gy = wg.div_ceil(gx);
+            let mut block = vec![0u8; groups.len() * align];
+            for (g, &(first, end)) in groups.iter().enumerate() {
+                let params = Params {
+                    count: count as u32,
+                    light_first: first as u32,
+                    light_end: end as u32,
+                    per_light: per_light as u32,
+                    row_stride: gx * pack::WORKGROUP_SIZE,
+                    accumulate: (g > 0) as u32,
+                    pad: [0; 2],
+                };
+                block[g * align..g * align + std::mem::size_of::<Params>()]
+                    .copy_from_slice(bytemuck::bytes_of(&params));
+            }
+            self.queue.write_buffer(&params_buf, 0, &block);
             let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some(kernel.entry_point()),
             });
-            {
+            for g in 0..groups.len() {
+                // A pass per group: passes are ordered, so a group reads the sums of the last.
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some(kernel.entry_point()),
                     timestamp_writes: None,
                 });
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
+                pass.set_bind_group(0, &bind_group, &[(g * align) as u32]);
                 pass.dispatch_workgroups(gx, gy, 1);
             }
             let used = (count * rows * 12) as u64;

@@ -4,7 +4,7 @@
 
 use std::collections::HashSet;
 
-use super::pack::WGSL_CONSTANTS;
+use super::pack::{WGSL_CONSTANTS, WGSL_F32_CONSTANTS, wgsl_f32_arrays};
 
 /// Every WGSL source file, by its path under `shaders/`.
 pub const SOURCES: &[(&str, &str)] = &[
@@ -26,6 +26,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
+    (
+        "irradiance.wgsl",
+        include_str!("../../shaders/irradiance.wgsl"),
+    ),
 ];
 
 /// A compute kernel: the file that holds its entry point, and the entry point's name.
@@ -33,15 +37,17 @@ pub const SOURCES: &[(&str, &str)] = &[
 pub enum Kernel {
     Emission,
     Radiance,
+    Irradiance,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 2] = [Kernel::Emission, Kernel::Radiance];
+    pub const ALL: [Kernel; 3] = [Kernel::Emission, Kernel::Radiance, Kernel::Irradiance];
 
     pub fn file(self) -> &'static str {
         match self {
             Kernel::Emission => "emission.wgsl",
             Kernel::Radiance => "radiance.wgsl",
+            Kernel::Irradiance => "irradiance.wgsl",
         }
     }
 
@@ -49,6 +55,7 @@ impl Kernel {
         match self {
             Kernel::Emission => "emission_main",
             Kernel::Radiance => "radiance_main",
+            Kernel::Irradiance => "irradiance_main",
         }
     }
 }
@@ -63,11 +70,32 @@ fn source(path: &str) -> &'static str {
 
 /// The prelude of shared constants.
 pub fn prelude() -> String {
-    let mut s = String::from("// Generated from src/gpu/pack.rs WGSL_CONSTANTS.\n");
+    let mut s = String::from(
+        "// Generated from src/gpu/pack.rs WGSL_CONSTANTS, WGSL_F32_CONSTANTS, wgsl_f32_arrays.\n",
+    );
     for (name, value) in WGSL_CONSTANTS {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
+    for (name, value) in WGSL_F32_CONSTANTS {
+        s.push_str(&format!("const {name}: f32 = {};\n", f32_literal(*value)));
+    }
+    for (name, values) in wgsl_f32_arrays() {
+        let items: Vec<String> = values.iter().map(|v| f32_literal(*v)).collect();
+        s.push_str(&format!(
+            "var<private> {name}: array<f32, {}> = array<f32, {}>({});\n",
+            values.len(),
+            values.len(),
+            items.join(", ")
+        ));
+    }
     s
+}
+
+/// A WGSL f32 literal that rounds to the nearest f32 of `v`.
+fn f32_literal(v: f64) -> String {
+    let f = v as f32;
+    // `{:?}` prints the shortest decimal that round-trips the f32, always with a '.' or 'e'.
+    format!("{f:?}")
 }
 
 /// The complete WGSL module for `kernel`.
