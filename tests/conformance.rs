@@ -320,3 +320,30 @@ fn irradiance_summed_and_per_light_agree() {
     }
     assert!(compared > n / 2, "only {compared} rows compared");
 }
+
+/// More lights than one dispatch takes on llvmpipe (16384 per group; llvmpipe leaves a loop after
+/// 65535 iterations in total): the summed result accumulates over the groups and still equals
+/// the CPU sum, and per-light rows land in their own rows.
+#[test]
+fn light_groups_accumulate_over_many_lights() {
+    let Some(gpu) = common::gpu() else { return };
+    let gpu = Evaluator::from_context(gpu);
+    let cpu = Evaluator::cpu();
+    let mut rng = Rng::new(99);
+    let base = random_lights(&mut rng, 1);
+    // 70 000 lights: every type and transform, repeated (the loop limit would cut a single
+    // dispatch's loop near 65 535).
+    let lights: Vec<Light> = (0..70_000).map(|i| base[i % base.len()].clone()).collect();
+    let dirs: Vec<[f32; 3]> = (0..16)
+        .map(|_| rng.unit().as_vec3().to_array())
+        .collect();
+    let g = gpu.emission(&lights, &dirs, Accumulate::Sum).unwrap();
+    let c = cpu.emission(&lights, &dirs, Accumulate::Sum).unwrap();
+    for (i, (g, c)) in g.iter().zip(&c).enumerate() {
+        let c = glam::Vec3::from_array(*c).as_dvec3();
+        // f32 summation over 70 000 terms on the GPU: 1e-3 bounds its rounding (n·ε/2 = 4e-3
+        // worst case; a cut loop would lose most of the sum).
+        let err = check::rel_error(c, *g);
+        assert!(err < 1e-3, "direction {i}: cpu {c} gpu {g:?} err {err:e}");
+    }
+}
