@@ -5,9 +5,9 @@
 //   of adaptive Gauss–Kronrod, on the same pieces and substitutions;
 // - cone crossings on elliptic arcs bracketed on IRR_ARC_SAMPLES samples;
 // - an unshaped rect goes to the quadrature (all positive terms) rather than Lambert's formula
-//   when it is farther than IRR_LAMBERT_FAR bounding radii (Lambert's edge terms cancel like
-//   d/size), seen within 1/IRR_LAMBERT_FAR rad of its plane (they cancel like 1/elevation), or
-//   cut by the receiver's horizon (a clipped sliver cancels like its thinness);
+//   when (d / smaller half-extent)·(d / height above its plane) exceeds IRR_LAMBERT_COND
+//   (Lambert's edge terms cancel like each factor), or when it is cut by the receiver's horizon
+//   (a clipped sliver cancels like its thinness);
 // - a cap whose centre is below the horizon is integrated over elevation (cap_sliver).
 
 // #import shared/light.wgsl
@@ -1079,12 +1079,12 @@ fn irradiance_of(light: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         case KIND_RECT: {
             let xl = to_local_point(light, x);
             if xl.z < 0.0 {
-                let size = light.size.x * length(light.world_x.xyz) + light.size.y * length(light.world_y.xyz);
-                // Lambert only where its sum cannot cancel much: near (d ≤ IRR_LAMBERT_FAR·size),
-                // not grazing (x at least 1/IRR_LAMBERT_FAR rad above the plane) and not clipped.
+                let size = min(light.size.x * length(light.world_x.xyz), light.size.y * length(light.world_y.xyz));
+                // Lambert only where its sum cannot cancel much (see IRR_LAMBERT_COND), and not
+                // clipped by the horizon.
                 let d = length(world_origin(light) - x);
                 let h = abs(dot(x - world_origin(light), light.normal.xyz));
-                let lambert = d <= IRR_LAMBERT_FAR * size && h * IRR_LAMBERT_FAR >= d;
+                let lambert = d * d <= IRR_LAMBERT_COND * size * h;
                 if !has_flag(light, FLAG_SHAPING) && lambert && rect_above_horizon(light, x, n) {
                     e = base * rect_lambert(light, x, n);
                 } else {

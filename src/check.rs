@@ -527,7 +527,8 @@ pub fn irradiance_outline(p: &PreparedLight, x: DVec3) -> Vec<DVec3> {
 /// - the receiver's horizon passing within `IRRADIANCE_SLIVER_FACTOR·η` of the top of what x
 ///   sees (only a sliver above the horizon), or of a distant cone's top;
 /// - a rect or disk seen within `IRRADIANCE_SLIVER_FACTOR·η` of its own plane (x near the plane;
-///   this includes x on the light);
+///   this includes x on the light), and likewise a cylinder's tube seen edge-on from x near the
+///   infinite tube through it (beyond an end);
 /// - x within `BAND` (relative) of a sphere's or cylinder's surface;
 /// - a ShapingAPI cone edge (hard or soft) within max([`CONE_BAND`]·θcone,
 ///   `IRRADIANCE_SLIVER_FACTOR·η`) of the smallest emission angle at which x sees the light
@@ -591,6 +592,22 @@ pub fn irradiance_margin(p: &PreparedLight, x: DVec3, n: DVec3) -> f64 {
         LightType::Rect { .. } | LightType::Disk { .. }
     ) {
         let h = (x - p.origin).dot(p.normal);
+        let elev = outline
+            .iter()
+            .map(|q| (h / (x - *q).length()).clamp(-1.0, 1.0).asin().abs())
+            .fold(0.0, f64::max);
+        m = m.min(scale(elev, band));
+    }
+    // A cylinder's own surface, the same way: x near the infinite tube through it (beyond an
+    // end) sees the tube edge-on. h: x's distance from that tube surface, in world units.
+    if let LightType::Cylinder {
+        radius,
+        treat_as_line: false,
+        ..
+    } = p.light.kind
+    {
+        let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+        let h = (rho - radius) * 0.5 * (lin.y_axis.length() + lin.z_axis.length());
         let elev = outline
             .iter()
             .map(|q| (h / (x - *q).length()).clamp(-1.0, 1.0).asin().abs())

@@ -16,6 +16,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 use luxeval::check;
+use luxeval::falloff::{self, Plane};
 use luxeval::gpu::{self, GpuContext};
 use luxeval::io::npy;
 use luxeval::scene::Scene;
@@ -83,6 +84,72 @@ enum Command {
         #[arg(short, long, value_name = "OUT.npy")]
         output: PathBuf,
     },
+    /// irradiance(x, n): diffuse-weighted RGB irradiance at each point x on a one-sided receiver
+    /// with normal n (lux for lights in nits), no occlusion.
+    Irradiance {
+        #[command(flatten)]
+        common: Common,
+        /// Points, float (N, 3), world space.
+        #[arg(long, value_name = "P.npy")]
+        points: PathBuf,
+        /// Receiver normals, float (N, 3), paired row by row with the points; normalised before use.
+        #[arg(long, value_name = "N.npy")]
+        normals: PathBuf,
+        /// Output: float32 (N, 3), or (L, N, 3) with --per-light.
+        #[arg(short, long, value_name = "OUT.npy")]
+        output: PathBuf,
+    },
+    /// A falloff map: the summed irradiance over a rectangle of a plane, written as a linear float
+    /// RGB EXR and optionally a false-colour PNG with a colour bar in lux.
+    ///
+    /// The rectangle is origin + s·u + t·v for s, t in [0, 1]; the receiver normal is
+    /// normalize(u × v). The image shows the plane from the side the normal points to, u to the
+    /// right and v up; each pixel is evaluated at its centre. Example, a 10 m floor at y = 0 seen
+    /// from above with -Z up the image: --origin -5,0,5 --u 10,0,0 --v 0,0,-10 --res 512,512
+    Falloff {
+        /// The stage: .usda, .usdc or .usdz.
+        scene: PathBuf,
+        /// The corner of the rectangle at the image's bottom-left, X,Y,Z.
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+        origin: [f64; 3],
+        /// The rectangle's horizontal edge (image left to right), X,Y,Z.
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+        u: [f64; 3],
+        /// The rectangle's vertical edge (image bottom to top), X,Y,Z.
+        #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+        v: [f64; 3],
+        /// Pixels, W,H.
+        #[arg(long, value_name = "W,H", value_parser = parse_res)]
+        res: (u32, u32),
+        /// Output EXR: linear float R, G, B irradiance.
+        #[arg(short, long, value_name = "MAP.exr")]
+        output: PathBuf,
+        /// Also write a false-colour PNG (luminance of the irradiance in lux, viridis) with a colour
+        /// bar in lux and the plane's extent.
+        #[arg(long, value_name = "MAP.png")]
+        png: Option<PathBuf>,
+        /// Colour scale of the PNG.
+        #[arg(long, value_enum, default_value_t = ScaleArg::Log)]
+        scale: ScaleArg,
+        /// Colour bar range of the PNG in lux, LOW,HIGH. Default: the map's maximum and three
+        /// decades below it (log) or 0 (linear).
+        #[arg(long, value_name = "LOW,HIGH", value_parser = parse_range)]
+        range: Option<(f64, f64)>,
+        /// Draw isolux contours on the PNG at the colour bar's tick values.
+        #[arg(long)]
+        contours: bool,
+        /// Evaluate only this light (prim path); repeatable.
+        #[arg(long = "light", value_name = "PATH")]
+        lights: Vec<String>,
+        /// Where to evaluate (default: the GPU, falling back to the CPU reference with a warning).
+        #[arg(long, value_enum)]
+        device: Option<DeviceArg>,
+        #[command(flatten)]
+        time: TimeArg,
+        /// How colorTemperature becomes RGB.
+        #[arg(long, value_enum, default_value_t = ModeArg::Spec)]
+        temperature_mode: ModeArg,
+    },
     /// Run every query on the CPU reference and on the GPU for randomised samples of every light
     /// in the stage, and print the largest relative errors per light and query. Exits 1 when any
     /// is over tolerance (1e-4 away from the documented excluded band).
@@ -142,6 +209,50 @@ struct TimeArg {
     /// attribute's earliest time sample (USD's EarliestTime).
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     time: Option<f64>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ScaleArg {
+    Log,
+    Linear,
+}
+
+fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("expected three finite numbers X,Y,Z, got {s:?}")),
+    }
+}
+
+fn parse_res(s: &str) -> Result<(u32, u32), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    match parts.as_slice() {
+        [w, h] => {
+            let w: u32 = w.trim().parse().map_err(|e| format!("width {w:?}: {e}"))?;
+            let h: u32 = h.trim().parse().map_err(|e| format!("height {h:?}: {e}"))?;
+            if w == 0 || h == 0 {
+                Err("width and height must be at least 1".into())
+            } else {
+                Ok((w, h))
+            }
+        }
+        _ => Err(format!("expected W,H, got {s:?}")),
+    }
+}
+
+fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [lo, hi] if lo.is_finite() && hi.is_finite() && hi > lo => Ok((*lo, *hi)),
+        _ => Err(format!("expected LOW,HIGH with LOW < HIGH, got {s:?}")),
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -243,6 +354,53 @@ fn run(cli: Cli) -> CliResult {
             let out = eval.radiance(&lights, &points, &dirs, accumulate(&common))?;
             write_rows(&output, &common, lights.len(), dirs.len(), &out)
         }
+        Command::Irradiance {
+            common,
+            points,
+            normals,
+            output,
+        } => {
+            let points = npy::read_vec3(&points)?;
+            let normals = npy::read_vec3(&normals)?;
+            let (eval, lights) = open(&common)?;
+            let out = eval.irradiance(&lights, &points, &normals, accumulate(&common))?;
+            write_rows(&output, &common, lights.len(), points.len(), &out)
+        }
+        Command::Falloff {
+            scene,
+            origin,
+            u,
+            v,
+            res,
+            output,
+            png,
+            scale,
+            range,
+            contours,
+            lights,
+            device,
+            time,
+            temperature_mode,
+        } => {
+            let common = Common {
+                scene,
+                lights,
+                per_light: false,
+                device,
+                time,
+                temperature_mode,
+            };
+            let plane = Plane::new(origin.into(), u.into(), v.into(), res.0, res.1)?;
+            let style = falloff::png::Style {
+                scale: match scale {
+                    ScaleArg::Log => falloff::png::Scale::Log,
+                    ScaleArg::Linear => falloff::png::Scale::Linear,
+                },
+                range,
+                contours,
+            };
+            falloff_cmd(&common, &plane, &output, png.as_deref(), &style)
+        }
         Command::Check {
             scene,
             samples,
@@ -323,6 +481,79 @@ fn write_rows(path: &Path, c: &Common, lights: usize, n: usize, rows: &[[f32; 3]
         vec![n as u64, 3]
     };
     npy::write_f32(path, &shape, rows)?;
+    Ok(())
+}
+
+fn falloff_cmd(
+    c: &Common,
+    plane: &Plane,
+    exr: &Path,
+    png: Option<&Path>,
+    style: &falloff::png::Style,
+) -> CliResult {
+    if let Some((lo, _)) = style.range {
+        if style.scale == falloff::png::Scale::Log && lo <= 0.0 {
+            return Err(Failure {
+                code: 2,
+                message: "--range: a log scale needs LOW > 0".into(),
+            });
+        }
+    }
+    let (eval, lights) = open(c)?;
+    // A bar on a terminal, nothing when stderr is redirected (indicatif hides itself there).
+    let bar = indicatif::ProgressBar::new(plane.pixels() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:40}] {percent:>3}% {pos}/{len} px, eta {eta}",
+        )
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar.set_message(format!("falloff on {}", eval.device_name()));
+    let map = falloff::evaluate(&eval, &lights, plane, |done, _| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    let n = plane.normal();
+    let comment = format!(
+        "luxeval falloff: {} at {}; origin {:?} u {:?} v {:?}; normal ({}, {}, {}); {} lights on {}",
+        c.scene.display(),
+        c.time
+            .time
+            .map(|t| t.to_string())
+            .unwrap_or_else(|| "the default time".into()),
+        plane.origin.to_array(),
+        plane.u.to_array(),
+        plane.v.to_array(),
+        n.x,
+        n.y,
+        n.z,
+        lights.len(),
+        eval.device_name()
+    );
+    // Render the PNG before writing anything, so that a bad style leaves no file.
+    let rendered = match png {
+        Some(_) => Some(falloff::png::render(&map, plane, style)?),
+        None => None,
+    };
+    falloff::write_exr(exr, &map, &comment)?;
+    if let (Some(path), Some(r)) = (png, rendered) {
+        if let Err(e) = falloff::png::write(path, &r) {
+            let _ = std::fs::remove_file(exr);
+            return Err(e.into());
+        }
+    }
+    let lum = map.luminance();
+    let max = lum.iter().copied().fold(0.0, f64::max);
+    eprintln!(
+        "{}: {}×{} px, max {:.6} lux{}",
+        exr.display(),
+        plane.width,
+        plane.height,
+        max,
+        png.map(|p| format!("; {}", p.display()))
+            .unwrap_or_default()
+    );
     Ok(())
 }
 

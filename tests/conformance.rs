@@ -334,9 +334,7 @@ fn light_groups_accumulate_over_many_lights() {
     // 70 000 lights: every type and transform, repeated (the loop limit would cut a single
     // dispatch's loop near 65 535).
     let lights: Vec<Light> = (0..70_000).map(|i| base[i % base.len()].clone()).collect();
-    let dirs: Vec<[f32; 3]> = (0..16)
-        .map(|_| rng.unit().as_vec3().to_array())
-        .collect();
+    let dirs: Vec<[f32; 3]> = (0..16).map(|_| rng.unit().as_vec3().to_array()).collect();
     let g = gpu.emission(&lights, &dirs, Accumulate::Sum).unwrap();
     let c = cpu.emission(&lights, &dirs, Accumulate::Sum).unwrap();
     for (i, (g, c)) in g.iter().zip(&c).enumerate() {

@@ -16,6 +16,8 @@ use glam::DVec3;
 
 use crate::error::{LuxError, Result};
 use crate::io::write_atomic;
+use crate::light::Light;
+use crate::query::{Accumulate, Evaluator};
 
 /// The most pixels one map may have (memory for points, normals and results stays < 4 GiB).
 pub const MAX_PIXELS: u64 = 1 << 27;
@@ -103,6 +105,40 @@ impl Map {
             .map(|c| 0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64)
             .collect()
     }
+}
+
+/// Rows evaluated per call, so that progress can be reported and memory stays bounded.
+const BLOCK_PIXELS: usize = 1 << 16;
+
+/// Evaluates the summed irradiance of `lights` over `plane` with `eval`, in blocks of rows;
+/// `progress(done, total)` is called after each block (pixels).
+pub fn evaluate(
+    eval: &Evaluator,
+    lights: &[Light],
+    plane: &Plane,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<Map> {
+    let n = plane.normal().as_vec3().to_array();
+    let total = plane.pixels();
+    let rows_per_block = (BLOCK_PIXELS / plane.width as usize).max(1) as u32;
+    let mut rgb = Vec::with_capacity(total);
+    let mut j0 = 0;
+    while j0 < plane.height {
+        let j1 = (j0 + rows_per_block).min(plane.height);
+        let points: Vec<[f32; 3]> = (j0..j1)
+            .flat_map(|j| (0..plane.width).map(move |i| (i, j)))
+            .map(|(i, j)| plane.pixel_centre(i, j).as_vec3().to_array())
+            .collect();
+        let normals = vec![n; points.len()];
+        rgb.extend(eval.irradiance(lights, &points, &normals, Accumulate::Sum)?);
+        progress(rgb.len(), total);
+        j0 = j1;
+    }
+    Ok(Map {
+        width: plane.width,
+        height: plane.height,
+        rgb,
+    })
 }
 
 /// Writes the map as a scanline EXR with linear float R, G, B channels (ZIP compressed),

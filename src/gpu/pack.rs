@@ -48,10 +48,12 @@ pub const IRR_INNER_TOL: f64 = 1e-5;
 pub const IRR_INNER_DEPTH: usize = 6;
 /// Irradiance kernel: samples per elliptic arc when bracketing cone crossings.
 pub const IRR_ARC_SAMPLES: u32 = 24;
-/// Irradiance kernel: an unshaped rect farther than this many times its bounding radius, or seen
-/// within 1/this rad of its plane, goes to the quadrature (all positive terms) instead of
-/// Lambert's formula, whose edge terms cancel like d/size and like 1/elevation in f32.
-pub const IRR_LAMBERT_FAR: f64 = 16.0;
+/// Irradiance kernel: an unshaped rect uses Lambert's formula only where its edge terms cannot
+/// cancel much in f32: (d / smaller half-extent) · (d / height above its plane) ≤ this. The
+/// terms of a rect that is far, thin or seen near its plane cancel like each factor (measured on
+/// lavapipe: 1.8e-4 at 590, a 0.2 × 2 rect 5 m away at 5° above its plane); past it, the
+/// quadrature (all positive terms) is used.
+pub const IRR_LAMBERT_COND: f64 = 16.0;
 
 /// The `u32` constants shared with WGSL, by name.
 pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
@@ -79,7 +81,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
 
 /// The `f32` constants shared with WGSL, by name.
 pub const WGSL_F32_CONSTANTS: &[(&str, f64)] = &[
-    ("IRR_LAMBERT_FAR", IRR_LAMBERT_FAR),
+    ("IRR_LAMBERT_COND", IRR_LAMBERT_COND),
     ("IRR_INNER_TOL", IRR_INNER_TOL),
     ("IRR_TAN_MAP_RHO", crate::cpu::irradiance::TAN_MAP_RHO),
     ("IRR_MAX_U_SPAN", crate::cpu::irradiance::MAX_U_SPAN),
