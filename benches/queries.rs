@@ -35,6 +35,15 @@ fn queries(c: &mut Criterion) {
                     .expect("radiance")
             })
         });
+        // Irradiance: a quadrature per (light, receiver), on 1/64 of the samples.
+        let mi = (m / 64).max(1);
+        group.throughput(Throughput::Elements((mi * lights.len()) as u64));
+        group.bench_with_input(BenchmarkId::new("irradiance", name), &mi, |b, &mi| {
+            b.iter(|| {
+                eval.irradiance(&lights, &points[..mi], &dirs[..mi], Accumulate::Sum)
+                    .expect("irradiance")
+            })
+        });
     }
     group.finish();
 }

@@ -13,7 +13,7 @@ use crate::{CliResult, Failure};
 
 #[derive(Args)]
 pub struct BenchArgs {
-    /// Samples per GPU run.
+    /// Samples per GPU run (irradiance: 1/64 of them).
     #[arg(long, default_value_t = 1 << 20)]
     samples: usize,
     /// Samples per CPU run (the reference is slower; throughput is per sample).
@@ -40,6 +40,12 @@ struct Row {
     /// (light, sample) evaluations per second.
     evals_per_second: f64,
 }
+
+const QUERIES: [&str; 3] = ["emission", "radiance", "irradiance"];
+
+/// Irradiance runs on this fraction of the samples (random receivers near the lights, random
+/// normals).
+const IRRADIANCE_SHARE: usize = 64;
 
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
@@ -80,11 +86,19 @@ pub fn run(args: BenchArgs) -> CliResult {
     let mut rows = Vec::new();
     for (eval, m) in &evaluators {
         let (d, p) = (&dirs[..*m], &points[..*m]);
-        for query in ["emission", "radiance"] {
+        for query in QUERIES {
+            // Irradiance is a quadrature per (light, receiver): 1/IRRADIANCE_SHARE of the samples.
+            let m = if query == "irradiance" {
+                (*m / IRRADIANCE_SHARE).max(1)
+            } else {
+                *m
+            };
+            let (d, p) = (&d[..m], &p[..m]);
             let t = time(args.repeat, || {
                 match query {
                     "emission" => eval.emission(&lights, d, Accumulate::Sum)?,
-                    _ => eval.radiance(&lights, p, d, Accumulate::Sum)?,
+                    "radiance" => eval.radiance(&lights, p, d, Accumulate::Sum)?,
+                    _ => eval.irradiance(&lights, p, d, Accumulate::Sum)?,
                 };
                 Ok(())
             })?;
@@ -92,9 +106,9 @@ pub fn run(args: BenchArgs) -> CliResult {
                 query,
                 device: eval.device_name(),
                 lights: lights.len(),
-                samples: *m,
+                samples: m,
                 median_seconds: t.as_secs_f64(),
-                evals_per_second: (*m * lights.len()) as f64 / t.as_secs_f64(),
+                evals_per_second: (m * lights.len()) as f64 / t.as_secs_f64(),
             });
         }
     }
@@ -126,7 +140,7 @@ pub fn run(args: BenchArgs) -> CliResult {
         );
     }
     if evaluators.len() == 2 {
-        for query in ["emission", "radiance"] {
+        for query in QUERIES {
             let g = rows
                 .iter()
                 .find(|r| r.query == query && !r.device.starts_with("cpu"));

@@ -491,13 +491,14 @@ fn falloff_cmd(
     png: Option<&Path>,
     style: &falloff::png::Style,
 ) -> CliResult {
-    if let Some((lo, _)) = style.range {
-        if style.scale == falloff::png::Scale::Log && lo <= 0.0 {
-            return Err(Failure {
-                code: 2,
-                message: "--range: a log scale needs LOW > 0".into(),
-            });
-        }
+    if let Some((lo, _)) = style.range
+        && style.scale == falloff::png::Scale::Log
+        && lo <= 0.0
+    {
+        return Err(Failure {
+            code: 2,
+            message: "--range: a log scale needs LOW > 0".into(),
+        });
     }
     let (eval, lights) = open(c)?;
     // A bar on a terminal, nothing when stderr is redirected (indicatif hides itself there).
@@ -537,11 +538,12 @@ fn falloff_cmd(
         None => None,
     };
     falloff::write_exr(exr, &map, &comment)?;
-    if let (Some(path), Some(r)) = (png, rendered) {
-        if let Err(e) = falloff::png::write(path, &r) {
-            let _ = std::fs::remove_file(exr);
-            return Err(e.into());
-        }
+    if let (Some(path), Some(r)) = (png, rendered)
+        && let Err(e) = falloff::png::write(path, &r)
+    {
+        // No half-finished pair: the EXR goes too.
+        let _ = std::fs::remove_file(exr);
+        return Err(e.into());
     }
     let lum = map.luminance();
     let max = lum.iter().copied().fold(0.0, f64::max);

@@ -280,7 +280,16 @@ fn help_explains_every_subcommand() {
     let o = luxeval(&["--help"]);
     assert!(o.status.success());
     let text = String::from_utf8_lossy(&o.stdout);
-    for sub in ["info", "lights", "emission", "radiance", "check", "bench"] {
+    for sub in [
+        "info",
+        "lights",
+        "emission",
+        "radiance",
+        "irradiance",
+        "falloff",
+        "check",
+        "bench",
+    ] {
         assert!(text.contains(sub), "--help lacks {sub}");
         let o = luxeval(&[sub, "--help"]);
         assert!(o.status.success(), "{sub} --help");
@@ -299,4 +308,170 @@ fn check_passes_on_the_bundled_scene() {
     );
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(v["samples"].as_u64().unwrap() >= 500 * 6);
+}
+
+fn luxtest(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/luxtest/usd")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+#[test]
+fn irradiance_on_the_bundled_floor_equals_the_library() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e.npy");
+    let o = luxeval(&[
+        "irradiance",
+        &asset("studio.usda"),
+        "--points",
+        &asset("floor_points.npy"),
+        "--normals",
+        &asset("floor_up.npy"),
+        "-o",
+        out.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--per-light",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (shape, got) = read_npy_f32(&out);
+    let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
+    let lights = scene.evaluable(&[]).unwrap();
+    let points = npy::read_vec3(Path::new(&asset("floor_points.npy"))).unwrap();
+    let normals = npy::read_vec3(Path::new(&asset("floor_up.npy"))).unwrap();
+    assert_eq!(
+        shape,
+        vec![lights.len() as u64, points.len() as u64, 3],
+        "(L, N, 3)"
+    );
+    let want = Evaluator::cpu()
+        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let want: Vec<f32> = want.iter().flatten().copied().collect();
+    assert_eq!(got, want);
+    assert!(got.iter().any(|v| *v > 0.0), "the floor is lit");
+}
+
+#[test]
+fn falloff_writes_an_exr_equal_to_the_library_and_a_png_with_its_colour_bar() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("rect.exr");
+    let png = dir.path().join("rect.png");
+    let o = luxeval(&[
+        "falloff",
+        &luxtest("rect.usda"),
+        "--time",
+        "5",
+        "--origin",
+        "-5,0,5",
+        "--u",
+        "10,0,0",
+        "--v",
+        "0,0,-10",
+        "--res",
+        "48,32",
+        "-o",
+        exr.to_str().unwrap(),
+        "--png",
+        png.to_str().unwrap(),
+        "--contours",
+        "--device",
+        "cpu",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The EXR: the library's map of the same plane, pixel for pixel (row 0 at the top).
+    let map = luxeval::falloff::read_exr(&exr).unwrap();
+    assert_eq!((map.width, map.height), (48, 32));
+    let scene = Scene::load(Path::new(&luxtest("rect.usda")), Some(5.0)).unwrap();
+    let lights = scene.evaluable(&[]).unwrap();
+    let plane = luxeval::falloff::Plane::new(
+        glam::DVec3::new(-5.0, 0.0, 5.0),
+        glam::DVec3::new(10.0, 0.0, 0.0),
+        glam::DVec3::new(0.0, 0.0, -10.0),
+        48,
+        32,
+    )
+    .unwrap();
+    let want = Evaluator::cpu()
+        .irradiance(
+            &lights,
+            &plane.points(),
+            &vec![[0.0, 1.0, 0.0]; plane.pixels()],
+            Accumulate::Sum,
+        )
+        .unwrap();
+    assert_eq!(map.rgb, want);
+    assert!(map.rgb.iter().any(|p| p[1] > 1.0), "a lit floor");
+    // The PNG: a real image, larger than the map (colour bar, labels), not blank.
+    let decoder = ::png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert!(
+        info.width > 48 && info.height > 32,
+        "{}x{}",
+        info.width,
+        info.height
+    );
+    let distinct: std::collections::HashSet<&[u8]> = buf[..info.buffer_size()].chunks(3).collect();
+    assert!(distinct.len() > 20, "only {} colours", distinct.len());
+}
+
+#[test]
+fn falloff_and_irradiance_reject_bad_input_with_exit_2_and_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("m.exr");
+    let base = |res: &str, u: &str| {
+        luxeval(&[
+            "falloff",
+            &luxtest("rect.usda"),
+            "--origin",
+            "-5,0,5",
+            "--u",
+            u,
+            "--v",
+            "0,0,-10",
+            "--res",
+            res,
+            "-o",
+            exr.to_str().unwrap(),
+            "--device",
+            "cpu",
+        ])
+    };
+    for (res, u, what) in [
+        ("0,10", "10,0,0", "res"),
+        ("10", "10,0,0", "res"),
+        ("10,10", "10,0", "u"),
+        ("10,10", "0,0,-10", "parallel"),
+        ("10,10", "nan,0,0", "u"),
+    ] {
+        let o = base(res, u);
+        assert_eq!(o.status.code(), Some(2), "{res} {u}: {}", stderr(&o));
+        assert!(
+            stderr(&o).to_lowercase().contains(what),
+            "{res} {u}: expected '{what}' in: {}",
+            stderr(&o)
+        );
+        assert!(no_stray_files(dir.path()).is_empty(), "{res} {u}");
+    }
+    // Points and normals that do not pair up.
+    let out = dir.path().join("e.npy");
+    let o = luxeval(&[
+        "irradiance",
+        &asset("studio.usda"),
+        "--points",
+        &asset("floor_points.npy"),
+        "--normals",
+        &luxtest("../../npy/dirs_f32.npy"),
+        "-o",
+        out.to_str().unwrap(),
+        "--device",
+        "cpu",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("normals"), "{}", stderr(&o));
+    assert!(!out.exists());
 }
