@@ -1,8 +1,9 @@
 // irradiance(x, n): diffuse · ∫ radiance(x, ω) max(0, n·ω) dω (DESIGN.md §3).
 // Twin of src/cpu/irradiance.rs, which carries the derivations and spec citations; functions
 // here have the names of their CPU twins. Differences, all for f32:
-// - fixed Gauss–Legendre rules (IRR_GL_OUTER / IRR_GL_INNER points per smooth piece) instead
-//   of adaptive Gauss–Kronrod, on the same pieces and substitutions;
+// - per span, a Gauss–Kronrod 7/15 outer rule and an IRR_GL_INNER-point Gauss–Legendre inner
+//   rule, each halved locally while its error test fails (depth-limited, see gpu::pack), instead
+//   of the reference's global adaptive Gauss–Kronrod, on the same pieces and substitutions;
 // - cone crossings on elliptic arcs bracketed on IRR_ARC_SAMPLES samples;
 // - an unshaped rect goes to the quadrature (all positive terms) rather than Lambert's formula
 //   when (d / smaller half-extent)·(d / height above its plane) exceeds IRR_LAMBERT_COND
@@ -1008,6 +1009,60 @@ fn outer_pole(c: Chart, y0: f32, y1: f32) -> vec2<f32> {
     return vec2<f32>(y_foot, sqrt(h * h + d * e1l * d * e1l) * e1l / sqrt(vv));
 }
 
+// The Gauss–Kronrod 7/15 pair on [s0, s1] of one outer span's parameter: (Kronrod value,
+// |Kronrod − Gauss| in the largest channel).
+fn outer_gk(light: Light, c: Chart, n: vec3<f32>, sp: PieceMap, s0: f32, s1: f32) -> vec4<f32> {
+    let h = s1 - s0;
+    var k = vec3<f32>(0.0);
+    var g = vec3<f32>(0.0);
+    for (var i = 0u; i < 15u; i++) {
+        let yd = map_eval(sp, s0 + h * IRR_GK_X[i], true);
+        if yd.y == 0.0 {
+            continue;
+        }
+        let xi = x_interval(c, yd.x);
+        if xi.z > 0.0 {
+            let v = line_integral(light, n, c.w0 + c.e2 * yd.x, c.e1, xi.x, xi.y) * (h * yd.y * c.jac);
+            k += IRR_GK_WK[i] * v;
+            g += IRR_GK_WG[i] * v;
+        }
+    }
+    return vec4<f32>(k, max3(abs(k - g)));
+}
+
+// One outer span: the pair, halved while it disagrees by more than IRR_OUTER_TOL (relative) and
+// depth allows, depth first (the CPU twin: Nodes::integrate in src/cpu/irradiance.rs).
+fn outer_adaptive(light: Light, c: Chart, n: vec3<f32>, sp: PieceMap) -> vec3<f32> {
+    var lo: array<f32, IRR_OUTER_DEPTH + 1u>;
+    var hi: array<f32, IRR_OUTER_DEPTH + 1u>;
+    var dep: array<u32, IRR_OUTER_DEPTH + 1u>;
+    lo[0] = 0.0;
+    hi[0] = 1.0;
+    dep[0] = 0u;
+    var top = 1u;
+    var sum = vec3<f32>(0.0);
+    while top > 0u {
+        top -= 1u;
+        let s0 = lo[top];
+        let s1 = hi[top];
+        let d = dep[top];
+        let r = outer_gk(light, c, n, sp, s0, s1);
+        if d + 1u >= IRR_OUTER_DEPTH || r.w <= IRR_OUTER_TOL * max3(abs(r.xyz)) {
+            sum += r.xyz;
+        } else {
+            let mid = 0.5 * (s0 + s1);
+            lo[top] = mid;
+            hi[top] = s1;
+            dep[top] = d + 1u;
+            lo[top + 1u] = s0;
+            hi[top + 1u] = mid;
+            dep[top + 1u] = d + 1u;
+            top += 2u;
+        }
+    }
+    return sum;
+}
+
 // ∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY over the chart's region (the base radiance not applied).
 fn chart_integral(light: Light, c: Chart, n: vec3<f32>) -> vec3<f32> {
     if has_flag(light, FLAG_DARK) || !(c.jac > 0.0) {
@@ -1021,17 +1076,7 @@ fn chart_integral(light: Light, c: Chart, n: vec3<f32>) -> vec3<f32> {
         let pm = piece_map(ys[i], ys[i + 1u], pole.x, pole.y, false, false);
         let spans = span_count(pm);
         for (var j = 0u; j < spans; j++) {
-            let sp = span(pm, j, spans);
-            for (var k = 0u; k < IRR_GL_OUTER; k++) {
-                let yd = map_eval(sp, IRR_GL_OUTER_X[k], true);
-                if yd.y == 0.0 {
-                    continue;
-                }
-                let xi = x_interval(c, yd.x);
-                if xi.z > 0.0 {
-                    total += line_integral(light, n, c.w0 + c.e2 * yd.x, c.e1, xi.x, xi.y) * (IRR_GL_OUTER_W[k] * yd.y * c.jac);
-                }
-            }
+            total += outer_adaptive(light, c, n, span(pm, j, spans));
         }
     }
     return total;

@@ -593,22 +593,25 @@ struct Ctx<'a> {
 pub enum Rule {
     /// Adaptive Gauss–Kronrod to 1e-10 (outer) / 1e-11 (inner) relative: the reference.
     Adaptive,
-    /// Gauss–Legendre with a fixed number of points per piece (outer, inner): the scheme of the
-    /// WGSL kernel, which runs it with `gpu::pack::IRR_GL_OUTER` / `IRR_GL_INNER` points. Tests
-    /// run it here in f64 to separate its quadrature error from f32 rounding.
-    Fixed { outer: usize, inner: usize },
+    /// The scheme of the WGSL kernel, run here in f64 so that tests can separate its quadrature
+    /// error from f32 rounding: per outer span the Gauss–Kronrod 7/15 pair, halved while they
+    /// differ by more than `IRR_OUTER_TOL` (at most `IRR_OUTER_DEPTH` times); per inner span
+    /// `IRR_GL_INNER`-point Gauss–Legendre, halved while halves and parent differ by more than
+    /// `IRR_INNER_TOL` (at most `IRR_INNER_DEPTH` times). Constants in `gpu::pack`.
+    Kernel,
 }
 
-/// Nodes and weights on [0, 1] for a fixed rule.
+/// The quadrature of [`chart_integral`] and [`line_integral`]: the reference or the kernel's.
 struct Nodes {
-    fixed: Option<[(Vec<f64>, Vec<f64>); 2]>,
+    /// The kernel rule's inner Gauss–Legendre nodes and weights on [0, 1].
+    fixed: Option<(Vec<f64>, Vec<f64>)>,
     /// Absolute tolerances of the adaptive outer (0) and inner (1) integrals (see
     /// [`ABS_FRACTION`]); 0 where no scale is known.
     abs: [f64; 2],
 }
 
 /// The adaptive reference also stops once its error estimate is below this fraction of the
-/// whole irradiance (estimated first with the kernel's fixed rule): pieces that contribute
+/// whole irradiance (estimated first with the kernel's rule): pieces that contribute
 /// nothing measurable (a factor that is zero up to rounding, a far corner of a cone's tail)
 /// cannot reach a relative tolerance of their own, and would each run to the interval cap.
 pub const ABS_FRACTION: f64 = 1e-12;
@@ -618,27 +621,42 @@ impl Nodes {
         Nodes {
             fixed: match rule {
                 Rule::Adaptive => None,
-                Rule::Fixed { outer, inner } => Some([
-                    super::quadrature::gauss_legendre(outer),
-                    super::quadrature::gauss_legendre(inner),
-                ]),
+                Rule::Kernel => Some(super::quadrature::gauss_legendre(
+                    crate::gpu::pack::IRR_GL_INNER,
+                )),
             },
             abs: [0.0; 2],
         }
     }
 
-    /// ∫₀¹ f by the outer (0) or inner (1) fixed rule, or adaptively.
+    /// ∫₀¹ f by the kernel's outer (0) or inner (1) rule, or by the adaptive reference.
     fn integrate(&self, which: usize, f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
         match &self.fixed {
-            Some(rules) => {
-                let (x, w) = &rules[which];
+            Some((x, w)) => {
+                if which == 0 {
+                    // The kernel's outer rule: Gauss–Kronrod 7/15 per span, halved while the
+                    // pair disagrees by more than IRR_OUTER_TOL (relative), depth first.
+                    use crate::gpu::pack::{IRR_OUTER_DEPTH, IRR_OUTER_TOL};
+                    let mut sum = DVec3::ZERO;
+                    let mut stack = vec![(0.0, 1.0, 0)];
+                    while let Some((s0, s1, depth)) = stack.pop() {
+                        let (k, err) = super::quadrature::gk15(f, s0, s1);
+                        if depth + 1 >= IRR_OUTER_DEPTH
+                            || err <= IRR_OUTER_TOL * k.abs().max_element()
+                        {
+                            sum += k;
+                        } else {
+                            let mid = 0.5 * (s0 + s1);
+                            stack.push((mid, s1, depth + 1));
+                            stack.push((s0, mid, depth + 1));
+                        }
+                    }
+                    return sum;
+                }
                 let mut rule = |s0: f64, s1: f64| -> DVec3 {
                     let h = s1 - s0;
                     x.iter().zip(w).map(|(x, w)| f(s0 + h * x) * (w * h)).sum()
                 };
-                if which == 0 {
-                    return rule(0.0, 1.0);
-                }
                 // The kernel's inner rule: halving until the halves agree with their parent to
                 // IRR_INNER_TOL (relative, the integrand is ≥ 0) or IRR_INNER_DEPTH is reached,
                 // depth first, in the same order as the WGSL twin.
@@ -694,11 +712,9 @@ pub fn chart_integral(prof: &Profile, chart: &Chart, n: DVec3, rule: Rule) -> DV
     if rule == Rule::Adaptive {
         // The scale of the answer from the kernel's rule; an inner error δ on every line moves
         // the outer integral by δ·jac·(Y extent).
-        let fixed = Rule::Fixed {
-            outer: crate::gpu::pack::IRR_GL_OUTER,
-            inner: crate::gpu::pack::IRR_GL_INNER,
-        };
-        let scale = chart_integral(prof, chart, n, fixed).abs().max_element();
+        let scale = chart_integral(prof, chart, n, Rule::Kernel)
+            .abs()
+            .max_element();
         let extent = chart.jac * (ys[ys.len() - 1] - ys[0]);
         if scale > 0.0 && scale.is_finite() && extent > 0.0 && extent.is_finite() {
             nodes.abs = [ABS_FRACTION * scale, ABS_FRACTION * scale / extent];

@@ -67,6 +67,26 @@ pub fn gk15(f: &mut impl FnMut(f64) -> DVec3, a: f64, b: f64) -> (DVec3, f64) {
     (k * h, norm((k - g) * h))
 }
 
+/// The 15 Gauss–Kronrod nodes on [0, 1], ascending, with their Kronrod weights and Gauss
+/// weights (0 at the nodes that are not Gauss nodes): the WGSL kernel's outer rule, passed to it
+/// through the generated prelude.
+pub fn gk15_unit() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut rows: Vec<(f64, f64, f64)> = Vec::with_capacity(15);
+    for j in 0..8 {
+        let wg = if j % 2 == 1 { WG[j / 2] } else { 0.0 };
+        rows.push((0.5 * (1.0 - XGK[j]), 0.5 * WGK[j], 0.5 * wg));
+        if j < 7 {
+            rows.push((0.5 * (1.0 + XGK[j]), 0.5 * WGK[j], 0.5 * wg));
+        }
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    (
+        rows.iter().map(|r| r.0).collect(),
+        rows.iter().map(|r| r.1).collect(),
+        rows.iter().map(|r| r.2).collect(),
+    )
+}
+
 /// Tolerances and limits of [`integrate`].
 #[derive(Clone, Copy, Debug)]
 pub struct Tolerance {
@@ -163,6 +183,20 @@ mod tests {
             }
             assert!(x.windows(2).all(|p| p[0] < p[1]));
         }
+    }
+
+    #[test]
+    fn gk15_unit_matches_gk15() {
+        let (x, wk, wg) = gk15_unit();
+        assert_eq!(x.len(), 15);
+        assert!(x.windows(2).all(|p| p[0] < p[1]));
+        assert!((wk.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        assert!((wg.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        let f = |t: f64| (3.0 * t).sin() + t * t;
+        let k: f64 = x.iter().zip(&wk).map(|(x, w)| w * f(*x)).sum();
+        let g: f64 = x.iter().zip(&wg).map(|(x, w)| w * f(*x)).sum();
+        let (kk, e) = gk15(&mut |t| DVec3::splat(f(t)), 0.0, 1.0);
+        assert!((k - kk.x).abs() < 1e-15 && ((k - g).abs() - e).abs() < 1e-15);
     }
 
     #[test]

@@ -37,7 +37,8 @@ pub const FLAG_AXIS_SINGULAR: u32 = 256;
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
 
-/// Irradiance kernel: Gauss–Legendre points per outer piece and per inner piece.
+/// Irradiance kernel: Gauss–Legendre points of the elevation integral of a sphere cap cut by the
+/// horizon (`cap_sliver`), and per inner span.
 pub const IRR_GL_OUTER: usize = 12;
 /// (The WGSL writes the inner rule's 10 nodes out: changing this needs `inner_rule` changed.)
 pub const IRR_GL_INNER: usize = 10;
@@ -46,6 +47,13 @@ pub const IRR_GL_INNER: usize = 10;
 /// again, at most `IRR_INNER_DEPTH` times (the order is chosen per light and receiver).
 pub const IRR_INNER_TOL: f64 = 1e-5;
 pub const IRR_INNER_DEPTH: usize = 6;
+/// Irradiance kernel: each outer span is integrated by the 7-point Gauss / 15-point Kronrod
+/// pair; a span whose Gauss and Kronrod values differ by more than `IRR_OUTER_TOL` of the
+/// Kronrod value is halved, at most `IRR_OUTER_DEPTH` times. (Kronrod's error is far below that
+/// difference, which measures Gauss's: the test `kernel_rule_in_f64_is_within_1e_5_of_the_reference`
+/// holds the whole rule to 1e-5.)
+pub const IRR_OUTER_TOL: f64 = 1e-3;
+pub const IRR_OUTER_DEPTH: usize = 5;
 /// Irradiance kernel: samples per elliptic arc when bracketing cone crossings.
 pub const IRR_ARC_SAMPLES: u32 = 24;
 /// Irradiance kernel: an unshaped rect uses Lambert's formula only where its edge terms cannot
@@ -76,6 +84,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("IRR_GL_OUTER", IRR_GL_OUTER as u32),
     ("IRR_GL_INNER", IRR_GL_INNER as u32),
     ("IRR_INNER_DEPTH", IRR_INNER_DEPTH as u32),
+    ("IRR_OUTER_DEPTH", IRR_OUTER_DEPTH as u32),
     ("IRR_ARC_SAMPLES", IRR_ARC_SAMPLES),
 ];
 
@@ -83,6 +92,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
 pub const WGSL_F32_CONSTANTS: &[(&str, f64)] = &[
     ("IRR_LAMBERT_COND", IRR_LAMBERT_COND),
     ("IRR_INNER_TOL", IRR_INNER_TOL),
+    ("IRR_OUTER_TOL", IRR_OUTER_TOL),
     ("IRR_TAN_MAP_RHO", crate::cpu::irradiance::TAN_MAP_RHO),
     ("IRR_MAX_U_SPAN", crate::cpu::irradiance::MAX_U_SPAN),
 ];
@@ -92,11 +102,15 @@ pub const WGSL_F32_CONSTANTS: &[(&str, f64)] = &[
 pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     let (xo, wo) = crate::cpu::quadrature::gauss_legendre(IRR_GL_OUTER);
     let (xi, wi) = crate::cpu::quadrature::gauss_legendre(IRR_GL_INNER);
+    let gk = crate::cpu::quadrature::gk15_unit();
     vec![
         ("IRR_GL_OUTER_X", xo),
         ("IRR_GL_OUTER_W", wo),
         ("IRR_GL_INNER_X", xi),
         ("IRR_GL_INNER_W", wi),
+        ("IRR_GK_X", gk.0),
+        ("IRR_GK_WK", gk.1),
+        ("IRR_GK_WG", gk.2),
     ]
 }
 
