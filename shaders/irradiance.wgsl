@@ -79,13 +79,13 @@ fn cap_sliver(alpha: f32, gamma: f32) -> f32 {
     let top = alpha + gamma;
     let cg = cos(gamma);
     var sum = 0.0;
-    for (var k = 0u; k < IRR_GL_OUTER; k++) {
-        let s = IRR_GL_OUTER_X[k];
+    for (var k = 0u; k < IRR_GL_CAP; k++) {
+        let s = IRR_GL_CAP_X[k];
         let t = top * (1.0 - s * s);
         let q = sin(0.5 * (alpha + t - gamma)) * sin(0.5 * (top - t)) / (cos(t) * cg);
         let sh = sqrt(clamp(q, 0.0, 1.0));
         let psi = 2.0 * atan2_accurate(sh, sqrt(max(1.0 - sh * sh, 0.0)));
-        sum += IRR_GL_OUTER_W[k] * sin(t) * cos(t) * 2.0 * psi * 2.0 * top * s;
+        sum += IRR_GL_CAP_W[k] * sin(t) * cos(t) * 2.0 * psi * 2.0 * top * s;
     }
     return sum;
 }

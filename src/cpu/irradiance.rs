@@ -603,8 +603,8 @@ pub enum Rule {
 
 /// The quadrature of [`chart_integral`] and [`line_integral`]: the reference or the kernel's.
 struct Nodes {
-    /// The kernel rule's inner Gauss–Legendre nodes and weights on [0, 1].
-    fixed: Option<(Vec<f64>, Vec<f64>)>,
+    /// The kernel rule's inner Gauss–Legendre nodes and weights on [0, 1]; None: the reference.
+    kernel: Option<(Vec<f64>, Vec<f64>)>,
     /// Absolute tolerances of the adaptive outer (0) and inner (1) integrals (see
     /// [`ABS_FRACTION`]); 0 where no scale is known.
     abs: [f64; 2],
@@ -619,7 +619,7 @@ pub const ABS_FRACTION: f64 = 1e-12;
 impl Nodes {
     fn new(rule: Rule) -> Self {
         Nodes {
-            fixed: match rule {
+            kernel: match rule {
                 Rule::Adaptive => None,
                 Rule::Kernel => Some(super::quadrature::gauss_legendre(
                     crate::gpu::pack::IRR_GL_INNER,
@@ -631,7 +631,7 @@ impl Nodes {
 
     /// ∫₀¹ f by the kernel's outer (0) or inner (1) rule, or by the adaptive reference.
     fn integrate(&self, which: usize, f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
-        match &self.fixed {
+        match &self.kernel {
             Some((x, w)) => {
                 if which == 0 {
                     // The kernel's outer rule: Gauss–Kronrod 7/15 per span, halved while the
@@ -693,7 +693,7 @@ impl Nodes {
 }
 
 /// A tan-mapped piece spanning more than this many radians of u is cut into equal spans, so
-/// that a fixed rule resolves both the near-field peak and the piece's ends.
+/// that the kernel's rule resolves both the near-field peak and the piece's ends.
 pub const MAX_U_SPAN: f64 = 0.8;
 
 /// Unit-base irradiance (times `p.base`) of the chart's region by the scheme in the module docs.
@@ -803,10 +803,10 @@ impl PieceMap {
         }
     }
 
-    /// For a fixed rule, the piece cut into equal u-spans of at most [`MAX_U_SPAN`] when
+    /// For the kernel's rule, the piece cut into equal u-spans of at most [`MAX_U_SPAN`] when
     /// tan-mapped (the grading stays on the outer ends); the adaptive rule needs no cut.
     fn spans(&self, rule: &Nodes) -> Vec<PieceMap> {
-        let k = if self.tan && rule.fixed.is_some() {
+        let k = if self.tan && rule.kernel.is_some() {
             ((self.u1 - self.u0).abs() / MAX_U_SPAN).ceil().max(1.0) as usize
         } else {
             1
@@ -924,7 +924,7 @@ fn line_integral(ctx: &Ctx, a: DVec3, e1: DVec3, x0: f64, x1: f64) -> DVec3 {
             continue;
         }
         let map = PieceMap::new(t0, t1, x_star, width);
-        if ctx.unshaped && (map.tan || ctx.rule.fixed.is_none()) {
+        if ctx.unshaped && (map.tan || ctx.rule.kernel.is_none()) {
             // Closed form (the GPU uses it where it maps with tan, where it cannot cancel).
             sum += DVec3::splat(unshaped_segment(ctx.n, perp, e1, m, width, x_star, t0, t1));
             continue;

@@ -5,8 +5,9 @@
 //!   (bisect the interval with the largest estimate until the sum of estimates meets the
 //!   tolerance), as in QUADPACK's `qag`.
 //! - [`gauss_legendre`]: n-point Gauss–Legendre nodes and weights on [0, 1], computed in f64 by
-//!   Newton's method on Pₙ. The WGSL kernel's fixed rule comes from here through the generated
-//!   prelude (`src/gpu/shaders.rs`), so no node is retyped.
+//!   Newton's method on Pₙ. The WGSL kernel's Gauss–Legendre nodes come from here through the
+//!   generated prelude (`src/gpu/shaders.rs`), so no node is retyped; [`gk15_unit`] gives it the
+//!   Gauss–Kronrod pair the same way.
 //!
 //! Values are RGB ([`DVec3`]); an error is measured in the largest channel.
 

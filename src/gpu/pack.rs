@@ -38,8 +38,9 @@ pub const FLAG_AXIS_SINGULAR: u32 = 256;
 pub const WORKGROUP_SIZE: u32 = 64;
 
 /// Irradiance kernel: Gauss–Legendre points of the elevation integral of a sphere cap cut by the
-/// horizon (`cap_sliver`), and per inner span.
-pub const IRR_GL_OUTER: usize = 12;
+/// horizon (`cap_sliver`).
+pub const IRR_GL_CAP: usize = 12;
+/// Irradiance kernel: Gauss–Legendre points per inner span.
 /// (The WGSL writes the inner rule's 10 nodes out: changing this needs `inner_rule` changed.)
 pub const IRR_GL_INNER: usize = 10;
 /// Irradiance kernel: each inner span is integrated adaptively: the rule on the span against the
@@ -81,7 +82,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_DARK", FLAG_DARK),
     ("FLAG_AXIS_SINGULAR", FLAG_AXIS_SINGULAR),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
-    ("IRR_GL_OUTER", IRR_GL_OUTER as u32),
+    ("IRR_GL_CAP", IRR_GL_CAP as u32),
     ("IRR_GL_INNER", IRR_GL_INNER as u32),
     ("IRR_INNER_DEPTH", IRR_INNER_DEPTH as u32),
     ("IRR_OUTER_DEPTH", IRR_OUTER_DEPTH as u32),
@@ -100,12 +101,12 @@ pub const WGSL_F32_CONSTANTS: &[(&str, f64)] = &[
 /// The `f32` arrays shared with WGSL (emitted as module-scope `var<private>` so that they can be
 /// indexed at run time): the irradiance kernel's Gauss–Legendre rules on [0, 1].
 pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
-    let (xo, wo) = crate::cpu::quadrature::gauss_legendre(IRR_GL_OUTER);
+    let (xo, wo) = crate::cpu::quadrature::gauss_legendre(IRR_GL_CAP);
     let (xi, wi) = crate::cpu::quadrature::gauss_legendre(IRR_GL_INNER);
     let gk = crate::cpu::quadrature::gk15_unit();
     vec![
-        ("IRR_GL_OUTER_X", xo),
-        ("IRR_GL_OUTER_W", wo),
+        ("IRR_GL_CAP_X", xo),
+        ("IRR_GL_CAP_W", wo),
         ("IRR_GL_INNER_X", xi),
         ("IRR_GL_INNER_W", wi),
         ("IRR_GK_X", gk.0),
