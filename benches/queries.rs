@@ -3,7 +3,7 @@
 //! ratio, use `luxeval bench`.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
-use luxeval::check::{Rng, synthetic_lights};
+use luxeval::testkit::{Rng, synthetic_lights};
 use luxeval::{Accumulate, Evaluator};
 
 fn queries(c: &mut Criterion) {

@@ -1,12 +1,15 @@
 // emission(light, ω): RGB radiance leaving the light along ω (DESIGN.md §3).
 // Twin of src/cpu/emission.rs, which carries the spec citations.
+//
+// GPU-only emission_main: the kernel's entry point; it normalises ω as cpu::emission_batch
+//   does, so emission() takes unit vectors on both sides.
 
-// #import shared/light.wgsl
+// #import shared/record.wgsl
 // #import shared/shaping.wgsl
 
 // Emission along unit direction e (pointing away from the light; for a dome, toward the
 // environment).
-fn emission_of(light: Light, e: vec3<f32>) -> vec3<f32> {
+fn emission(light: Record, e: vec3<f32>) -> vec3<f32> {
     let base = light.base.xyz;
     switch light.kind {
         case KIND_DOME: {
@@ -50,7 +53,7 @@ fn emission_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let e = normalize(load3(false, i));
     var sum = vec3<f32>(0.0);
     for (var l = params.light_first; l < params.light_end; l++) {
-        add(i, l, emission_of(lights[l], e), &sum);
+        add(i, l, emission(lights[l], e), &sum);
     }
     finish(i, sum);
 }

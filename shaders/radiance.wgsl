@@ -1,15 +1,19 @@
 // radiance(x, ω): RGB radiance arriving at x from direction ω (DESIGN.md §3).
 // Twin of src/cpu/radiance.rs, which carries the spec citations.
+//
+// f32: the ray–shape dispatch (cpu::radiance::hits_emitting_surface) is written inline.
+// GPU-only radiance_main: the kernel's entry point; it normalises ω as cpu::radiance_batch
+//   does.
 
-// #import shared/light.wgsl
+// #import shared/record.wgsl
 // #import shared/shapes.wgsl
 // #import emission.wgsl
 
-fn radiance_of(light: Light, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
+fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
     switch light.kind {
         case KIND_DOME, KIND_DISTANT: {
             // The environment, or the distant light's cone, in direction w.
-            return emission_of(light, -w);
+            return emission(light, -w);
         }
         default: {}
     }
@@ -37,7 +41,7 @@ fn radiance_of(light: Light, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
     if !hit {
         return vec3<f32>(0.0);
     }
-    return emission_of(light, -w);
+    return emission(light, -w);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)
@@ -50,7 +54,7 @@ fn radiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let w = normalize(load3(true, i));
     var sum = vec3<f32>(0.0);
     for (var l = params.light_first; l < params.light_end; l++) {
-        add(i, l, radiance_of(lights[l], x, w), &sum);
+        add(i, l, radiance(lights[l], x, w), &sum);
     }
     finish(i, sum);
 }

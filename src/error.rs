@@ -1,5 +1,6 @@
-//! Typed library errors. Every variant names what the user must look at: the light (prim path),
-//! the attribute, the file.
+//! Typed library errors. Every variant names what the user must look at (the light's prim path,
+//! the attribute, the file) and keeps the error it came from as its `source`. `Display` already
+//! includes the source's message, so a caller reports an error once by printing it.
 
 use std::path::PathBuf;
 
@@ -21,23 +22,48 @@ pub enum LuxError {
     #[error("light {light}: world transform {reason}")]
     InvalidTransform { light: String, reason: String },
 
-    /// Query input arrays of the wrong shape or content.
+    /// Query input arrays of the wrong shape or content, or a bad argument.
     #[error("{what}: {reason}")]
     InvalidInput { what: String, reason: String },
 
     /// No wgpu adapter could be found.
     #[error(
-        "no GPU adapter found ({0}); use --device cpu, or install a Vulkan driver (e.g. Mesa's lavapipe: mesa-vulkan-drivers)"
+        "no GPU adapter found ({reason}); use --device cpu, or install a Vulkan driver (e.g. Mesa's lavapipe: mesa-vulkan-drivers)"
     )]
-    NoAdapter(String),
+    NoAdapter {
+        reason: String,
+        #[source]
+        source: Option<wgpu::RequestAdapterError>,
+    },
 
-    /// The GPU device failed: creation, validation, out of memory, device lost, readback.
-    #[error("GPU: {0}")]
-    Gpu(String),
+    /// The adapter refused to open a device.
+    #[error("GPU: cannot open {adapter}: {source}")]
+    DeviceRequest {
+        adapter: String,
+        #[source]
+        source: wgpu::RequestDeviceError,
+    },
 
-    /// A file could not be read or written.
+    /// The GPU failed while working: validation, out of memory, device lost, readback.
+    #[error("GPU: {context}: {source}")]
+    Gpu {
+        context: String,
+        #[source]
+        source: GpuFailure,
+    },
+
+    /// A file could not be read (or an output could not be created where the path says).
     #[error("{}: {source}", path.display())]
     Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+
+    /// Writing an output failed once it was under way (disk full, I/O error): a runtime failure,
+    /// not bad input.
+    #[error("writing {}: {source}", path.display())]
+    Write {
         path: PathBuf,
         #[source]
         source: std::io::Error,
@@ -50,6 +76,26 @@ pub enum LuxError {
         line: Option<usize>,
         reason: String,
     },
+}
+
+/// What went wrong on the GPU, keeping wgpu's own error.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuFailure {
+    /// Validation, out-of-memory or internal errors caught by an error scope.
+    #[error(transparent)]
+    Wgpu(#[from] wgpu::Error),
+    /// Waiting for the device failed.
+    #[error(transparent)]
+    Poll(#[from] wgpu::PollError),
+    /// Mapping a readback buffer failed.
+    #[error(transparent)]
+    Map(#[from] wgpu::BufferAsyncError),
+    /// Viewing a mapped buffer failed.
+    #[error(transparent)]
+    View(#[from] wgpu::MapRangeError),
+    /// The device went away (a callback was dropped unanswered).
+    #[error("the device was lost")]
+    Lost,
 }
 
 impl LuxError {
@@ -71,6 +117,13 @@ impl LuxError {
         LuxError::InvalidInput {
             what: what.into(),
             reason: reason.into(),
+        }
+    }
+
+    pub(crate) fn gpu(context: impl Into<String>, source: impl Into<GpuFailure>) -> Self {
+        LuxError::Gpu {
+            context: context.into(),
+            source: source.into(),
         }
     }
 

@@ -31,25 +31,34 @@
 // Comparisons written `!(x > y)` reject NaN on purpose.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod check;
-pub mod cpu;
-pub mod error;
-pub mod falloff;
-pub mod gpu;
+// The data flow of DESIGN.md §1, each module depending only on those above it:
+// model → usd → prepare → cpu | gpu → query → io, falloff → the CLI (src/bin/luxeval).
+// `rules` holds what the WGSL kernels and their f64 counterparts share; neither backend owns it.
+pub(crate) mod error;
+pub(crate) mod model;
+#[cfg(feature = "usd")]
+pub(crate) mod usd;
+pub(crate) mod prepare;
+pub(crate) mod rules;
+pub(crate) mod cpu;
+pub(crate) mod gpu;
+pub(crate) mod query;
 pub mod io;
-pub mod light;
-pub mod query;
-pub mod scene;
-pub mod schema;
-pub mod usd;
+pub mod falloff;
+#[cfg(any(test, feature = "testkit"))]
+pub mod testkit;
+#[cfg(any(test, feature = "testkit"))]
+pub mod check;
 
 /// Compiles and runs the README's examples as doctests.
-#[cfg(doctest)]
+#[cfg(all(doctest, feature = "usd"))]
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 
-pub use cpu::TemperatureMode;
-pub use error::{LuxError, Result};
-pub use light::{Light, LightInputs, LightType, Shaping};
-pub use query::{Accumulate, Backend, Evaluator};
-pub use scene::Scene;
+pub use error::{GpuFailure, LuxError, Result};
+pub use gpu::{AdapterSummary, DeviceLimits, adapters};
+pub use model::{Input, Light, LightInputs, LightType, Shaping, Value, schema};
+pub use prepare::TemperatureMode;
+pub use query::{Accumulate, Evaluator, PreparedScene, Reference};
+#[cfg(feature = "usd")]
+pub use usd::{Scene, SceneLight, Stage, StageInfo, TimeRule};

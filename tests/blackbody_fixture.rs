@@ -1,7 +1,7 @@
 //! Colour temperature against Pixar's usd-core (fixture made by tools/gen_blackbody_fixture.py).
 
 use luxeval::TemperatureMode;
-use luxeval::cpu::blackbody::temperature_rgb;
+
 
 fn rows() -> Vec<(f64, [f64; 3], [f64; 3])> {
     let text = include_str!("data/blackbody_usdcore.json");
@@ -36,7 +36,7 @@ fn usd_mode_matches_usd_core() {
     assert!(rows.len() >= 12);
     assert!(rows.iter().any(|r| r.0 <= 800.0) && rows.iter().any(|r| r.0 >= 12000.0));
     for (t, want, _) in &rows {
-        let got = temperature_rgb(*t, TemperatureMode::Usd).to_array();
+        let got = TemperatureMode::Usd.rgb(*t).to_array();
         for c in 0..3 {
             assert!(
                 (got[c] - want[c]).abs() <= 1e-5,
@@ -54,7 +54,7 @@ fn spec_mode_is_usd_core_over_6500() {
     let rows = rows();
     let white = rows.iter().find(|r| r.0 == 6500.0).expect("6500 K row").1;
     for (t, usd, _) in &rows {
-        let got = temperature_rgb(*t, TemperatureMode::Spec).to_array();
+        let got = TemperatureMode::Spec.rgb(*t).to_array();
         for c in 0..3 {
             let want = usd[c] / white[c];
             assert!(
@@ -77,7 +77,7 @@ fn planckian_mode_matches_gf_color_inside_the_gamut() {
             continue;
         }
         compared += 1;
-        let got = temperature_rgb(t, TemperatureMode::Planckian).to_array();
+        let got = TemperatureMode::Planckian.rgb(t).to_array();
         for c in 0..3 {
             assert!(
                 (got[c] - want[c]).abs() <= 1e-5 * want[c].max(1.0),

@@ -1,5 +1,6 @@
 //! Command-line integration tests (DESIGN.md §4): outputs equal the library's results, exit
 //! codes and messages for bad input, and no partial output file after a failure.
+#![cfg(feature = "cli")]
 
 mod common;
 
@@ -7,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use luxeval::io::npy;
-use luxeval::scene::Scene;
+use luxeval::Scene;
 use luxeval::{Accumulate, Evaluator};
 
 fn luxeval(args: &[&str]) -> Output {

@@ -9,14 +9,21 @@
 mod common;
 
 use glam::DVec3;
-use luxeval::check::{self, Rng, TRANSFORMS, random_light, random_lights};
-use luxeval::cpu::{self, PreparedLight};
-use luxeval::{Accumulate, Evaluator, Light, LightType, TemperatureMode};
+use luxeval::check;
+use luxeval::testkit::{Rng, TRANSFORMS, random_light, random_lights};
+use luxeval::{Accumulate, Evaluator, Light, LightType, Reference, TemperatureMode};
+
+fn references(lights: &[Light], mode: TemperatureMode) -> Vec<Reference> {
+    lights
+        .iter()
+        .map(|l| Reference::new(l, mode).expect("valid light"))
+        .collect()
+}
 
 #[test]
 fn gpu_matches_cpu_on_randomised_lights() {
     let Some(gpu) = common::gpu() else { return };
-    let device = gpu.adapter().name.to_string();
+    let device = gpu.device_name();
     let mut rng = Rng::new(0x1A7E_5EED);
     let lights = random_lights(&mut rng, 6); // 6 types × 7 transforms × 6 = 252 lights
     let samples_per_query = 200;
@@ -31,9 +38,9 @@ fn gpu_matches_cpu_on_randomised_lights() {
             .filter(|(i, _)| k == 0 || i % 3 == k)
             .map(|(_, l)| l)
             .collect();
-        let prepared: Vec<PreparedLight> = subset
+        let prepared: Vec<Reference> = subset
             .iter()
-            .map(|l| PreparedLight::new(l, mode).expect("valid light"))
+            .map(|l| Reference::new(l, mode).expect("valid light"))
             .collect();
         // Irradiance depends on the temperature mode only through the base radiance: a few
         // receivers per light under the spec mode here; tests below cover it in depth.
@@ -42,8 +49,8 @@ fn gpu_matches_cpu_on_randomised_lights() {
             radiance: samples_per_query,
             irradiance: if k == 0 { 12 } else { 0 },
         };
-        let report = check::check_with(&gpu, &device, &prepared, counts, 7 + k as u64)
-            .expect("GPU check runs");
+        let report =
+            check::check_with(&gpu, &prepared, counts, 7 + k as u64).expect("GPU check runs");
         total += report.samples;
         excluded += report.excluded;
         worst.extend(report.rows);
@@ -89,11 +96,10 @@ fn gpu_matches_cpu_on_randomised_lights() {
 #[test]
 fn summed_and_per_light_batches_agree() {
     let Some(gpu) = common::gpu() else { return };
-    let gpu = Evaluator::from_context(gpu);
     let cpu = Evaluator::cpu();
     let mut rng = Rng::new(99);
     let lights = random_lights(&mut rng, 1);
-    let prepared = cpu::prepare(&lights, TemperatureMode::Spec).unwrap();
+    let prepared = references(&lights, TemperatureMode::Spec);
     let n = 4000;
     let dirs: Vec<[f32; 3]> = (0..n).map(|_| rng.unit().as_vec3().to_array()).collect();
     let points: Vec<[f32; 3]> = (0..n)
@@ -165,7 +171,7 @@ fn summed_and_per_light_batches_agree() {
 #[test]
 fn irradiance_matches_cpu_on_every_type_and_transform() {
     let Some(gpu) = common::gpu() else { return };
-    let device = gpu.adapter().name.to_string();
+    let device = gpu.device_name();
     let mut rng = Rng::new(0x1AAD_1A4C);
     let mut lights = random_lights(&mut rng, 2); // 84 lights
     for (i, xf) in TRANSFORMS.iter().enumerate() {
@@ -189,16 +195,13 @@ fn irradiance_matches_cpu_on_every_type_and_transform() {
             }
         }
     }
-    let prepared: Vec<PreparedLight> = lights
-        .iter()
-        .map(|l| PreparedLight::new(l, TemperatureMode::Spec).expect("valid light"))
-        .collect();
+    let prepared = references(&lights, TemperatureMode::Spec);
     let counts = check::Samples {
         emission: 0,
         radiance: 0,
         irradiance: 40,
     };
-    let report = check::check_with(&gpu, &device, &prepared, counts, 11).expect("GPU check runs");
+    let report = check::check_with(&gpu, &prepared, counts, 11).expect("GPU check runs");
     let mut rows = report.rows.clone();
     rows.sort_by(|a, b| b.max_rel_error.total_cmp(&a.max_rel_error));
     let nonzero: usize = rows.iter().map(|r| r.nonzero).sum();
@@ -249,11 +252,10 @@ fn irradiance_matches_cpu_on_every_type_and_transform() {
 #[test]
 fn irradiance_summed_and_per_light_agree() {
     let Some(gpu) = common::gpu() else { return };
-    let gpu = Evaluator::from_context(gpu);
     let cpu = Evaluator::cpu();
     let mut rng = Rng::new(4242);
     let lights = random_lights(&mut rng, 1); // 42 lights
-    let prepared = cpu::prepare(&lights, TemperatureMode::Spec).unwrap();
+    let prepared = references(&lights, TemperatureMode::Spec);
     let n = 40;
     let mut points = Vec::new();
     let mut normals = Vec::new();
@@ -327,7 +329,6 @@ fn irradiance_summed_and_per_light_agree() {
 #[test]
 fn light_groups_accumulate_over_many_lights() {
     let Some(gpu) = common::gpu() else { return };
-    let gpu = Evaluator::from_context(gpu);
     let cpu = Evaluator::cpu();
     let mut rng = Rng::new(99);
     let base = random_lights(&mut rng, 1);

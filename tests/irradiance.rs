@@ -18,16 +18,15 @@ mod common;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
-use luxeval::check::Rng;
-use luxeval::cpu::{self, PreparedLight, TemperatureMode};
-use luxeval::{Light, LightType, Shaping};
+use luxeval::testkit::Rng;
+use luxeval::{Light, LightType, Reference, Shaping, TemperatureMode};
 
-fn prep(l: &Light) -> PreparedLight {
-    PreparedLight::new(l, TemperatureMode::Spec).unwrap()
+fn prep(l: &Light) -> Reference {
+    Reference::new(l, TemperatureMode::Spec).unwrap()
 }
 
 fn cpu_e(l: &Light, x: DVec3, n: DVec3) -> DVec3 {
-    cpu::irradiance::irradiance(&prep(l), x, n)
+    prep(l).irradiance(x, n)
 }
 
 /// Largest-channel relative difference.
@@ -984,24 +983,23 @@ fn point_and_line_sources() {
 /// error must leave room for f32 rounding within the 1e-4 GPU tolerance.
 #[test]
 fn kernel_rule_in_f64_is_within_1e_5_of_the_reference() {
-    use luxeval::check::{Rng, irradiance_samples, random_lights};
-    use luxeval::cpu::irradiance::{Rule, irradiance_with};
+    use luxeval::testkit::{irradiance_samples, kernel_rule_irradiance, random_lights};
     let mut rng = Rng::new(0xF1_7ED);
     let lights = random_lights(&mut rng, 2);
-    let rule = Rule::Kernel;
     let mut worst = (0.0f64, String::new());
     let mut compared = 0;
     for l in &lights {
-        let p = luxeval::cpu::PreparedLight::new(l, luxeval::TemperatureMode::Spec).unwrap();
+        let p = prep(l);
         let (pts, nrms) = irradiance_samples(&p, 30, &mut rng);
         for (x, n) in pts.iter().zip(&nrms) {
-            let (x, n) = (luxeval::cpu::dvec(*x), luxeval::cpu::dvec(*n));
-            let a = irradiance_with(&p, x, n, Rule::Adaptive);
+            let x = glam::Vec3::from_array(*x).as_dvec3();
+            let n = glam::Vec3::from_array(*n).as_dvec3();
+            let a = p.irradiance(x, n);
             if a.max_element() <= 0.0 {
                 continue;
             }
             compared += 1;
-            let f = irradiance_with(&p, x, n, rule);
+            let f = kernel_rule_irradiance(&p, x, n);
             let e = (f - a).abs().max_element() / a.abs().max_element();
             if e > worst.0 {
                 worst = (e, format!("{} at x {x} n {n}: {f} vs {a}", l.path));

@@ -2,15 +2,14 @@
 //! scene authors, at every frame, GPU against the CPU reference within tolerance. Frames where
 //! the light uses a feature luxeval does not evaluate yet (IES profiles, textures) are listed by
 //! the scene with a warning and skipped here, and the test says how many.
+#![cfg(feature = "usd")]
 
 mod common;
 
 use std::path::Path;
 
-use luxeval::TemperatureMode;
 use luxeval::check;
-use luxeval::cpu;
-use luxeval::scene::Scene;
+use luxeval::{Reference, Scene, TemperatureMode};
 
 #[test]
 fn every_luxtest_light_at_every_frame_is_within_tolerance() {
@@ -43,10 +42,12 @@ fn every_luxtest_light_at_every_frame_is_within_tolerance() {
             if lights.is_empty() {
                 continue;
             }
-            let prepared = cpu::prepare(&lights, TemperatureMode::Spec)
+            let prepared = lights
+                .iter()
+                .map(|l| Reference::new(l, TemperatureMode::Spec))
+                .collect::<Result<Vec<_>, _>>()
                 .unwrap_or_else(|e| panic!("{name} frame {frame}: {e}"));
-            let report =
-                check::check(&gpu, "test", &prepared, 150, frame as u64).expect("check runs");
+            let report = check::check(&gpu, &prepared, 150, frame as u64).expect("check runs");
             samples += report.samples;
             checked += prepared.len();
             if report.max_rel_error() > worst.0 {

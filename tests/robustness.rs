@@ -1,9 +1,10 @@
 //! Malformed input never panics: truncated and corrupted stages and .npy files give errors.
+#![cfg(feature = "usd")]
 
 use std::path::Path;
 
-use luxeval::check::Rng;
-use luxeval::scene::Scene;
+use luxeval::Scene;
+use luxeval::testkit::Rng;
 
 fn mutate(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
     let mut b = bytes.to_vec();

@@ -1,12 +1,11 @@
 //! The USD loader against Pixar's usd-core: every light of every fixture scene, at every time
 //! code it authors and under the EarliestTime rule, must resolve to what usd-core resolved
 //! (tests/data/usd/expected/*.json, written by tools/gen_usd_fixtures.py).
+#![cfg(feature = "usd")]
 
 use std::path::{Path, PathBuf};
 
-use luxeval::scene::{TimeRule, Value};
-use luxeval::usd::{LightPrim, Time, UsdStage};
-use luxeval::{LightType, LuxError, Scene};
+use luxeval::{LightType, LuxError, Scene, SceneLight, Stage, TimeRule, Value};
 use serde_json::Value as Json;
 
 fn data() -> PathBuf {
@@ -34,7 +33,7 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 
 /// Compares one light with usd-core's record of it; returns every mismatch, each naming the
 /// scene, time, prim and attribute.
-fn compare(ctx: &str, ours: &LightPrim, exp: &Json, problems: &mut Vec<String>) {
+fn compare(ctx: &str, ours: &SceneLight, exp: &Json, problems: &mut Vec<String>) {
     let mut bad = |what: String| problems.push(format!("{ctx} {}: {what}", ours.path));
     if ours.path != exp["path"] {
         bad(format!("path, usd-core has {}", exp["path"]));
@@ -47,7 +46,7 @@ fn compare(ctx: &str, ours: &LightPrim, exp: &Json, problems: &mut Vec<String>) 
         ));
     }
     // usd-core's GetAppliedSchemas() drops authored names no registered schema declares;
-    // ours lists them after the known ones (see luxeval::usd::LightPrim::applied_schemas).
+    // ours lists them after the known ones (see luxeval::SceneLight::applied_schemas).
     let mut applied: Vec<String> = exp["applied_schemas"]
         .as_array()
         .unwrap()
@@ -145,7 +144,7 @@ fn compare(ctx: &str, ours: &LightPrim, exp: &Json, problems: &mut Vec<String>) 
 fn check_scene(fixture: &str) {
     let exp = expected(fixture);
     let path = data().join(exp["scene"].as_str().unwrap());
-    let stage = UsdStage::open(&path).unwrap_or_else(|e| panic!("{fixture}: {e}"));
+    let stage = Stage::open(&path).unwrap_or_else(|e| panic!("{fixture}: {e}"));
     let info = stage.info();
     assert_eq!(info.up_axis, exp["up_axis"].as_str().unwrap(), "{fixture}");
     assert_eq!(
@@ -169,13 +168,14 @@ fn check_scene(fixture: &str) {
     assert!(!samples.is_empty());
     for sample in samples {
         let time = match sample["time"].as_f64() {
-            Some(t) => Time::Code(t),
-            None => Time::Earliest,
+            Some(t) => TimeRule::Given(t),
+            None => TimeRule::Earliest,
         };
         let ctx = format!("{fixture} @ {time:?}");
         let ours = stage
-            .lights_at(time)
-            .unwrap_or_else(|e| panic!("{ctx}: {e}"));
+            .scene_at(time)
+            .unwrap_or_else(|e| panic!("{ctx}: {e}"))
+            .lights;
         let theirs = sample["lights"].as_array().unwrap();
         let ours_paths: Vec<&str> = ours.iter().map(|l| l.path.as_str()).collect();
         let their_paths: Vec<&str> = theirs.iter().map(|l| l["path"].as_str().unwrap()).collect();

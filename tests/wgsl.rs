@@ -3,8 +3,7 @@
 
 use std::mem::{offset_of, size_of};
 
-use luxeval::gpu::shaders::{Kernel, compose};
-use luxeval::gpu::{LightRecord, Params};
+use luxeval::testkit::wgsl::{IRR_GL_INNER, Kernel, Params, Record, SOURCES, compose};
 
 fn module(kernel: Kernel) -> naga::Module {
     let src = compose(kernel);
@@ -59,29 +58,29 @@ fn wgsl_layout(m: &naga::Module, name: &str) -> (u32, u32, Vec<(String, u32)>) {
 }
 
 #[test]
-fn light_record_layout_matches_naga() {
+fn record_layout_matches_naga() {
     let m = module(Kernel::Radiance);
-    let (size, align, members) = wgsl_layout(&m, "Light");
-    assert_eq!(size as usize, size_of::<LightRecord>(), "struct size");
-    assert_eq!(size_of::<LightRecord>() % align as usize, 0, "array stride");
+    let (size, align, members) = wgsl_layout(&m, "Record");
+    assert_eq!(size as usize, size_of::<Record>(), "struct size");
+    assert_eq!(size_of::<Record>() % align as usize, 0, "array stride");
     let rust = [
-        ("to_local0", offset_of!(LightRecord, to_local)),
-        ("to_local1", offset_of!(LightRecord, to_local) + 16),
-        ("to_local2", offset_of!(LightRecord, to_local) + 32),
-        ("axis", offset_of!(LightRecord, axis)),
-        ("normal", offset_of!(LightRecord, normal)),
-        ("base", offset_of!(LightRecord, base)),
-        ("focus_tint", offset_of!(LightRecord, focus_tint)),
-        ("cone", offset_of!(LightRecord, cone)),
-        ("size", offset_of!(LightRecord, size)),
-        ("world_x", offset_of!(LightRecord, world)),
-        ("world_y", offset_of!(LightRecord, world) + 16),
-        ("world_z", offset_of!(LightRecord, world) + 32),
-        ("irr", offset_of!(LightRecord, irr)),
-        ("kind", offset_of!(LightRecord, kind)),
-        ("flags", offset_of!(LightRecord, flags)),
-        ("pad0", offset_of!(LightRecord, pad)),
-        ("pad1", offset_of!(LightRecord, pad) + 4),
+        ("to_local0", offset_of!(Record, to_local)),
+        ("to_local1", offset_of!(Record, to_local) + 16),
+        ("to_local2", offset_of!(Record, to_local) + 32),
+        ("axis", offset_of!(Record, axis)),
+        ("normal", offset_of!(Record, normal)),
+        ("base", offset_of!(Record, base)),
+        ("focus_tint", offset_of!(Record, focus_tint)),
+        ("cone", offset_of!(Record, cone)),
+        ("size", offset_of!(Record, size)),
+        ("world_x", offset_of!(Record, world)),
+        ("world_y", offset_of!(Record, world) + 16),
+        ("world_z", offset_of!(Record, world) + 32),
+        ("irr", offset_of!(Record, irr)),
+        ("kind", offset_of!(Record, kind)),
+        ("flags", offset_of!(Record, flags)),
+        ("pad0", offset_of!(Record, pad)),
+        ("pad1", offset_of!(Record, pad) + 4),
     ];
     assert_eq!(members.len(), rust.len(), "member count: {members:?}");
     for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
@@ -126,14 +125,14 @@ fn validation_rejects_a_type_error() {
 /// would spend llvmpipe's loop budget): as many nodes as `IRR_GL_INNER` says.
 #[test]
 fn inner_rule_is_written_out_with_every_node() {
-    let src = luxeval::gpu::shaders::SOURCES
+    let src = SOURCES
         .iter()
-        .find(|(name, _)| *name == "irradiance.wgsl")
+        .find(|(name, _)| *name == "irradiance/line.wgsl")
         .unwrap()
         .1;
     let body = &src[src.find("fn inner_rule(").unwrap()..];
     let body = &body[..body.find("\n}").unwrap()];
-    for k in 0..luxeval::gpu::pack::IRR_GL_INNER {
+    for k in 0..IRR_GL_INNER {
         assert!(
             body.contains(&format!("h, {k}u)")),
             "node {k} missing from inner_rule"
@@ -141,6 +140,6 @@ fn inner_rule_is_written_out_with_every_node() {
     }
     assert_eq!(
         body.matches("inner_node(").count(),
-        luxeval::gpu::pack::IRR_GL_INNER
+        IRR_GL_INNER
     );
 }

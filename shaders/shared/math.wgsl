@@ -43,3 +43,18 @@ fn atan2_accurate(y: f32, x: f32) -> f32 {
     }
     return select(a, -a, y < 0.0);
 }
+
+// Building an orthonormal basis, revisited (Duff et al. 2017), as glam's any_orthonormal_pair.
+fn orthonormal_pair_a(v: vec3<f32>) -> vec3<f32> {
+    let s = select(-1.0, 1.0, v.z >= 0.0);
+    let a = -1.0 / (s + v.z);
+    let b = v.x * v.y * a;
+    return vec3<f32>(1.0 + s * v.x * v.x * a, s * b, -s * v.x);
+}
+
+fn orthonormal_pair_b(v: vec3<f32>) -> vec3<f32> {
+    let s = select(-1.0, 1.0, v.z >= 0.0);
+    let a = -1.0 / (s + v.z);
+    let b = v.x * v.y * a;
+    return vec3<f32>(b, s + v.y * v.y * a, -v.y);
+}

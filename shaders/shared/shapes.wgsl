@@ -1,6 +1,9 @@
 // Ray–shape tests in the light's local frame. Twin of src/cpu/shapes.rs, which states the
 // one-sidedness rules (DESIGN.md §2 "Frames and shapes", "Edge cases").
 // x: ray origin, d: ray direction (any length), both already mapped to local space.
+//
+// f32: plane_hit returns the hit point in xyz with w = 1 for a hit, w = 0 for none (the CPU: an
+//   Option).
 
 // Where a ray from the -Z side meets z = 0 travelling toward +Z; w = 0 when it does not.
 fn plane_hit(x: vec3<f32>, d: vec3<f32>) -> vec4<f32> {

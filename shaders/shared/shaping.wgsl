@@ -1,7 +1,14 @@
 // ShapingAPI on the GPU. Twin of src/cpu/shaping.rs, which carries the spec citations
 // (spec/002 cone:angle, cone:softness, focus, focusTint; DESIGN.md §2 "Shaping").
+//
+// f32: θoff uses atan2_accurate (WGSL's builtin atan2 may err by ~1e-6 rad on lavapipe, which
+//   the angle-space smoothstep turns into 1e-4 relative errors near a soft cone edge).
+// f32: cone_factor evaluates 1 − smoothstep(θ; start, cone) as smoothstep(cone − θ; 0,
+//   cone − start) (equal in exact arithmetic), so that f32 does not cancel where the factor is
+//   small; the CPU evaluates the spec's form.
+// f32: pow(0, focus) is undefined in WGSL; focus_factor uses the limit 0.
 
-// #import shared/light.wgsl
+// #import shared/record.wgsl
 // #import shared/math.wgsl
 
 // θoff in radians: atan2(|e × a|, e · a), accurate near 0 where acos is not.
@@ -43,7 +50,7 @@ fn focus_factor(focus: f32, tint: vec3<f32>, cos_off: f32) -> vec3<f32> {
 }
 
 // The RGB factor ShapingAPI applies along unit emission direction e.
-fn shaping(light: Light, e: vec3<f32>) -> vec3<f32> {
+fn shaping(light: Record, e: vec3<f32>) -> vec3<f32> {
     if !has_flag(light, FLAG_SHAPING) {
         return vec3<f32>(1.0);
     }

@@ -7,36 +7,21 @@
 
 use glam::DVec3;
 
-use super::PreparedLight;
-use super::blackbody::{TemperatureMode, temperature_rgb};
-use super::normalize::distant_half_angle;
 use super::shaping::{off_axis_angle, shaping};
-use crate::light::{Light, LightType};
+use crate::model::LightType;
+use crate::prepare::Prepared;
 
-/// `intensity · 2^exposure · color ⊙ temperature(T)` (spec/001 intensity, exposure, color,
-/// colorTemperature), before normalize and shaping.
-pub fn base_radiance(light: &Light, mode: TemperatureMode) -> DVec3 {
-    let i = &light.inputs;
-    let scalar = i.intensity * 2f64.powf(i.exposure);
-    let tint = if i.enable_color_temperature {
-        temperature_rgb(i.color_temperature, mode)
-    } else {
-        DVec3::ONE
-    };
-    scalar * i.color * tint
-}
-
-/// emission along `e` (any non-zero length; normalised here).
-pub fn emission(p: &PreparedLight, e: DVec3) -> DVec3 {
-    let e = e.normalize();
+/// emission along the unit direction `e`.
+pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
+    let base = p.base;
     match p.light.kind {
-        LightType::Dome => p.base,
-        LightType::Distant { angle } => {
+        LightType::Dome => base,
+        LightType::Distant { .. } => {
             // A delta light (θmax = 0) has emission 0 (DESIGN.md §2 "Edge cases"); a finite
             // cone's boundary is inclusive. Distant lights are never shaped.
-            let theta_max = distant_half_angle(angle);
+            let theta_max = p.distant_half_angle;
             if theta_max > 0.0 && off_axis_angle(p.axis, e) <= theta_max {
-                p.base
+                base
             } else {
                 DVec3::ZERO
             }
@@ -44,7 +29,7 @@ pub fn emission(p: &PreparedLight, e: DVec3) -> DVec3 {
         LightType::Rect { .. } | LightType::Disk { .. } => {
             // One-sided toward local −Z: strictly ω · n > 0, edge-on is 0.
             if e.dot(p.normal) > 0.0 {
-                shaped(p, e)
+                base * shaping(p, e)
             } else {
                 DVec3::ZERO
             }
@@ -54,32 +39,25 @@ pub fn emission(p: &PreparedLight, e: DVec3) -> DVec3 {
             // parallel to the axis.
             let el = p.to_local * e;
             if el.y != 0.0 || el.z != 0.0 {
-                shaped(p, e)
+                base * shaping(p, e)
             } else {
                 DVec3::ZERO
             }
         }
         // A sphere (and its point approximation) emits along every direction.
-        LightType::Sphere { .. } => shaped(p, e),
-    }
-}
-
-/// The base radiance times ShapingAPI's factor, where the API is applied.
-fn shaped(p: &PreparedLight, e: DVec3) -> DVec3 {
-    match &p.light.shaping {
-        Some(s) => p.base * shaping(s, p.axis, e),
-        None => p.base,
+        LightType::Sphere { .. } => base * shaping(p, e),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::Shaping;
+    use crate::model::{Light, Shaping};
+    use crate::prepare::TemperatureMode;
     use glam::{DMat4, DQuat};
 
-    fn prep(l: &Light) -> PreparedLight {
-        PreparedLight::new(l, TemperatureMode::Spec).unwrap()
+    fn prep(l: &Light) -> Prepared {
+        Prepared::new(l, TemperatureMode::Spec).unwrap()
     }
 
     /// reference/luxtest.md §6 A1: L = intensity·2^exposure·color for an unshaped light.
@@ -89,7 +67,7 @@ mod tests {
             .with_intensity(5.0)
             .with_exposure(-11.0)
             .with_color(DVec3::new(1.0, 0.5, 0.25));
-        let got = emission(&prep(&l), DVec3::new(0.3, -0.2, 0.9));
+        let got = emission(&prep(&l), DVec3::new(0.3, -0.2, 0.9).normalize());
         let want = 5.0 / 2048.0 * DVec3::new(1.0, 0.5, 0.25);
         assert_eq!(got, want);
         // Any direction, even behind: a sphere emits everywhere.
@@ -260,11 +238,11 @@ mod tests {
             .with_intensity(5.0)
             .with_temperature(2000.0);
         let spec = emission(
-            &PreparedLight::new(&l, TemperatureMode::Spec).unwrap(),
+            &Prepared::new(&l, TemperatureMode::Spec).unwrap(),
             DVec3::NEG_Z,
         );
         let usd = emission(
-            &PreparedLight::new(&l, TemperatureMode::Usd).unwrap(),
+            &Prepared::new(&l, TemperatureMode::Usd).unwrap(),
             DVec3::NEG_Z,
         );
         assert!(
@@ -278,7 +256,7 @@ mod tests {
         let l6500 = l.clone().with_temperature(6500.0);
         assert_eq!(
             emission(
-                &PreparedLight::new(&l6500, TemperatureMode::Spec).unwrap(),
+                &Prepared::new(&l6500, TemperatureMode::Spec).unwrap(),
                 DVec3::NEG_Z
             ),
             DVec3::splat(5.0)

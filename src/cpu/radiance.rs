@@ -8,14 +8,13 @@
 
 use glam::DVec3;
 
-use super::PreparedLight;
 use super::emission::emission;
 use super::shapes::{cylinder_hit, disk_hit, rect_hit, sphere_hit};
-use crate::light::LightType;
+use crate::model::LightType;
+use crate::prepare::Prepared;
 
-/// radiance at `x` from direction `w` (any non-zero length; normalised here).
-pub fn radiance(p: &PreparedLight, x: DVec3, w: DVec3) -> DVec3 {
-    let w = w.normalize();
+/// radiance at `x` from the unit direction `w`.
+pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
     if hits_emitting_surface(p, x, w) {
         emission(p, -w)
     } else {
@@ -23,9 +22,10 @@ pub fn radiance(p: &PreparedLight, x: DVec3, w: DVec3) -> DVec3 {
     }
 }
 
-/// Whether a ray from `x` along `w` sees the light: always for a dome, inside the cone for a
-/// distant light (decided by its emission), the first hit on an emitting surface otherwise.
-pub fn hits_emitting_surface(p: &PreparedLight, x: DVec3, w: DVec3) -> bool {
+/// Whether a ray from `x` along `w` (any length) sees the light: always for a dome, inside the
+/// cone for a distant light (decided by its emission), the first hit on an emitting surface
+/// otherwise.
+pub fn hits_emitting_surface(p: &Prepared, x: DVec3, w: DVec3) -> bool {
     let xl = p.to_local * (x - p.origin);
     let dl = p.to_local * w;
     match p.light.kind {
@@ -48,12 +48,12 @@ pub fn hits_emitting_surface(p: &PreparedLight, x: DVec3, w: DVec3) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cpu::TemperatureMode;
-    use crate::light::Light;
+    use crate::model::Light;
+    use crate::prepare::TemperatureMode;
     use glam::{DMat4, DQuat};
 
-    fn prep(l: &Light) -> PreparedLight {
-        PreparedLight::new(l, TemperatureMode::Spec).unwrap()
+    fn prep(l: &Light) -> Prepared {
+        Prepared::new(l, TemperatureMode::Spec).unwrap()
     }
 
     #[test]

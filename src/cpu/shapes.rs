@@ -14,6 +14,15 @@
 
 use glam::DVec3;
 
+/// Where a ray from the −Z side meets the plane z = 0 travelling toward +Z.
+fn plane_hit(x: DVec3, d: DVec3) -> Option<DVec3> {
+    if !(d.z > 0.0 && x.z < 0.0) {
+        return None;
+    }
+    let t = -x.z / d.z;
+    Some(x + t * d)
+}
+
 /// Rect of half extents `hw` × `hh` in the XY plane, emitting toward −Z.
 pub fn rect_hit(x: DVec3, d: DVec3, hw: f64, hh: f64) -> bool {
     match plane_hit(x, d) {
@@ -28,15 +37,6 @@ pub fn disk_hit(x: DVec3, d: DVec3, r: f64) -> bool {
         Some(p) => p.x * p.x + p.y * p.y <= r * r,
         None => false,
     }
-}
-
-/// Where a ray from the −Z side meets the plane z = 0 travelling toward +Z.
-fn plane_hit(x: DVec3, d: DVec3) -> Option<DVec3> {
-    if !(d.z > 0.0 && x.z < 0.0) {
-        return None;
-    }
-    let t = -x.z / d.z;
-    Some(x + t * d)
 }
 
 /// Sphere of radius `r` at the origin, seen from outside.

@@ -11,29 +11,11 @@
 
 use glam::DVec3;
 
-use crate::light::Shaping;
-
-/// The RGB factor ShapingAPI applies to emission along unit direction `e`, for a light whose
-/// unit primary axis is `axis`.
-pub fn shaping(s: &Shaping, axis: DVec3, e: DVec3) -> DVec3 {
-    let cos = e.dot(axis);
-    let theta = off_axis_angle(axis, e);
-    focus_factor(s.focus, s.focus_tint, cos)
-        * cone_factor(theta, s.cone_angle.to_radians(), s.cone_softness)
-}
+use crate::prepare::Prepared;
 
 /// θoff in radians, in [0, π].
 pub fn off_axis_angle(axis: DVec3, e: DVec3) -> f64 {
     e.cross(axis).length().atan2(e.dot(axis))
-}
-
-/// `1 − smoothstep(θ; (1 − softness)·θcone, θcone)`, with the spec's guarantee θ > θcone → 0.
-pub fn cone_factor(theta: f64, cone: f64, softness: f64) -> f64 {
-    if theta > cone {
-        return 0.0;
-    }
-    let start = (1.0 - softness.clamp(0.0, 1.0)) * cone;
-    1.0 - smoothstep_angle(theta, start, cone)
 }
 
 /// UsdLux's `_Smoothstep(t, [lo, hi])` (value first): a zero-width range is a step that is 0 at
@@ -46,6 +28,15 @@ pub fn smoothstep_angle(t: f64, lo: f64, hi: f64) -> f64 {
     s * s * (3.0 - 2.0 * s)
 }
 
+/// `1 − smoothstep(θ; start, θcone)` with `start = (1 − softness)·θcone` (prepared), and the
+/// spec's guarantee θ > θcone → 0.
+pub fn cone_factor(theta: f64, cone: f64, start: f64) -> f64 {
+    if theta > cone {
+        return 0.0;
+    }
+    1.0 - smoothstep_angle(theta, start, cone)
+}
+
 /// `lerp(|cos|^focus, focusTint, 1)` per channel; white when focus ≤ 0.
 pub fn focus_factor(focus: f64, tint: DVec3, cos: f64) -> DVec3 {
     if focus <= 0.0 {
@@ -55,15 +46,33 @@ pub fn focus_factor(focus: f64, tint: DVec3, cos: f64) -> DVec3 {
     tint + f * (DVec3::ONE - tint)
 }
 
+/// The RGB factor ShapingAPI applies to emission along unit direction `e` (1 where the light is
+/// not shaped).
+pub fn shaping(p: &Prepared, e: DVec3) -> DVec3 {
+    let Some(s) = &p.shaping else {
+        return DVec3::ONE;
+    };
+    let cos = e.dot(p.axis);
+    let theta = off_axis_angle(p.axis, e);
+    focus_factor(s.focus, s.focus_tint, cos) * cone_factor(theta, s.cone, s.start)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The smoothstep start for `softness` (spec/002: softness clamped to [0, 1]).
+    fn start(cone: f64, softness: f64) -> f64 {
+        (1.0 - softness.clamp(0.0, 1.0)) * cone
+    }
 
     /// reference/openusd-reference.md §3.2: angle 45°, softness 0.25 → factor 1 up to 33.75°,
     /// 0.5 at 39.375°, 0 at 45°.
     #[test]
     fn cone_softness_example() {
         let c = 45f64.to_radians();
+        // softness 0.25: the smoothstep starts at 0.75·θcone.
+        let cone_factor = |t: f64, c: f64, soft: f64| cone_factor(t, c, start(c, soft));
         assert_eq!(cone_factor(33.0f64.to_radians(), c, 0.25), 1.0);
         assert_eq!(cone_factor(33.75f64.to_radians(), c, 0.25), 1.0);
         assert!((cone_factor(39.375f64.to_radians(), c, 0.25) - 0.5).abs() < 1e-12);
@@ -74,6 +83,7 @@ mod tests {
     #[test]
     fn hard_cone_boundary_is_lit_and_softness_is_clamped() {
         let c = 30f64.to_radians();
+        let cone_factor = |t: f64, c: f64, soft: f64| cone_factor(t, c, start(c, soft));
         assert_eq!(cone_factor(c, c, 0.0), 1.0);
         assert_eq!(cone_factor(c + 1e-12, c, 0.0), 0.0);
         assert_eq!(cone_factor(c * 0.5, c, -3.0), 1.0); // softness −3 → 0: hard
@@ -100,5 +110,45 @@ mod tests {
         let tiny = 1e-9f64;
         let e = DVec3::new(tiny.sin(), 0.0, -tiny.cos());
         assert!((off_axis_angle(axis, e) - tiny).abs() < 1e-20);
+    }
+
+    /// A ShapingAPI whose factor is 1 everywhere is dropped by `prepare`; check that the factor
+    /// it would have applied is indeed 1 everywhere, so that dropping it changes no value.
+    #[test]
+    fn identity_shaping_is_dropped_without_changing_values() {
+        use crate::model::{Light, Shaping};
+        use crate::prepare::{Prepared, ShapingConsts, TemperatureMode, shaping_is_identity};
+        use crate::testkit::Rng;
+        let cone180 = Shaping {
+            cone_angle: 180.0,
+            ..Shaping::default()
+        };
+        assert!(shaping_is_identity(&cone180));
+        assert!(shaping_is_identity(&Shaping {
+            focus: 3.0,
+            focus_tint: DVec3::ONE,
+            ..cone180.clone()
+        }));
+        assert!(!shaping_is_identity(&Shaping::default())); // the 90° fallback cone
+        assert!(!shaping_is_identity(&Shaping {
+            cone_softness: 0.1,
+            ..cone180.clone()
+        }));
+        assert!(!shaping_is_identity(&Shaping {
+            focus: 1.0,
+            ..cone180.clone()
+        }));
+        let light = Light::sphere(0.5).with_shaping(cone180.clone());
+        let p = Prepared::new(&light, TemperatureMode::Spec).unwrap();
+        assert!(p.light.shaping.is_none() && p.shaping.is_none());
+        let s = ShapingConsts::new(&cone180);
+        let mut rng = Rng::new(5);
+        for _ in 0..1000 {
+            let e = rng.unit();
+            let f = focus_factor(s.focus, s.focus_tint, e.dot(p.axis))
+                * cone_factor(off_axis_angle(p.axis, e), s.cone, s.start);
+            assert_eq!(f, DVec3::ONE, "{e}");
+            assert_eq!(crate::cpu::emission::emission(&p, e), p.base);
+        }
     }
 }

@@ -16,8 +16,7 @@ use glam::DVec3;
 
 use crate::error::{LuxError, Result};
 use crate::io::write_atomic;
-use crate::light::Light;
-use crate::query::{Accumulate, Evaluator};
+use crate::query::{Accumulate, PreparedScene};
 
 /// The most pixels one map may have (memory for points, normals and results stays < 4 GiB).
 pub const MAX_PIXELS: u64 = 1 << 27;
@@ -110,11 +109,11 @@ impl Map {
 /// Rows evaluated per call, so that progress can be reported and memory stays bounded.
 const BLOCK_PIXELS: usize = 1 << 16;
 
-/// Evaluates the summed irradiance of `lights` over `plane` with `eval`, in blocks of rows;
-/// `progress(done, total)` is called after each block (pixels).
+/// Evaluates the summed irradiance of the prepared lights over `plane`, in blocks of rows (the
+/// scene's buffers are reused from block to block); `progress(done, total)` is called after
+/// each block (pixels).
 pub fn evaluate(
-    eval: &Evaluator,
-    lights: &[Light],
+    scene: &PreparedScene,
     plane: &Plane,
     mut progress: impl FnMut(usize, usize),
 ) -> Result<Map> {
@@ -130,7 +129,7 @@ pub fn evaluate(
             .map(|(i, j)| plane.pixel_centre(i, j).as_vec3().to_array())
             .collect();
         let normals = vec![n; points.len()];
-        rgb.extend(eval.irradiance(lights, &points, &normals, Accumulate::Sum)?);
+        rgb.extend(scene.irradiance(&points, &normals, Accumulate::Sum)?);
         progress(rgb.len(), total);
         j0 = j1;
     }
@@ -158,10 +157,9 @@ pub fn write_exr(path: &Path, map: &Map, comment: &str) -> Result<()> {
     Image::from_layer(layer)
         .write()
         .to_buffered(&mut bytes)
-        .map_err(|e| LuxError::Format {
+        .map_err(|e| LuxError::Write {
             path: path.to_path_buf(),
-            line: None,
-            reason: format!("encoding EXR: {e}"),
+            source: std::io::Error::other(format!("encoding EXR: {e}")),
         })?;
     write_atomic(path, |f| f.write_all(bytes.get_ref()))
 }

@@ -1,16 +1,18 @@
 //! WGSL composition: each kernel file names the modules it needs with `// #import path` lines;
 //! the composer inlines them once each, in dependency order, after a prelude of the constants
-//! shared with Rust ([`super::pack::WGSL_CONSTANTS`]).
+//! shared with Rust: the record's kinds and flags ([`super::record::WGSL_CONSTANTS`]) and the
+//! quadrature rules and tuning constants of [`crate::rules`]. No constant is retyped in WGSL.
 
 use std::collections::HashSet;
 
-use super::pack::{WGSL_CONSTANTS, WGSL_F32_CONSTANTS, wgsl_f32_arrays};
+use super::record::WGSL_CONSTANTS;
+use crate::rules;
 
 /// Every WGSL source file, by its path under `shaders/`.
 pub const SOURCES: &[(&str, &str)] = &[
     (
-        "shared/light.wgsl",
-        include_str!("../../shaders/shared/light.wgsl"),
+        "shared/record.wgsl",
+        include_str!("../../shaders/shared/record.wgsl"),
     ),
     (
         "shared/math.wgsl",
@@ -24,11 +26,45 @@ pub const SOURCES: &[(&str, &str)] = &[
         "shared/shapes.wgsl",
         include_str!("../../shaders/shared/shapes.wgsl"),
     ),
-    ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
-    ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
+    (
+        "shared/roots.wgsl",
+        include_str!("../../shaders/shared/roots.wgsl"),
+    ),
+    (
+        "emission.wgsl",
+        include_str!("../../shaders/emission.wgsl"),
+    ),
+    (
+        "radiance.wgsl",
+        include_str!("../../shaders/radiance.wgsl"),
+    ),
     (
         "irradiance.wgsl",
         include_str!("../../shaders/irradiance.wgsl"),
+    ),
+    (
+        "irradiance/closed.wgsl",
+        include_str!("../../shaders/irradiance/closed.wgsl"),
+    ),
+    (
+        "irradiance/chart.wgsl",
+        include_str!("../../shaders/irradiance/chart.wgsl"),
+    ),
+    (
+        "irradiance/critical.wgsl",
+        include_str!("../../shaders/irradiance/critical.wgsl"),
+    ),
+    (
+        "irradiance/pieces.wgsl",
+        include_str!("../../shaders/irradiance/pieces.wgsl"),
+    ),
+    (
+        "irradiance/line.wgsl",
+        include_str!("../../shaders/irradiance/line.wgsl"),
+    ),
+    (
+        "irradiance/outer.wgsl",
+        include_str!("../../shaders/irradiance/outer.wgsl"),
     ),
 ];
 
@@ -71,15 +107,15 @@ fn source(path: &str) -> &'static str {
 /// The prelude of shared constants.
 pub fn prelude() -> String {
     let mut s = String::from(
-        "// Generated from src/gpu/pack.rs WGSL_CONSTANTS, WGSL_F32_CONSTANTS, wgsl_f32_arrays.\n",
+        "// Generated from src/gpu/record.rs (WGSL_CONSTANTS) and src/rules.rs.\n",
     );
-    for (name, value) in WGSL_CONSTANTS {
+    for (name, value) in WGSL_CONSTANTS.iter().copied().chain(rules::wgsl_u32_constants()) {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
-    for (name, value) in WGSL_F32_CONSTANTS {
-        s.push_str(&format!("const {name}: f32 = {};\n", f32_literal(*value)));
+    for (name, value) in rules::wgsl_f32_constants() {
+        s.push_str(&format!("const {name}: f32 = {};\n", f32_literal(value)));
     }
-    for (name, values) in wgsl_f32_arrays() {
+    for (name, values) in rules::wgsl_f32_arrays() {
         let items: Vec<String> = values.iter().map(|v| f32_literal(*v)).collect();
         s.push_str(&format!(
             "var<private> {name}: array<f32, {}> = array<f32, {}>({});\n",

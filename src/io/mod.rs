@@ -11,11 +11,19 @@ use crate::error::{LuxError, Result};
 /// Writes `path` atomically: the bytes go to a temporary file in the same directory, which is
 /// renamed over `path` only once everything was written and flushed. On any error nothing is
 /// left at `path` (an existing file there is untouched).
+///
+/// Errors: a path where no file can be created (no such directory, no permission, a directory
+/// in the way) is [`LuxError::Io`], bad input; a failure while writing (disk full, I/O error)
+/// is [`LuxError::Write`], a runtime failure.
 pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<()> {
     let io_err = |source| LuxError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let write_err = |source| LuxError::Write {
         path: path.to_path_buf(),
         source,
     };
@@ -35,10 +43,10 @@ pub fn write_atomic(
     let mut tmp = builder.tempfile_in(dir).map_err(io_err)?;
     {
         let mut w = std::io::BufWriter::new(tmp.as_file_mut());
-        write(&mut w).map_err(io_err)?;
-        w.flush().map_err(io_err)?;
+        write(&mut w).map_err(write_err)?;
+        w.flush().map_err(write_err)?;
     }
-    tmp.as_file().sync_all().map_err(io_err)?;
+    tmp.as_file().sync_all().map_err(write_err)?;
     tmp.persist(path).map_err(|e| io_err(e.error))?;
     Ok(())
 }

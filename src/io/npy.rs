@@ -85,13 +85,13 @@ pub fn read_vec3(path: &Path) -> Result<Vec<[f32; 3]>> {
 /// Writes float32 RGB rows with the given shape (the product of `shape` must be `3·rows`),
 /// atomically.
 pub fn write_f32(path: &Path, shape: &[u64], rows: &[[f32; 3]]) -> Result<()> {
-    let expected: u64 = shape.iter().product();
-    assert_eq!(
-        expected as usize,
-        rows.len() * 3,
-        "shape {shape:?} does not hold {} rows",
-        rows.len()
-    );
+    let expected = shape.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
+    if expected != Some(rows.len() as u64 * 3) {
+        return Err(LuxError::input(
+            path.display().to_string(),
+            format!("shape {shape:?} does not hold {} RGB rows", rows.len()),
+        ));
+    }
     write_atomic(path, |w| {
         let mut writer = npyz::WriteOptions::new()
             .default_dtype()

@@ -6,10 +6,10 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 
-use luxeval::check::{Rng, synthetic_lights};
+use luxeval::testkit::{Rng, synthetic_lights};
 use luxeval::{Accumulate, Evaluator};
 
-use crate::{CliResult, Failure};
+use crate::exit::{CliResult, Failure};
 
 #[derive(Args)]
 pub struct BenchArgs {

@@ -17,7 +17,7 @@
 use glam::{DMat3, DVec3};
 use std::f64::consts::PI;
 
-use crate::light::{Light, LightType};
+use crate::model::{Light, LightType};
 
 /// The sizeFactor the light's luminance is divided by: 1 when `normalize` is off.
 pub fn size_factor(light: &Light) -> f64 {

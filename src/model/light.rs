@@ -1,6 +1,6 @@
 //! The light model: resolved UsdLux lights, independent of where they came from (a USD stage,
 //! or built in code). Every input is stored with its resolved value (authored or the schema
-//! fallback of [`crate::schema`]); angles are in degrees as USD authors them.
+//! fallback of [`super::schema`]); angles are in degrees as USD authors them.
 //!
 //! Transforms: `world` is the light's local-to-world matrix in glam's column-vector convention
 //! (`p_world = world * p_local`). USD writes the same matrix in row-vector form
@@ -10,7 +10,7 @@
 use glam::{DMat3, DMat4, DVec3};
 
 use crate::error::{LuxError, Result};
-use crate::schema;
+use super::schema;
 
 /// LightAPI inputs shared by every light (spec/001).
 #[derive(Clone, Debug, PartialEq)]

@@ -1,13 +1,13 @@
 // The GPU light record and the query bindings shared by every kernel.
 //
-// The record's Rust twin is `LightRecord` in src/gpu/pack.rs; tests/wgsl.rs asserts both layouts
+// The record's Rust twin is `Record` in src/gpu/record.rs; tests/wgsl.rs asserts both layouts
 // against naga's layouter. The constants KIND_* and FLAG_* come from a prelude that
 // src/gpu/shaders.rs generates from the Rust constants, so they are never retyped here.
 //
 // All per-light constants (base radiance including colour temperature and normalize, the
 // world->local map, axes, cone angles) are computed on the CPU in f64 and rounded once.
 
-struct Light {
+struct Record {
     // Rows of the world->local affine map: local = (dot(row.xyz, p) + row.w) for points,
     // dot(row.xyz, v) for directions.
     to_local0: vec4<f32>,
@@ -55,7 +55,7 @@ struct Params {
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(1) var<storage, read> lights: array<Record>;
 // Float triples: directions (emission) or points (radiance, irradiance).
 @group(0) @binding(2) var<storage, read> in_a: array<f32>;
 // Float triples: directions (radiance) or receiver normals (irradiance); unused by emission.
@@ -101,11 +101,11 @@ fn finish(i: u32, sum: vec3<f32>) {
     }
 }
 
-fn has_flag(light: Light, flag: u32) -> bool {
+fn has_flag(light: Record, flag: u32) -> bool {
     return (light.flags & flag) != 0u;
 }
 
-fn to_local_point(light: Light, p: vec3<f32>) -> vec3<f32> {
+fn to_local_point(light: Record, p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(
         dot(light.to_local0.xyz, p) + light.to_local0.w,
         dot(light.to_local1.xyz, p) + light.to_local1.w,
@@ -113,15 +113,24 @@ fn to_local_point(light: Light, p: vec3<f32>) -> vec3<f32> {
     );
 }
 
-fn to_local_dir(light: Light, v: vec3<f32>) -> vec3<f32> {
+fn to_local_dir(light: Record, v: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(light.to_local0.xyz, v), dot(light.to_local1.xyz, v), dot(light.to_local2.xyz, v));
 }
 
 // The local-to-world linear map applied to a local vector.
-fn to_world_dir(light: Light, v: vec3<f32>) -> vec3<f32> {
+fn to_world_dir(light: Record, v: vec3<f32>) -> vec3<f32> {
     return light.world_x.xyz * v.x + light.world_y.xyz * v.y + light.world_z.xyz * v.z;
 }
 
-fn world_origin(light: Light) -> vec3<f32> {
+fn world_origin(light: Record) -> vec3<f32> {
     return vec3<f32>(light.world_x.w, light.world_y.w, light.world_z.w);
+}
+
+// The kink cones of the light's shaping (prepare::Profile): count, and their cosines.
+fn kink_count(light: Record) -> u32 {
+    return select(0u, 1u, has_flag(light, FLAG_KINK_A)) + select(0u, 1u, has_flag(light, FLAG_KINK_B));
+}
+
+fn kink_cos(light: Record, i: u32) -> f32 {
+    return select(light.irr.z, light.irr.w, i == 1u);
 }

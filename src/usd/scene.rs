@@ -1,7 +1,7 @@
 //! The resolved scene: every light of a USD stage at one time, as plain data, and the subset
 //! luxeval evaluates as [`Light`]s.
 //!
-//! [`crate::usd`] reads the stage (it is the only module that sees openusd); this module decides
+//! [`super::stage`] reads the stage (with openusd); this module decides
 //! what each light means to luxeval: which types it evaluates, which it lists with a warning, and
 //! which time the stage is read at (DESIGN.md §2 "Query time").
 
@@ -10,35 +10,9 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use serde::Serialize;
 
+use super::stage::{self as usd, UsdStage};
 use crate::error::{LuxError, Result};
-use crate::light::{Light, LightInputs, LightType, Shaping};
-use crate::usd::{self, UsdStage};
-
-/// A resolved input value, typed as the schema table types its fallback.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(untagged)]
-pub enum Value {
-    Float(f64),
-    Bool(bool),
-    Color([f64; 3]),
-    Token(String),
-    /// An `asset` input: the path as authored (empty when unauthored) and the path it resolves
-    /// to, anchored to the layer that authored it (`/abs/pkg.usdz[inner/path]` inside a usdz);
-    /// `None` where it resolves to no existing file.
-    Asset {
-        authored: String,
-        resolved: Option<String>,
-    },
-}
-
-/// One input of a light: its resolved value and whether any layer authors it (a default or time
-/// samples); an unauthored input holds the schema fallback of [`crate::schema`].
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Input {
-    pub name: String,
-    pub value: Value,
-    pub authored: bool,
-}
+use crate::model::{Input, Light, LightInputs, LightType, Shaping, Value};
 
 /// Which time the stage was read at.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -63,7 +37,7 @@ pub struct SceneLight {
     pub visible: bool,
     /// Local-to-world, USD row-vector convention (`world[3]` is the translation).
     pub world: [[f64; 4]; 4],
-    /// Every attribute of [`crate::schema::attrs_for`] in its order.
+    /// Every attribute of [`crate::model::schema::attrs_for`] in its order.
     pub inputs: Vec<Input>,
     /// `Some` where luxeval evaluates the light (also when it is invisible). Serialized as the
     /// boolean `evaluable`.
@@ -93,42 +67,6 @@ pub struct Scene {
     pub lights: Vec<SceneLight>,
 }
 
-/// Prints a value that came from a USD `float` as that float's shortest form (0.95, not
-/// 0.949999988079071); genuine doubles print in full.
-struct Short(f64);
-
-impl std::fmt::Display for Short {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let single = self.0 as f32;
-        if single as f64 == self.0 {
-            write!(f, "{single}")
-        } else {
-            write!(f, "{}", self.0)
-        }
-    }
-}
-
-impl std::fmt::Display for Value {
-    /// The value as `luxeval lights` prints it.
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Value::Float(v) => write!(f, "{}", Short(*v)),
-            Value::Bool(v) => write!(f, "{v}"),
-            Value::Color([r, g, b]) => write!(f, "({}, {}, {})", Short(*r), Short(*g), Short(*b)),
-            Value::Token(t) => write!(f, "{t:?}"),
-            Value::Asset { authored, .. } if authored.is_empty() => write!(f, "@@"),
-            Value::Asset {
-                authored,
-                resolved: Some(r),
-            } => write!(f, "@{authored}@ -> {r}"),
-            Value::Asset {
-                authored,
-                resolved: None,
-            } => write!(f, "@{authored}@ (unresolved)"),
-        }
-    }
-}
-
 impl std::fmt::Display for TimeRule {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -144,37 +82,8 @@ impl Scene {
     /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
     /// else at USD's EarliestTime (DESIGN.md §2).
     pub fn load(path: &Path, time: Option<f64>) -> Result<Scene> {
-        if let Some(t) = time.filter(|t| !t.is_finite()) {
-            return Err(LuxError::input(
-                "--time",
-                format!("{t} is not a finite time code"),
-            ));
-        }
-        let stage = UsdStage::open(path)?;
-        let rule = match time {
-            Some(t) => TimeRule::Given(t),
-            None => match stage.info().start_time_code {
-                Some(start) => TimeRule::StartTimeCode(start),
-                None => TimeRule::Earliest,
-            },
-        };
-        let at = match rule {
-            TimeRule::Given(t) | TimeRule::StartTimeCode(t) => usd::Time::Code(t),
-            TimeRule::Earliest => usd::Time::Earliest,
-        };
-        let lights = stage
-            .lights_at(at)?
-            .into_iter()
-            .map(SceneLight::from_prim)
-            .collect();
-        let info = stage.info();
-        Ok(Scene {
-            file: path.to_path_buf(),
-            up_axis: info.up_axis.clone(),
-            meters_per_unit: info.meters_per_unit,
-            time: rule,
-            lights,
-        })
+        check_time(time)?;
+        UsdStage::open(path)?.scene(time)
     }
 
     /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
@@ -234,6 +143,56 @@ impl Scene {
                 _ => None,
             })
             .collect()
+    }
+}
+
+impl UsdStage {
+    /// The stage's lights at `time`; without one, at its `startTimeCode` when authored, else at
+    /// USD's EarliestTime (DESIGN.md §2 "Query time").
+    pub fn scene(&self, time: Option<f64>) -> Result<Scene> {
+        check_time(time)?;
+        let rule = match time {
+            Some(t) => TimeRule::Given(t),
+            None => match self.info().start_time_code {
+                Some(start) => TimeRule::StartTimeCode(start),
+                None => TimeRule::Earliest,
+            },
+        };
+        self.scene_at(rule)
+    }
+
+    /// The stage's lights read as `rule` says.
+    pub fn scene_at(&self, rule: TimeRule) -> Result<Scene> {
+        let at = match rule {
+            TimeRule::Given(t) | TimeRule::StartTimeCode(t) => {
+                check_time(Some(t))?;
+                usd::Time::Code(t)
+            }
+            TimeRule::Earliest => usd::Time::Earliest,
+        };
+        let lights = self
+            .lights_at(at)?
+            .into_iter()
+            .map(SceneLight::from_prim)
+            .collect();
+        let info = self.info();
+        Ok(Scene {
+            file: self.file().to_path_buf(),
+            up_axis: info.up_axis.clone(),
+            meters_per_unit: info.meters_per_unit,
+            time: rule,
+            lights,
+        })
+    }
+}
+
+fn check_time(time: Option<f64>) -> Result<()> {
+    match time.filter(|t| !t.is_finite()) {
+        Some(t) => Err(LuxError::input(
+            "--time",
+            format!("{t} is not a finite time code"),
+        )),
+        None => Ok(()),
     }
 }
 
@@ -423,7 +382,7 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::schema;
+    use crate::model::schema;
 
     /// A light prim as `crate::usd` would return it, every input at its table fallback.
     fn prim(ty: &str, applied: &[&str]) -> usd::LightPrim {
@@ -431,7 +390,7 @@ mod tests {
             .into_iter()
             .map(|a| Input {
                 name: a.name.to_string(),
-                value: usd::fallback_value(a.fallback),
+                value: Value::fallback(a.fallback),
                 authored: false,
             })
             .collect();

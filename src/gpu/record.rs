@@ -1,13 +1,14 @@
-//! Packing prepared lights into GPU records. Twin of the `Light` struct in
-//! `shaders/shared/light.wgsl`; `tests/wgsl.rs` checks this layout against naga's layouter.
+//! Packing prepared lights into GPU records. Twin of the `Record` struct in
+//! `shaders/shared/record.wgsl`; `tests/wgsl.rs` checks this layout against naga's layouter.
+//!
+//! Every value comes from `prepare` (computed once per light in f64) and is rounded once here.
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::cpu::PreparedLight;
-use crate::cpu::irradiance;
-use crate::light::LightType;
+use crate::model::LightType;
+use crate::prepare::{Kink, Prepared};
 
-/// Record kinds; the WGSL prelude declares the same names from this table.
+/// Record kinds; the WGSL prelude declares the same names from [`WGSL_CONSTANTS`].
 pub const KIND_DISTANT: u32 = 0;
 pub const KIND_SPHERE: u32 = 1;
 pub const KIND_DISK: u32 = 2;
@@ -22,7 +23,7 @@ pub const FLAG_TREAT_AS_POINT_OR_LINE: u32 = 2;
 /// The linear map is a similarity (a sphere stays a sphere: the irradiance cap applies).
 pub const FLAG_SIMILARITY: u32 = 4;
 /// Irradiance kink cones (`irr.z`, `irr.w` hold their cos θ): the shaping's cone edge and
-/// smoothstep start, as `cpu::irradiance::Profile` lists them.
+/// smoothstep start, as `prepare::Profile` lists them.
 pub const FLAG_KINK_A: u32 = 8;
 pub const FLAG_KINK_B: u32 = 16;
 /// The plane ⊥ the axis (θ = 90°) is a kink of the shaping.
@@ -31,40 +32,13 @@ pub const FLAG_FOCUS_PLANE: u32 = 32;
 pub const FLAG_FOCUS_GRADED: u32 = 64;
 /// ShapingAPI makes the light dark everywhere (cone angle ≤ 0).
 pub const FLAG_DARK: u32 = 128;
-/// The shaping is not smooth at the axis directions (`Profile::axis_singular`).
+/// The shaping is not smooth at the axis directions (`prepare::Profile::axis_singular`).
 pub const FLAG_AXIS_SINGULAR: u32 = 256;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
 
-/// Irradiance kernel: Gauss–Legendre points of the elevation integral of a sphere cap cut by the
-/// horizon (`cap_sliver`).
-pub const IRR_GL_CAP: usize = 12;
-/// Irradiance kernel: Gauss–Legendre points per inner span.
-/// (The WGSL writes the inner rule's 10 nodes out: changing this needs `inner_rule` changed.)
-pub const IRR_GL_INNER: usize = 10;
-/// Irradiance kernel: each inner span is integrated adaptively: the rule on the span against the
-/// rule on its halves; halves whose difference exceeds `IRR_INNER_TOL` of their value are split
-/// again, at most `IRR_INNER_DEPTH` times (the order is chosen per light and receiver).
-pub const IRR_INNER_TOL: f64 = 1e-5;
-pub const IRR_INNER_DEPTH: usize = 6;
-/// Irradiance kernel: each outer span is integrated by the 7-point Gauss / 15-point Kronrod
-/// pair; a span whose Gauss and Kronrod values differ by more than `IRR_OUTER_TOL` of the
-/// Kronrod value is halved, at most `IRR_OUTER_DEPTH` times. (Kronrod's error is far below that
-/// difference, which measures Gauss's: the test `kernel_rule_in_f64_is_within_1e_5_of_the_reference`
-/// holds the whole rule to 1e-5.)
-pub const IRR_OUTER_TOL: f64 = 1e-3;
-pub const IRR_OUTER_DEPTH: usize = 5;
-/// Irradiance kernel: samples per elliptic arc when bracketing cone crossings.
-pub const IRR_ARC_SAMPLES: u32 = 24;
-/// Irradiance kernel: an unshaped rect uses Lambert's formula only where its edge terms cannot
-/// cancel much in f32: (d / smaller half-extent) · (d / height above its plane) ≤ this. The
-/// terms of a rect that is far, thin or seen near its plane cancel like each factor (measured on
-/// lavapipe: 1.8e-4 at 590, a 0.2 × 2 rect 5 m away at 5° above its plane); past it, the
-/// quadrature (all positive terms) is used.
-pub const IRR_LAMBERT_COND: f64 = 16.0;
-
-/// The `u32` constants shared with WGSL, by name.
+/// The record constants the WGSL prelude declares, by name.
 pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("KIND_DISTANT", KIND_DISTANT),
     ("KIND_SPHERE", KIND_SPHERE),
@@ -82,43 +56,12 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_DARK", FLAG_DARK),
     ("FLAG_AXIS_SINGULAR", FLAG_AXIS_SINGULAR),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
-    ("IRR_GL_CAP", IRR_GL_CAP as u32),
-    ("IRR_GL_INNER", IRR_GL_INNER as u32),
-    ("IRR_INNER_DEPTH", IRR_INNER_DEPTH as u32),
-    ("IRR_OUTER_DEPTH", IRR_OUTER_DEPTH as u32),
-    ("IRR_ARC_SAMPLES", IRR_ARC_SAMPLES),
 ];
 
-/// The `f32` constants shared with WGSL, by name.
-pub const WGSL_F32_CONSTANTS: &[(&str, f64)] = &[
-    ("IRR_LAMBERT_COND", IRR_LAMBERT_COND),
-    ("IRR_INNER_TOL", IRR_INNER_TOL),
-    ("IRR_OUTER_TOL", IRR_OUTER_TOL),
-    ("IRR_TAN_MAP_RHO", crate::cpu::irradiance::TAN_MAP_RHO),
-    ("IRR_MAX_U_SPAN", crate::cpu::irradiance::MAX_U_SPAN),
-];
-
-/// The `f32` arrays shared with WGSL (emitted as module-scope `var<private>` so that they can be
-/// indexed at run time): the irradiance kernel's Gauss–Legendre rules on [0, 1].
-pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
-    let (xo, wo) = crate::cpu::quadrature::gauss_legendre(IRR_GL_CAP);
-    let (xi, wi) = crate::cpu::quadrature::gauss_legendre(IRR_GL_INNER);
-    let gk = crate::cpu::quadrature::gk15_unit();
-    vec![
-        ("IRR_GL_CAP_X", xo),
-        ("IRR_GL_CAP_W", wo),
-        ("IRR_GL_INNER_X", xi),
-        ("IRR_GL_INNER_W", wi),
-        ("IRR_GK_X", gk.0),
-        ("IRR_GK_WK", gk.1),
-        ("IRR_GK_WG", gk.2),
-    ]
-}
-
-/// One light as the kernels read it (see `shaders/shared/light.wgsl` for each field).
+/// One light as the kernels read it (see `shaders/shared/record.wgsl` for each field).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct LightRecord {
+pub struct Record {
     pub to_local: [[f32; 4]; 3],
     pub axis: [f32; 4],
     pub normal: [f32; 4],
@@ -135,7 +78,7 @@ pub struct LightRecord {
     pub pad: [u32; 2],
 }
 
-/// The kernel-side parameters of one dispatch (`Params` in `shaders/shared/light.wgsl`).
+/// The kernel-side parameters of one dispatch (`Params` in `shaders/shared/record.wgsl`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Params {
@@ -153,12 +96,12 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 }
 
 /// Rounds a prepared light's f64 constants to its GPU record.
-pub fn pack(p: &PreparedLight) -> LightRecord {
+pub fn pack(p: &Prepared) -> Record {
     let m = p.to_local;
     // Local = M⁻¹·(x − o): row i is (row_i(M⁻¹), −row_i(M⁻¹)·o).
     let row = |i: usize| v4(m.row(i), -m.row(i).dot(p.origin));
-    let lin = p.light.linear();
-    let mut r = LightRecord {
+    let lin = p.linear;
+    let mut r = Record {
         to_local: [row(0), row(1), row(2)],
         axis: v4(p.axis, 0.0),
         normal: v4(p.normal, 0.0),
@@ -168,19 +111,14 @@ pub fn pack(p: &PreparedLight) -> LightRecord {
             v4(lin.y_axis, p.origin.y),
             v4(lin.z_axis, p.origin.z),
         ],
-        irr: [
-            p.light.inputs.diffuse as f32,
-            lin.determinant().abs() as f32,
-            0.0,
-            0.0,
-        ],
-        ..LightRecord::default()
+        irr: [p.light.inputs.diffuse as f32, p.det as f32, 0.0, 0.0],
+        ..Record::default()
     };
-    if irradiance::similarity_scale(lin).is_some() {
+    if p.similarity.is_some() {
         r.flags |= FLAG_SIMILARITY;
     }
     // The shaping's kinks exactly as the CPU quadrature lists them.
-    let profile = irradiance::Profile::new(p.light.shaping.as_ref(), p.axis);
+    let profile = &p.profile;
     if profile.dark {
         r.flags |= FLAG_DARK;
     }
@@ -190,12 +128,12 @@ pub fn pack(p: &PreparedLight) -> LightRecord {
     let mut cones = 0;
     for k in &profile.kinks {
         match *k {
-            irradiance::Kink::Cone { cos } => {
+            Kink::Cone { cos } => {
                 r.irr[2 + cones] = cos as f32;
                 r.flags |= if cones == 0 { FLAG_KINK_A } else { FLAG_KINK_B };
                 cones += 1;
             }
-            irradiance::Kink::Plane { graded, .. } => {
+            Kink::Plane { graded, .. } => {
                 r.flags |= FLAG_FOCUS_PLANE;
                 if graded {
                     r.flags |= FLAG_FOCUS_GRADED;
@@ -203,16 +141,14 @@ pub fn pack(p: &PreparedLight) -> LightRecord {
             }
         }
     }
-    if let Some(s) = &p.light.shaping {
+    if let Some(s) = &p.shaping {
         r.flags |= FLAG_SHAPING;
         r.focus_tint = v4(s.focus_tint, s.focus);
-        let cone = s.cone_angle.to_radians();
-        let start = (1.0 - s.cone_softness.clamp(0.0, 1.0)) * cone;
-        r.cone = [cone as f32, start as f32, 0.0, 0.0];
+        r.cone = [s.cone as f32, s.start as f32, 0.0, 0.0];
     }
     let (kind, size) = match p.light.kind {
-        LightType::Distant { angle } => {
-            r.axis[3] = crate::cpu::normalize::distant_half_angle(angle) as f32;
+        LightType::Distant { .. } => {
+            r.axis[3] = p.distant_half_angle as f32;
             (KIND_DISTANT, [0.0; 4])
         }
         LightType::Sphere {

@@ -38,6 +38,11 @@ impl TemperatureMode {
         }
     }
 
+    /// The RGB multiplier of `kelvin` in this mode (T clamped to [`Self::valid_range`]).
+    pub fn rgb(self, kelvin: f64) -> DVec3 {
+        temperature_rgb(kelvin, self)
+    }
+
     /// The temperature range the mode clamps to, in kelvin.
     pub fn valid_range(self) -> (f64, f64) {
         match self {

@@ -1,0 +1,211 @@
+// The inner (line) integrals of the chart quadrature. Twin of src/cpu/irradiance/line.rs,
+// which carries the derivations.
+//
+// f32: the kernel's inner rule: per span IRR_GL_INNER-point Gauss–Legendre, halved while the
+//   halves and their parent differ by more than IRR_INNER_TOL (relative; the integrand is ≥ 0),
+//   at most IRR_INNER_DEPTH times, depth first, instead of the reference's globally adaptive
+//   Gauss–Kronrod; tan-mapped pieces are cut into spans of at most IRR_MAX_U_SPAN radians. Its
+//   f64 replay is testkit::kernel_rule.
+// f32: an unshaped line piece takes the closed form only where it is tan-mapped (there its terms
+//   cannot cancel), else the inner rule (the CPU: the closed form everywhere).
+// f32: at most MAX_BPS breakpoints per line.
+// GPU-only inner_node, inner_rule, max3, inner_adaptive: the kernel's inner rule (above).
+
+// #import shared/record.wgsl
+// #import shared/shaping.wgsl
+// #import shared/roots.wgsl
+// #import irradiance/pieces.wgsl
+
+const MAX_BPS: u32 = 10u;
+
+// Node k of the inner Gauss–Legendre rule on [s0, s0 + h] of one span's parameter.
+fn inner_node(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap, s0: f32, h: f32, k: u32) -> vec3<f32> {
+    let xd = map_eval(sp, s0 + h * IRR_GL_INNER_X[k], false);
+    let w = a + e1 * xd.x;
+    let nw = dot(n, w);
+    if nw > 0.0 && xd.y != 0.0 {
+        let l2 = dot(w, w);
+        let e = -w / sqrt(l2);
+        return shaping(light, e) * (IRR_GL_INNER_W[k] * h * nw / (l2 * l2) * xd.y);
+    }
+    return vec3<f32>(0.0);
+}
+
+// The inner rule on [s0, s1], its IRR_GL_INNER = 10 nodes written out rather than looped:
+// llvmpipe stops a shader invocation's loops after 65535 iterations in total (see
+// GpuContext::lights_per_dispatch), and this is the innermost, most repeated loop.
+fn inner_rule(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap, s0: f32, s1: f32) -> vec3<f32> {
+    let h = s1 - s0;
+    return inner_node(light, n, a, e1, sp, s0, h, 0u) + inner_node(light, n, a, e1, sp, s0, h, 1u)
+        + inner_node(light, n, a, e1, sp, s0, h, 2u) + inner_node(light, n, a, e1, sp, s0, h, 3u)
+        + inner_node(light, n, a, e1, sp, s0, h, 4u) + inner_node(light, n, a, e1, sp, s0, h, 5u)
+        + inner_node(light, n, a, e1, sp, s0, h, 6u) + inner_node(light, n, a, e1, sp, s0, h, 7u)
+        + inner_node(light, n, a, e1, sp, s0, h, 8u) + inner_node(light, n, a, e1, sp, s0, h, 9u);
+}
+
+fn max3(v: vec3<f32>) -> f32 {
+    return max(max(v.x, v.y), v.z);
+}
+
+// One span by halving until the halves agree with their parent to IRR_INNER_TOL (relative; the
+// integrand is ≥ 0) or IRR_INNER_DEPTH is reached, depth first (the CPU twin: Nodes::integrate
+// in src/cpu/irradiance.rs). A depth-first stack never holds more than depth + 1 entries.
+fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap) -> vec3<f32> {
+    var lo: array<f32, IRR_INNER_DEPTH + 1u>;
+    var hi: array<f32, IRR_INNER_DEPTH + 1u>;
+    var q: array<vec3<f32>, IRR_INNER_DEPTH + 1u>;
+    var dep: array<u32, IRR_INNER_DEPTH + 1u>;
+    lo[0] = 0.0;
+    hi[0] = 1.0;
+    q[0] = inner_rule(light, n, a, e1, sp, 0.0, 1.0);
+    dep[0] = 0u;
+    var top = 1u;
+    var sum = vec3<f32>(0.0);
+    while top > 0u {
+        top -= 1u;
+        let s0 = lo[top];
+        let s1 = hi[top];
+        let parent = q[top];
+        let d = dep[top];
+        let mid = 0.5 * (s0 + s1);
+        let ql = inner_rule(light, n, a, e1, sp, s0, mid);
+        let qr = inner_rule(light, n, a, e1, sp, mid, s1);
+        let fine = ql + qr;
+        if d + 1u >= IRR_INNER_DEPTH || max3(abs(fine - parent)) <= IRR_INNER_TOL * max3(abs(fine)) {
+            sum += fine;
+        } else {
+            lo[top] = mid;
+            hi[top] = s1;
+            q[top] = qr;
+            dep[top] = d + 1u;
+            lo[top + 1u] = s0;
+            hi[top + 1u] = mid;
+            q[top + 1u] = ql;
+            dep[top + 1u] = d + 1u;
+            top += 2u;
+        }
+    }
+    return sum;
+}
+
+// ∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX along w = a + X e1, X ∈ [x0, x1].
+fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f32, x1: f32) -> vec3<f32> {
+    let na = dot(n, a);
+    let ne = dot(n, e1);
+    var lo = x0;
+    var hi = x1;
+    if ne > 0.0 {
+        lo = max(lo, -na / ne);
+    } else if ne < 0.0 {
+        hi = min(hi, -na / ne);
+    } else if !(na > 0.0) {
+        return vec3<f32>(0.0);
+    }
+    if !(hi > lo) {
+        return vec3<f32>(0.0);
+    }
+    // Breakpoints (value, graded) inside [lo, hi].
+    var bp: array<f32, MAX_BPS>;
+    var graded: array<u32, MAX_BPS>;
+    bp[0] = lo;
+    graded[0] = 0u;
+    bp[1] = hi;
+    graded[1] = 0u;
+    var count = 2u;
+    let axis = light.axis.xyz;
+    for (var ci = 0u; ci < kink_count(light); ci++) {
+        let r = cone_roots_on_line(axis, kink_cos(light, ci), a, e1);
+        let mask = u32(r.z);
+        if (mask & 1u) != 0u && r.x > lo && r.x < hi {
+            bp[count] = r.x;
+            graded[count] = 0u;
+            count += 1u;
+        }
+        if (mask & 2u) != 0u && r.y > lo && r.y < hi {
+            bp[count] = r.y;
+            graded[count] = 0u;
+            count += 1u;
+        }
+    }
+    if has_flag(light, FLAG_FOCUS_PLANE) {
+        let den = dot(axis, e1);
+        if den != 0.0 {
+            let xf = -dot(axis, a) / den;
+            if xf > lo && xf < hi {
+                bp[count] = xf;
+                graded[count] = select(0u, 1u, has_flag(light, FLAG_FOCUS_GRADED));
+                count += 1u;
+            }
+        }
+    }
+    if has_flag(light, FLAG_AXIS_SINGULAR) {
+        let xa = axis_approach(axis, a, e1);
+        if xa.y > 0.0 && xa.x > lo && xa.x < hi {
+            bp[count] = xa.x;
+            graded[count] = 0u;
+            count += 1u;
+        }
+    }
+    for (var i = 1u; i < count; i++) {
+        let v = bp[i];
+        let g = graded[i];
+        var j = i;
+        while j > 0u && bp[j - 1u] > v {
+            bp[j] = bp[j - 1u];
+            graded[j] = graded[j - 1u];
+            j -= 1u;
+        }
+        bp[j] = v;
+        graded[j] = g;
+    }
+    // The line's closest approach to x: X* and the width √m/|e1|, m = |a × e1|²/|e1|².
+    let e12 = dot(e1, e1);
+    let x_star = -dot(a, e1) / e12;
+    let perp = a + e1 * x_star;
+    let cr = length(cross(a, e1));
+    let width = cr / e12;
+    let m = cr * cr / e12;
+    let unshaped = !has_flag(light, FLAG_SHAPING);
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i + 1u < count; i++) {
+        let t0 = bp[i];
+        let t1 = bp[i + 1u];
+        if !(t1 > t0) {
+            continue;
+        }
+        let pm = piece_map(t0, t1, x_star, width, false, false);
+        if unshaped && pm.tan_map && m > 0.0 {
+            // (n·w)/|w|⁴ dX = (width/m²)(n·perp cos²u + width n·e1 sin u cos u) du.
+            let np = dot(n, perp);
+            let nw = ne * width;
+            let p1 = np * (0.5 * pm.u1 + 0.25 * sin(2.0 * pm.u1)) + nw * 0.5 * sin(pm.u1) * sin(pm.u1);
+            let p0 = np * (0.5 * pm.u0 + 0.25 * sin(2.0 * pm.u0)) + nw * 0.5 * sin(pm.u0) * sin(pm.u0);
+            sum += vec3<f32>(max(width / (m * m) * (p1 - p0), 0.0));
+            continue;
+        }
+        // Grade only the quarter next to a graded end (see graded_parts in the CPU twin).
+        let g0 = graded[i] != 0u;
+        let g1 = graded[i + 1u] != 0u;
+        let q = 0.25 * (t1 - t0);
+        var cuts = array<f32, 4>(t0, t0, t1, t1);
+        if g0 {
+            cuts[1] = t0 + q;
+        }
+        if g1 {
+            cuts[2] = t1 - q;
+        }
+        for (var part = 0u; part < 3u; part++) {
+            let p0 = cuts[part];
+            let p1 = cuts[part + 1u];
+            if !(p1 > p0) {
+                continue;
+            }
+            let pp = piece_map(p0, p1, x_star, width, part == 0u && g0, part == 2u && g1);
+            let spans = span_count(pp);
+            for (var j = 0u; j < spans; j++) {
+                sum += inner_adaptive(light, n, a, e1, span(pp, j, spans));
+            }
+        }
+    }
+    return sum;
+}

@@ -1,0 +1,124 @@
+//! Arguments shared by several commands, and their parsers.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use luxeval::{Accumulate, TemperatureMode};
+
+/// The stage, light selection, time and colour-temperature mode every scene command takes.
+#[derive(Args)]
+pub struct SceneArgs {
+    /// The stage: .usda, .usdc or .usdz.
+    pub scene: PathBuf,
+    /// Evaluate only this light (prim path); repeatable. Default: every visible light that luxeval
+    /// evaluates, in stage order.
+    #[arg(long = "light", value_name = "PATH")]
+    pub lights: Vec<String>,
+    #[command(flatten)]
+    pub time: TimeArg,
+    /// How colorTemperature becomes RGB: spec (6500 K is white), usd (Pixar's
+    /// UsdLux.BlackbodyTemperatureAsRgb), planckian (the OpenUSD reference renderer's path).
+    #[arg(long, value_enum, default_value_t = ModeArg::Spec)]
+    pub temperature_mode: ModeArg,
+}
+
+/// Options shared by the array queries.
+#[derive(Args)]
+pub struct QueryArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// One result per light, shape (L, N, 3), in the order `luxeval lights` lists them, instead of
+    /// the sum over lights.
+    #[arg(long)]
+    pub per_light: bool,
+    /// Where to evaluate. Default: the GPU, falling back to the CPU reference with a warning when
+    /// no adapter exists.
+    #[arg(long, value_enum)]
+    pub device: Option<DeviceArg>,
+}
+
+impl QueryArgs {
+    pub fn accumulate(&self) -> Accumulate {
+        if self.per_light {
+            Accumulate::PerLight
+        } else {
+            Accumulate::Sum
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct TimeArg {
+    /// USD time code to evaluate at. Default: the stage's startTimeCode when authored, else each
+    /// attribute's earliest time sample (USD's EarliestTime).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub time: Option<f64>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum DeviceArg {
+    Gpu,
+    Cpu,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ModeArg {
+    Spec,
+    Usd,
+    Planckian,
+}
+
+impl From<ModeArg> for TemperatureMode {
+    fn from(m: ModeArg) -> Self {
+        match m {
+            ModeArg::Spec => TemperatureMode::Spec,
+            ModeArg::Usd => TemperatureMode::Usd,
+            ModeArg::Planckian => TemperatureMode::Planckian,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ScaleArg {
+    Log,
+    Linear,
+}
+
+pub fn parse_vec3(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("expected three finite numbers X,Y,Z, got {s:?}")),
+    }
+}
+
+pub fn parse_res(s: &str) -> Result<(u32, u32), String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    match parts.as_slice() {
+        [w, h] => {
+            let w: u32 = w.trim().parse().map_err(|e| format!("width {w:?}: {e}"))?;
+            let h: u32 = h.trim().parse().map_err(|e| format!("height {h:?}: {e}"))?;
+            if w == 0 || h == 0 {
+                Err("width and height must be at least 1".into())
+            } else {
+                Ok((w, h))
+            }
+        }
+        _ => Err(format!("expected W,H, got {s:?}")),
+    }
+}
+
+pub fn parse_range(s: &str) -> Result<(f64, f64), String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().map_err(|e| format!("{x:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [lo, hi] if lo.is_finite() && hi.is_finite() && hi > lo => Ok((*lo, *hi)),
+        _ => Err(format!("expected LOW,HIGH with LOW < HIGH, got {s:?}")),
+    }
+}

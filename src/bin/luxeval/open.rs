@@ -1,0 +1,58 @@
+//! The one opening path of every scene command: load the stage, print its warnings, select and
+//! validate the lights, open the device, prepare the lights once.
+
+use luxeval::{Evaluator, Light, LuxError, PreparedScene, Scene};
+
+use crate::args::{DeviceArg, SceneArgs};
+use crate::exit::{CliResult, in_scene};
+
+/// The selected, visible, evaluable lights of the stage, validated (an invalid attribute is
+/// reported with the stage it comes from). Prints the stage's warnings.
+pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
+    let scene = Scene::load(&args.scene, args.time.time)?;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let lights = scene.evaluable(&args.lights)?;
+    for l in &lights {
+        l.validate().map_err(|e| in_scene(&args.scene, e))?;
+    }
+    Ok(lights)
+}
+
+/// The evaluator `device` asks for: the GPU (an error when there is none), the CPU, or by
+/// default the GPU with a fallback to the CPU reference and a warning.
+pub fn evaluator(device: Option<DeviceArg>, args: &SceneArgs) -> CliResult<Evaluator> {
+    let eval = match device {
+        Some(DeviceArg::Cpu) => Evaluator::cpu(),
+        Some(DeviceArg::Gpu) => Evaluator::gpu()?,
+        None => match Evaluator::gpu() {
+            Ok(e) => e,
+            Err(LuxError::NoAdapter { reason, .. }) => {
+                eprintln!("warning: no GPU adapter ({reason}); using the CPU reference");
+                Evaluator::cpu()
+            }
+            Err(e) => return Err(e.into()),
+        },
+    };
+    Ok(eval.with_temperature_mode(args.temperature_mode.into()))
+}
+
+/// Loads, selects and prepares the lights on the chosen device.
+pub fn prepare(
+    args: &SceneArgs,
+    device: Option<DeviceArg>,
+) -> CliResult<(Evaluator, PreparedScene)> {
+    let lights = lights(args)?;
+    if lights.is_empty() {
+        eprintln!(
+            "warning: {}: no light to evaluate; the output is all zeros",
+            args.scene.display()
+        );
+    }
+    let eval = evaluator(device, args)?;
+    let scene = eval
+        .prepare(&lights)
+        .map_err(|e| in_scene(&args.scene, e))?;
+    Ok((eval, scene))
+}

@@ -1,0 +1,226 @@
+//! The outer breakpoints of the chart quadrature (f64). Twin of
+//! `shaders/irradiance/critical.wgsl`.
+//!
+//! The integral over the chart is taken over lines Y = const (planes through x containing E1);
+//! the outer integrand is smooth in Y except where the inner structure of a line changes. The
+//! outer integral is split at every such Y:
+//! - the region's ends (square edges; disk and cylinder ends, where the X-interval closes like a
+//!   square root);
+//! - the horizon (and the focus plane) crossing the region boundary, each other, and the kink
+//!   cones;
+//! - the kink cones (cone edge, smoothstep start) tangent to a line of the pencil (closed form: a
+//!   plane through x containing E1 tangent to a circular cone), crossing the region boundary
+//!   (quadratic for straight edges; for elliptic boundaries the degree-2 trigonometric equation
+//!   is solved by bracketing and bisection);
+//! - where the outer integrand peaks: a curve bounding the inner intervals (a region edge, a
+//!   cone edge, the focus line) comes nearest to x;
+//! - the line through the axis directions where the shaping is singular there.
+//!
+//! A split placed slightly off (bisection precision) leaves an error of second order in the
+//! offset.
+
+use glam::DVec3;
+use std::f64::consts::PI;
+
+use super::chart::{Arc, Chart, Region, arc_at};
+use crate::cpu::roots::{
+    bracket_roots, cone_roots_on_line, lin_trig_roots, plane_cone_dirs, wrap_into,
+};
+use crate::prepare::{Kink, Prepared};
+
+/// Samples per arc when bracketing the roots of a degree-2 trigonometric polynomial (the
+/// kernel uses `rules::IRR_ARC_SAMPLES`, fewer, for speed).
+const ARC_SAMPLES: usize = 64;
+
+/// Keeps `y` when it lies in the chart's Y-range.
+fn push_y(ys: &mut Vec<f64>, y: f64, chart: &Chart) {
+    let (ya, yb) = chart.y_range();
+    if y.is_finite() && y >= ya && y <= yb {
+        ys.push(y);
+    }
+}
+
+/// Keeps the chart Y of the direction `w`, when the ray reaches the chart plane.
+fn push_dir(ys: &mut Vec<f64>, w: DVec3, chart: &Chart) {
+    if let Some(y) = chart.chart_y(w) {
+        push_y(ys, y, chart);
+    }
+}
+
+/// Crossings of the cone −ŵ·axis = cos with an elliptic arc (correct nappe).
+fn arc_cone_crossings(ys: &mut Vec<f64>, chart: &Chart, arc: &Arc, axis: DVec3, cos: f64) {
+    let f = |t: f64| arc_f(arc, axis, cos, t);
+    for t in bracket_roots(&f, arc.t0, arc.t1, ARC_SAMPLES) {
+        let w = arc_at(arc, t);
+        if -w.dot(axis) * cos > 0.0 {
+            push_dir(ys, w, chart);
+        }
+    }
+}
+
+/// The local minima of |w(t)|² on the arc: its points nearest to x.
+fn arc_nearest(ys: &mut Vec<f64>, chart: &Chart, arc: &Arc) {
+    let d = |t: f64| arc_d(arc, t);
+    for t in bracket_roots(&d, arc.t0, arc.t1, ARC_SAMPLES) {
+        if d(t).1 > 0.0 {
+            push_dir(ys, arc_at(arc, t), chart);
+        }
+    }
+}
+
+/// ½ d|w|²/dt on the arc, and its derivative.
+fn arc_d(arc: &Arc, t: f64) -> (f64, f64) {
+    let w = arc_at(arc, t);
+    let dw = arc.v * t.cos() - arc.u * t.sin();
+    let ddw = -arc.u * t.cos() - arc.v * t.sin();
+    (w.dot(dw), dw.length_squared() + w.dot(ddw))
+}
+
+/// F(t) = (w·a)² − cos²|w|² on the arc (degree 2 in (cos t, sin t)), and F'(t).
+fn arc_f(arc: &Arc, axis: DVec3, cos: f64, t: f64) -> (f64, f64) {
+    let w = arc_at(arc, t);
+    let dw = arc.v * t.cos() - arc.u * t.sin();
+    let wa = w.dot(axis);
+    (
+        wa * wa - cos * cos * w.length_squared(),
+        2.0 * wa * dw.dot(axis) - 2.0 * cos * cos * w.dot(dw),
+    )
+}
+
+/// The Y values where the inner structure of the chart integral changes (see the module docs),
+/// sorted, within and including the region's Y-range.
+pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
+    let prof = &p.profile;
+    let axis = p.axis;
+    let (ya, yb) = chart.y_range();
+    let mut ys = vec![ya, yb];
+    let mut planes: Vec<DVec3> = vec![n];
+    let mut cones: Vec<f64> = Vec::new();
+    for k in &prof.kinks {
+        match *k {
+            Kink::Cone { cos } => cones.push(cos),
+            Kink::Plane { m, .. } => planes.push(m),
+        }
+    }
+    let (w0, e1, e2) = (chart.w0, chart.e1, chart.e2);
+    // Straight region edges X = const (the square's sides), and elliptic arcs.
+    let segs: Vec<f64> = match &chart.region {
+        Region::Square => vec![-1.0, 1.0],
+        _ => vec![],
+    };
+    let arcs: Vec<Arc> = match &chart.region {
+        Region::Square => vec![],
+        Region::Disk => vec![Arc {
+            c: w0,
+            u: e1,
+            v: e2,
+            t0: 0.0,
+            t1: 2.0 * PI,
+        }],
+        Region::Cylinder(c) => c.arcs.to_vec(),
+    };
+    for &m in &planes {
+        let (me1, me2, mw0) = (m.dot(e1), m.dot(e2), m.dot(w0));
+        if me1.abs() <= 1e-12 * m.length() * e1.length() && me2 != 0.0 {
+            // A plane of the pencil: one line Y = const lies in it.
+            push_y(&mut ys, -mw0 / me2, chart);
+        }
+        if me2 != 0.0 {
+            for &xs in &segs {
+                push_y(&mut ys, -(mw0 + xs * me1) / me2, chart);
+            }
+        }
+        for arc in &arcs {
+            for t in lin_trig_roots(m.dot(arc.u), m.dot(arc.v), -m.dot(arc.c)) {
+                let t = wrap_into(t, arc.t0);
+                if t <= arc.t1 {
+                    push_dir(&mut ys, arc_at(arc, t), chart);
+                }
+            }
+        }
+        // Plane ∩ plane: the line through x along m × m'.
+        for &m2 in &planes {
+            let d = m.cross(m2);
+            if d.length_squared() > 0.0 {
+                push_dir(&mut ys, d, chart);
+                push_dir(&mut ys, -d, chart);
+            }
+        }
+        // Plane ∩ kink cones.
+        for &c in &cones {
+            for w in plane_cone_dirs(m, axis, c) {
+                push_dir(&mut ys, w, chart);
+            }
+        }
+    }
+    for &c in &cones {
+        // Planes of the pencil (through x, containing e1) tangent to the cone: unit normals
+        // m ⊥ e1 with |m·axis| = sin θ.
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        let (m1, m2) = e1.normalize().any_orthonormal_pair();
+        let (pa, pb) = (m1.dot(axis), m2.dot(axis));
+        let ra = pa.hypot(pb);
+        if ra >= s && ra > 0.0 {
+            let t0 = pb.atan2(pa);
+            let d = (s / ra).clamp(-1.0, 1.0).acos();
+            for t in [t0 + d, t0 - d] {
+                let mm = m1 * t.cos() + m2 * t.sin();
+                let me2 = mm.dot(e2);
+                if me2 != 0.0 {
+                    push_y(&mut ys, -mm.dot(w0) / me2, chart);
+                }
+            }
+        }
+        // Cone ∩ straight edges X = xs: quadratic in Y.
+        for &xs in &segs {
+            for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
+                push_y(&mut ys, y, chart);
+            }
+        }
+        // Cone ∩ elliptic arcs.
+        for arc in &arcs {
+            arc_cone_crossings(&mut ys, chart, arc, axis, c);
+        }
+    }
+    // The outer integrand peaks where a curve bounding the inner intervals (a region edge, a
+    // cone edge, the focus line) comes nearest to x: split there too.
+    for &xs in &segs {
+        push_y(&mut ys, -(w0 + e1 * xs).dot(e2) / e2.length_squared(), chart);
+    }
+    for arc in &arcs {
+        arc_nearest(&mut ys, chart, arc);
+    }
+    let nrm = e1.cross(e2).normalize() * w0.dot(e1.cross(e2)).signum();
+    for &c in &cones {
+        // The cone's generator nearest to the chart plane's normal: the nearest point of the
+        // cone-edge curve.
+        let q = -axis;
+        let perp = nrm - q * nrm.dot(q);
+        if perp.length_squared() > 0.0 {
+            push_dir(
+                &mut ys,
+                q * c + perp.normalize() * (1.0 - c * c).max(0.0).sqrt(),
+                chart,
+            );
+        }
+    }
+    for &m in planes.iter().skip(1) {
+        // The nearest point of the plane's line in the chart plane.
+        let mu = m.normalize();
+        let perp = nrm - mu * nrm.dot(mu);
+        if perp.length_squared() > 0.0 {
+            push_dir(&mut ys, perp, chart);
+        }
+    }
+    if prof.axis_singular {
+        // The line of the pencil through the axis directions.
+        let m = e1.cross(axis);
+        if m.dot(e2) != 0.0 {
+            push_y(&mut ys, -m.dot(w0) / m.dot(e2), chart);
+        }
+    }
+    ys.sort_by(f64::total_cmp);
+    let span = yb - ya;
+    ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+    ys
+}

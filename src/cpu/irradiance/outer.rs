@@ -1,0 +1,107 @@
+//! The outer (across lines) integral of the chart quadrature, and `treatAsLine` (f64). Twin of
+//! `shaders/irradiance/outer.wgsl`.
+//!
+//! The chart's Y-range is split at the critical Ys (`critical`); each piece is mapped by the
+//! cosine substitution (square-root ends become smooth) after a tan map around the foot of x
+//! when x is close to the chart plane (`pieces`), and integrated by the rule's outer integral of
+//! the line integrals (`line`).
+//!
+//! `treatAsLine` is one inner line: the segment along the axis, whose intensity along e is
+//! `L(e)·2·length·r·|det M|·|(M⁻¹e)_yz|` (DESIGN.md §2 "Edge cases"), which gives the weight
+//! `2 r |det M| ρ` (ρ = distance of x from the axis in light space) for the same integrand.
+
+use glam::DVec3;
+
+use super::chart::Chart;
+use super::line::line_integral;
+use super::pieces::{map_eval, piece_map, span, span_count};
+use super::{Ctx, Rule};
+use crate::prepare::Prepared;
+
+/// The nearest singularity `y_foot ± i·width` of the outer integrand on the piece [y0, y1].
+///
+/// Along a line Y, min over X of |w|² is |(w0 + Y e2) × e1|²/|e1|² = |U + Y V|²/|e1|²
+/// (U = w0 × e1, V = e2 × e1) = H² + |V|²(Y − y_foot)²/|e1|², H = jac/|V| the distance from x to
+/// the chart plane: a Lorentzian of width H|e1|/|V| when the foot of x lies inside the region.
+/// When it lies a chart distance D outside the region's X-interval, the line's integrand never
+/// reaches that minimum and the peak widens to √(H² + D²|e1|²)·|e1|/|V|.
+fn outer_pole(chart: &Chart, y0: f64, y1: f64) -> (f64, f64) {
+    let u = chart.w0.cross(chart.e1);
+    let v = chart.e2.cross(chart.e1);
+    let vv = v.length_squared();
+    let y_foot = -u.dot(v) / vv;
+    let e1l = chart.e1.length();
+    let h = chart.jac / vv.sqrt();
+    let x_foot = -(chart.w0 + chart.e2 * y_foot).dot(chart.e1) / (e1l * e1l);
+    let d = match chart.x_interval(y_foot.clamp(y0, y1)) {
+        Some((x0, x1)) => (x0 - x_foot).max(x_foot - x1).max(0.0),
+        None => 0.0,
+    };
+    (y_foot, (h * h + (d * e1l).powi(2)).sqrt() * e1l / vv.sqrt())
+}
+
+/// `∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY` over the chart's region, split at `ys` (the critical
+/// Ys of `critical::critical_ys`, which include the ends of the region's Y-range).
+pub fn chart_integral<R: Rule>(p: &Prepared, chart: &Chart, n: DVec3, ys: &[f64], rule: &R) -> DVec3 {
+    if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
+        return DVec3::ZERO;
+    }
+    let ctx = Ctx {
+        p,
+        n,
+        unshaped: p.shaping.is_none(),
+        rule,
+    };
+    let mut total = DVec3::ZERO;
+    for w in ys.windows(2) {
+        let (y_foot, width) = outer_pole(chart, w[0], w[1]);
+        let map = piece_map(w[0], w[1], y_foot, width, false, false);
+        let k = span_count(&map, rule.max_u_span());
+        for j in 0..k {
+            let piece = span(&map, j, k);
+            total += rule.outer(&mut |s: f64| {
+                let (y, dy) = map_eval(&piece, s, true);
+                if dy == 0.0 {
+                    return DVec3::ZERO;
+                }
+                match chart.x_interval(y) {
+                    Some((x0, x1)) => {
+                        line_integral(&ctx, chart.w0 + chart.e2 * y, chart.e1, x0, x1)
+                            * (dy * chart.jac)
+                    }
+                    None => DVec3::ZERO,
+                }
+            });
+        }
+    }
+    total
+}
+
+/// treatAsLine: the segment along the light's X axis (DESIGN.md §2), see the module docs.
+pub fn line_irradiance<R: Rule>(
+    p: &Prepared,
+    x: DVec3,
+    n: DVec3,
+    hl: f64,
+    r: f64,
+    rule: &R,
+) -> DVec3 {
+    let m = p.linear;
+    let xl = p.to_local * (x - p.origin);
+    let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+    let weight = 2.0 * r * p.det * rho;
+    if !(weight > 0.0) || !(hl > 0.0) {
+        return DVec3::ZERO;
+    }
+    if p.profile.dark {
+        return DVec3::ZERO;
+    }
+    let ctx = Ctx {
+        p,
+        n,
+        unshaped: p.shaping.is_none(),
+        rule,
+    };
+    p.base * line_integral(&ctx, p.origin - x, m * DVec3::X, -hl, hl) * weight
+}
+

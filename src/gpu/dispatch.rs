@@ -1,0 +1,293 @@
+//! Running a kernel over a batch: the lights uploaded once per prepared scene ([`GpuLights`]),
+//! input/output/readback buffers kept between calls of the same size class ([`Scratch`]), and
+//! the batch cut into chunks that fit the device's binding and dispatch limits.
+
+use crate::error::{GpuFailure, LuxError, Result};
+
+use super::record::{Params, Record, WORKGROUP_SIZE};
+use super::{GpuContext, Kernel};
+
+/// A prepared scene's light records on the device.
+pub(crate) struct GpuLights {
+    buffer: wgpu::Buffer,
+    count: usize,
+}
+
+/// The buffers of one size class: a chunk capacity (a power of two, or the device's largest
+/// chunk), the rows per sample (lights with `per_light`, else 1), and the light groups of a
+/// kernel. A call of the same class reuses them.
+#[derive(Clone, Debug, PartialEq, Eq)]
+struct ScratchKey {
+    chunk: usize,
+    rows: usize,
+    groups: Vec<(usize, usize)>,
+    two_inputs: bool,
+}
+
+/// Reusable input, output, readback and parameter buffers with their bind group.
+pub(crate) struct Scratch {
+    key: ScratchKey,
+    buf_a: wgpu::Buffer,
+    buf_b: Option<wgpu::Buffer>,
+    buf_out: wgpu::Buffer,
+    staging: wgpu::Buffer,
+    params: wgpu::Buffer,
+    align: usize,
+    bind_group: wgpu::BindGroup,
+}
+
+impl GpuContext {
+    /// Uploads the records of a prepared scene (None when there are no lights).
+    pub fn upload(&self, records: &[Record]) -> Result<Option<GpuLights>> {
+        if records.is_empty() {
+            return Ok(None);
+        }
+        let bytes = std::mem::size_of_val(records) as u64;
+        if bytes > self.limits.max_storage_buffer_binding_size {
+            return Err(LuxError::input(
+                "lights",
+                format!(
+                    "{} lights need {bytes} bytes, over this device's storage binding limit of {} bytes; split the stage with --light",
+                    records.len(),
+                    self.limits.max_storage_buffer_binding_size
+                ),
+            ));
+        }
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lights"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.queue
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(records));
+        Ok(Some(GpuLights {
+            buffer,
+            count: records.len(),
+        }))
+    }
+
+    /// Runs `kernel` over `a` (and `b`) for every light: `count` rows summed over lights, or
+    /// `lights × count` rows in light-major order with `per_light`. `scratch` holds the buffers
+    /// of the last call and is replaced when this call needs another size class.
+    pub fn run(
+        &self,
+        kernel: Kernel,
+        lights: &GpuLights,
+        scratch: &mut Option<Scratch>,
+        a: &[[f32; 3]],
+        b: Option<&[[f32; 3]]>,
+        per_light: bool,
+    ) -> Result<Vec<[f32; 3]>> {
+        let n = a.len();
+        let count = lights.count;
+        let rows = if per_light { count } else { 1 };
+        let mut out = vec![[0f32; 3]; rows * n];
+        if n == 0 || count == 0 {
+            return Ok(out);
+        }
+        let pipeline = self.pipeline(kernel)?;
+        let capacity = self.chunk_capacity(count, per_light);
+        let per_group = self.lights_per_dispatch(kernel).max(1);
+        let key = ScratchKey {
+            chunk: n.next_power_of_two().min(capacity),
+            rows,
+            groups: (0..count)
+                .step_by(per_group)
+                .map(|g| (g, (g + per_group).min(count)))
+                .collect(),
+            two_inputs: b.is_some(),
+        };
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        if scratch.as_ref().is_none_or(|s| s.key != key) {
+            *scratch = Some(self.scratch(key, lights));
+        }
+        let s = scratch.as_ref().expect("set above");
+        let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, count, &mut out);
+        let oom = pollster::block_on(oom.pop());
+        let validation = pollster::block_on(validation.pop());
+        if let Some(e) = oom {
+            *scratch = None;
+            return Err(LuxError::gpu("out of memory", e));
+        }
+        if let Some(e) = validation {
+            *scratch = None;
+            return Err(LuxError::gpu(
+                format!("running {}", kernel.entry_point()),
+                e,
+            ));
+        }
+        result.map(|_| out)
+    }
+
+    fn scratch(&self, key: ScratchKey, lights: &GpuLights) -> Scratch {
+        let dev = &self.device;
+        let storage = |label, size: u64, extra: wgpu::BufferUsages| {
+            dev.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | extra,
+                mapped_at_creation: false,
+            })
+        };
+        let in_bytes = (key.chunk * 12) as u64;
+        let out_bytes = (key.chunk * key.rows * 12) as u64;
+        let buf_a = storage("in_a", in_bytes, wgpu::BufferUsages::COPY_DST);
+        let buf_b = key
+            .two_inputs
+            .then(|| storage("in_b", in_bytes, wgpu::BufferUsages::COPY_DST));
+        let buf_out = storage("out", out_bytes, wgpu::BufferUsages::COPY_SRC);
+        let staging = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: out_bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        // One Params block per light group at the uniform offset alignment.
+        let align = (self.limits.min_uniform_buffer_offset_alignment as usize)
+            .max(std::mem::size_of::<Params>());
+        let params = dev.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: (key.groups.len() * align) as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("luxeval queries"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                    }),
+                },
+                entry(1, &lights.buffer),
+                entry(2, &buf_a),
+                // Emission reads no second input; bind the first again (read-only aliasing).
+                entry(3, buf_b.as_ref().unwrap_or(&buf_a)),
+                entry(4, &buf_out),
+            ],
+        });
+        Scratch {
+            key,
+            buf_a,
+            buf_b,
+            buf_out,
+            staging,
+            params,
+            align,
+            bind_group,
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_chunks(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        kernel: Kernel,
+        s: &Scratch,
+        a: &[[f32; 3]],
+        b: Option<&[[f32; 3]]>,
+        per_light: bool,
+        lights: usize,
+        out: &mut [[f32; 3]],
+    ) -> Result<()> {
+        let n = a.len();
+        let rows = s.key.rows;
+        let groups = &s.key.groups;
+        let align = s.align;
+        let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
+        let mut block = vec![0u8; groups.len() * align];
+        let mut start = 0;
+        while start < n {
+            let count = s.key.chunk.min(n - start);
+            self.queue
+                .write_buffer(&s.buf_a, 0, bytemuck::cast_slice(&a[start..start + count]));
+            if let (Some(buf), Some(b)) = (&s.buf_b, b) {
+                self.queue
+                    .write_buffer(buf, 0, bytemuck::cast_slice(&b[start..start + count]));
+            }
+            let wg = (count as u32).div_ceil(WORKGROUP_SIZE);
+            let gx = wg.min(max_groups);
+            let gy = wg.div_ceil(gx);
+            for (g, &(first, end)) in groups.iter().enumerate() {
+                let params = Params {
+                    count: count as u32,
+                    light_first: first as u32,
+                    light_end: end as u32,
+                    per_light: per_light as u32,
+                    row_stride: gx * WORKGROUP_SIZE,
+                    accumulate: (g > 0) as u32,
+                    pad: [0; 2],
+                };
+                block[g * align..g * align + std::mem::size_of::<Params>()]
+                    .copy_from_slice(bytemuck::bytes_of(&params));
+            }
+            self.queue.write_buffer(&s.params, 0, &block);
+            let mut enc = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some(kernel.entry_point()),
+                });
+            for g in 0..groups.len() {
+                // A pass per group: passes are ordered, so a group reads the sums of the last.
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some(kernel.entry_point()),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &s.bind_group, &[(g * align) as u32]);
+                pass.dispatch_workgroups(gx, gy, 1);
+            }
+            let used = (count * rows * 12) as u64;
+            enc.copy_buffer_to_buffer(&s.buf_out, 0, &s.staging, 0, used);
+            self.queue.submit([enc.finish()]);
+
+            let data = self.read_back(&s.staging, used)?;
+            let values: &[[f32; 3]] = bytemuck::cast_slice(&data);
+            if per_light {
+                for l in 0..lights {
+                    out[l * n + start..l * n + start + count]
+                        .copy_from_slice(&values[l * count..(l + 1) * count]);
+                }
+            } else {
+                out[start..start + count].copy_from_slice(values);
+            }
+            start += count;
+        }
+        Ok(())
+    }
+
+    fn read_back(&self, staging: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+        let slice = staging.slice(..size);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| LuxError::gpu("waiting for the device", e))?;
+        rx.recv()
+            .map_err(|_| LuxError::gpu("reading the results back", GpuFailure::Lost))?
+            .map_err(|e| LuxError::gpu("mapping the result buffer", e))?;
+        let bytes = {
+            let view = slice
+                .get_mapped_range()
+                .map_err(|e| LuxError::gpu("reading the result buffer", e))?;
+            view.to_vec()
+        };
+        staging.unmap();
+        Ok(bytes)
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}

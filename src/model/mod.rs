@@ -1,0 +1,10 @@
+//! The light model: lights as plain data, independent of where they came from (a USD stage, or
+//! built in code), with the one table of UsdLux schema fallbacks and the resolved values of
+//! authored inputs. Depends on nothing else in the crate (DESIGN.md §1).
+
+pub mod light;
+pub mod schema;
+pub mod value;
+
+pub use light::{Light, LightInputs, LightType, Shaping};
+pub use value::{Input, Value};

@@ -1,0 +1,192 @@
+//! The queries of DESIGN.md §3 behind one front (DESIGN.md §1 "query"): an [`Evaluator`] picks
+//! the backend (the f64 CPU reference or a wgpu device) and prepares a set of lights once into a
+//! [`PreparedScene`], which answers any number of emission / radiance / irradiance calls and
+//! returns float32 RGB rows. [`Reference`] is the f64 reference of one light, sample by sample.
+
+mod reference;
+mod scene;
+
+use std::sync::Arc;
+
+use crate::error::{LuxError, Result};
+use crate::gpu::{AdapterSummary, DeviceLimits, GpuContext};
+use crate::model::Light;
+use crate::prepare::TemperatureMode;
+pub use reference::Reference;
+pub use scene::PreparedScene;
+
+/// Where queries run.
+#[derive(Clone, Debug)]
+pub(crate) enum Backend {
+    /// The f64 CPU reference (rayon-parallel), rounded to f32 on output.
+    Cpu,
+    /// A wgpu compute device.
+    Gpu(Arc<GpuContext>),
+}
+
+/// Sum the lights per sample, or keep one row per (light, sample).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Accumulate {
+    /// `N` rows: the sum over lights (lights do not occlude each other).
+    #[default]
+    Sum,
+    /// `L × N` rows, light-major: row `l·N + i` is light `l` at sample `i`.
+    PerLight,
+}
+
+/// Evaluates the queries on one backend with one set of options. Cloning is cheap (the device
+/// is shared).
+#[derive(Clone, Debug)]
+pub struct Evaluator {
+    backend: Backend,
+    temperature_mode: TemperatureMode,
+}
+
+impl Evaluator {
+    /// The CPU reference.
+    pub fn cpu() -> Self {
+        Evaluator {
+            backend: Backend::Cpu,
+            temperature_mode: TemperatureMode::default(),
+        }
+    }
+
+    /// A GPU evaluator on the adapter named by `LUXEVAL_ADAPTER` (a name substring), else the
+    /// default high-performance adapter. Pipelines are compiled when a query first needs them.
+    pub fn gpu() -> Result<Self> {
+        Ok(Evaluator {
+            backend: Backend::Gpu(Arc::new(GpuContext::new()?)),
+            temperature_mode: TemperatureMode::default(),
+        })
+    }
+
+    pub fn with_temperature_mode(mut self, mode: TemperatureMode) -> Self {
+        self.temperature_mode = mode;
+        self
+    }
+
+    pub fn temperature_mode(&self) -> TemperatureMode {
+        self.temperature_mode
+    }
+
+    pub(crate) fn backend(&self) -> &Backend {
+        &self.backend
+    }
+
+    /// Whether queries run on a GPU.
+    pub fn is_gpu(&self) -> bool {
+        matches!(self.backend, Backend::Gpu(_))
+    }
+
+    /// The GPU adapter, when queries run on one.
+    pub fn adapter(&self) -> Option<AdapterSummary> {
+        match &self.backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(g.adapter()),
+        }
+    }
+
+    /// The device limits that bound a batch, when queries run on a GPU.
+    pub fn device_limits(&self) -> Option<DeviceLimits> {
+        match &self.backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(g.device_limits()),
+        }
+    }
+
+    /// "cpu (f64 reference)" or the adapter's name and backend.
+    pub fn device_name(&self) -> String {
+        match &self.backend {
+            Backend::Cpu => "cpu (f64 reference)".into(),
+            Backend::Gpu(g) => format!("{} ({})", g.adapter().name, g.adapter().backend),
+        }
+    }
+
+    /// Validates the lights, computes their per-light constants once and, on a GPU, uploads
+    /// them: the prepared scene answers any number of queries.
+    pub fn prepare(&self, lights: &[Light]) -> Result<PreparedScene> {
+        PreparedScene::new(self.backend.clone(), lights, self.temperature_mode)
+    }
+
+    /// emission(light, ω) for every direction (DESIGN.md §3); prepares `lights` for this one
+    /// call (use [`Evaluator::prepare`] to query the same lights many times).
+    pub fn emission(
+        &self,
+        lights: &[Light],
+        dirs: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_directions("directions", dirs)?;
+        self.prepare(lights)?.emission(dirs, acc)
+    }
+
+    /// radiance(x, ω) for every (point, direction) pair (DESIGN.md §3).
+    pub fn radiance(
+        &self,
+        lights: &[Light],
+        points: &[[f32; 3]],
+        dirs: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_pairs(points, "points", dirs, "directions")?;
+        self.prepare(lights)?.radiance(points, dirs, acc)
+    }
+
+    /// irradiance(x, n) for every (point, receiver normal) pair (DESIGN.md §3): the
+    /// diffuse-weighted irradiance `diffuse · ∫ radiance(x, ω) max(0, n·ω) dω`.
+    pub fn irradiance(
+        &self,
+        lights: &[Light],
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_pairs(points, "points", normals, "normals")?;
+        self.prepare(lights)?.irradiance(points, normals, acc)
+    }
+}
+
+/// Every point must be finite.
+pub(crate) fn check_points(what: &str, points: &[[f32; 3]]) -> Result<()> {
+    if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(LuxError::input(
+            what,
+            format!("row {i} is not finite: {:?}", points[i]),
+        ));
+    }
+    Ok(())
+}
+
+/// Every direction must be finite and non-zero (it is normalised before use).
+pub(crate) fn check_directions(what: &str, dirs: &[[f32; 3]]) -> Result<()> {
+    check_points(what, dirs)?;
+    if let Some(i) = dirs.iter().position(|d| d.iter().all(|c| *c == 0.0)) {
+        return Err(LuxError::input(
+            what,
+            format!("row {i} is the zero vector, which has no direction"),
+        ));
+    }
+    Ok(())
+}
+
+/// Points and directions (or normals) that pair up row by row.
+pub(crate) fn check_pairs(
+    points: &[[f32; 3]],
+    what_points: &str,
+    dirs: &[[f32; 3]],
+    what_dirs: &str,
+) -> Result<()> {
+    check_points(what_points, points)?;
+    check_directions(what_dirs, dirs)?;
+    if points.len() != dirs.len() {
+        return Err(LuxError::input(
+            format!("{what_points}/{what_dirs}"),
+            format!(
+                "{} {what_points} but {} {what_dirs}; they pair up row by row",
+                points.len(),
+                dirs.len()
+            ),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,69 @@
+//! The f64 reference of one light, sample by sample: what the CPU path evaluates before it
+//! rounds to f32, for users who check a renderer against the spec and for tests.
+
+use glam::DVec3;
+
+use crate::cpu;
+use crate::error::Result;
+use crate::model::Light;
+use crate::prepare::{Prepared, TemperatureMode};
+
+/// One light, validated and prepared, evaluated in f64 on the CPU.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    pub(crate) p: Prepared,
+}
+
+impl Reference {
+    /// Validates `light` and computes its per-light constants for `mode`.
+    pub fn new(light: &Light, mode: TemperatureMode) -> Result<Self> {
+        Ok(Reference {
+            p: Prepared::new(light, mode)?,
+        })
+    }
+
+    /// The light as evaluated (a ShapingAPI whose factor is 1 everywhere is dropped).
+    pub fn light(&self) -> &Light {
+        &self.p.light
+    }
+
+    /// `intensity · 2^exposure · color ⊙ temperature(T) / sizeFactor`.
+    pub fn base_radiance(&self) -> DVec3 {
+        self.p.base
+    }
+
+    /// The sizeFactor the base radiance was divided by (1 when normalize is off).
+    pub fn size_factor(&self) -> f64 {
+        self.p.size_factor
+    }
+
+    /// The unit primary axis in world space (the image of local −Z).
+    pub fn axis(&self) -> DVec3 {
+        self.p.axis
+    }
+
+    /// The world-space origin.
+    pub fn origin(&self) -> DVec3 {
+        self.p.origin
+    }
+
+    /// emission along `e` (any non-zero length; normalised here).
+    pub fn emission(&self, e: DVec3) -> DVec3 {
+        cpu::emission::emission(&self.p, e.normalize())
+    }
+
+    /// radiance arriving at `x` from direction `w` (any non-zero length; normalised here).
+    pub fn radiance(&self, x: DVec3, w: DVec3) -> DVec3 {
+        cpu::radiance::radiance(&self.p, x, w.normalize())
+    }
+
+    /// irradiance at `x` on a receiver with normal `n` (any length; 0 for a zero normal),
+    /// `diffuse` applied.
+    pub fn irradiance(&self, x: DVec3, n: DVec3) -> DVec3 {
+        let len = n.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return DVec3::ZERO;
+        }
+        cpu::irradiance::irradiance(&self.p, x, n / len)
+    }
+}

@@ -1,0 +1,139 @@
+//! A set of lights prepared once, answering any number of queries.
+
+use std::sync::Mutex;
+
+use glam::DVec3;
+
+use super::{Accumulate, Backend, check_directions, check_pairs};
+use crate::cpu;
+use crate::error::Result;
+use crate::gpu::{GpuLights, Kernel, Scratch, record};
+use crate::model::Light;
+use crate::prepare::{self, Prepared, TemperatureMode};
+
+/// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
+/// uploaded and the input/output buffers of the last size class kept), answering emission,
+/// radiance and irradiance for any number of batches.
+pub struct PreparedScene {
+    backend: Backend,
+    lights: Vec<Prepared>,
+    gpu: Option<GpuLights>,
+    /// The buffers of the last GPU call, reused by the next call of the same size class.
+    scratch: Mutex<Option<Scratch>>,
+}
+
+impl std::fmt::Debug for PreparedScene {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PreparedScene")
+            .field("backend", &self.backend)
+            .field("lights", &self.lights.len())
+            .finish()
+    }
+}
+
+impl PreparedScene {
+    pub(crate) fn new(backend: Backend, lights: &[Light], mode: TemperatureMode) -> Result<Self> {
+        Self::from_prepared(backend, prepare::prepare(lights, mode)?)
+    }
+
+    /// A scene of lights already prepared (the GPU records are packed from exactly these
+    /// constants).
+    pub(crate) fn from_prepared(backend: Backend, lights: Vec<Prepared>) -> Result<Self> {
+        let gpu = match &backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => {
+                let records: Vec<record::Record> = lights.iter().map(record::pack).collect();
+                g.upload(&records)?
+            }
+        };
+        Ok(PreparedScene {
+            backend,
+            lights,
+            gpu,
+            scratch: Mutex::new(None),
+        })
+    }
+
+    /// The number of lights.
+    pub fn len(&self) -> usize {
+        self.lights.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.lights.is_empty()
+    }
+
+    /// The lights as evaluated, in order (a ShapingAPI whose factor is 1 everywhere is dropped).
+    pub fn lights(&self) -> impl Iterator<Item = &Light> {
+        self.lights.iter().map(|p| &p.light)
+    }
+
+    /// emission(light, ω) for every direction (DESIGN.md §3): ω points away from the light (for
+    /// a dome, toward the environment); any non-zero length, normalised here.
+    pub fn emission(&self, dirs: &[[f32; 3]], acc: Accumulate) -> Result<Vec<[f32; 3]>> {
+        check_directions("directions", dirs)?;
+        let per_light = acc == Accumulate::PerLight;
+        self.run(Kernel::Emission, dirs, None, per_light, || {
+            cpu::emission_batch(&self.lights, dirs, per_light)
+        })
+    }
+
+    /// radiance(x, ω) for every (point, direction) pair (DESIGN.md §3): ω points from x toward
+    /// the light.
+    pub fn radiance(
+        &self,
+        points: &[[f32; 3]],
+        dirs: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_pairs(points, "points", dirs, "directions")?;
+        let per_light = acc == Accumulate::PerLight;
+        self.run(Kernel::Radiance, points, Some(dirs), per_light, || {
+            cpu::radiance_batch(&self.lights, points, dirs, per_light)
+        })
+    }
+
+    /// irradiance(x, n) for every (point, receiver normal) pair (DESIGN.md §3): the
+    /// diffuse-weighted irradiance `diffuse · ∫ radiance(x, ω) max(0, n·ω) dω` on a one-sided
+    /// receiver, no occlusion.
+    pub fn irradiance(
+        &self,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_pairs(points, "points", normals, "normals")?;
+        let per_light = acc == Accumulate::PerLight;
+        self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
+            cpu::irradiance_batch(&self.lights, points, normals, per_light)
+        })
+    }
+
+    fn run(
+        &self,
+        kernel: Kernel,
+        a: &[[f32; 3]],
+        b: Option<&[[f32; 3]]>,
+        per_light: bool,
+        on_cpu: impl FnOnce() -> Vec<DVec3>,
+    ) -> Result<Vec<[f32; 3]>> {
+        match (&self.backend, &self.gpu) {
+            (Backend::Cpu, _) => Ok(on_cpu()
+                .into_iter()
+                .map(|c| c.as_vec3().to_array())
+                .collect()),
+            (Backend::Gpu(g), Some(lights)) => {
+                let mut scratch = self
+                    .scratch
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                g.run(kernel, lights, &mut scratch, a, b, per_light)
+            }
+            // No lights: every row is zero.
+            (Backend::Gpu(_), None) => {
+                let rows = if per_light { self.lights.len() } else { 1 };
+                Ok(vec![[0.0; 3]; rows * a.len()])
+            }
+        }
+    }
+}

@@ -1,0 +1,235 @@
+//! Quadrature rules and the tuning constants of the irradiance quadrature, shared by the WGSL
+//! kernel and its f64 counterparts (DESIGN.md §1: owned by neither backend).
+//!
+//! - [`gk15`]: the 7-point Gauss / 15-point Kronrod pair (QUADPACK `qk15` nodes and weights);
+//!   [`gk15_unit`] gives the same pair on [0, 1] as arrays for the WGSL prelude.
+//! - [`gauss_legendre`]: n-point Gauss–Legendre nodes and weights on [0, 1], computed in f64 by
+//!   Newton's method on Pₙ.
+//! - `IRR_*`, [`TAN_MAP_RHO`], [`MAX_U_SPAN`]: how the kernel's rule refines; the CPU reference
+//!   uses [`TAN_MAP_RHO`] too (the same piece maps), the rest only the kernel and its f64 replay
+//!   (`testkit`).
+//!
+//! Everything here reaches WGSL through the prelude that `gpu::shaders` generates from
+//! [`wgsl_u32_constants`], [`wgsl_f32_constants`] and [`wgsl_f32_arrays`]: no node or constant
+//! is retyped in a shader.
+
+// The nodes and weights are QUADPACK's published 33-digit values, kept verbatim.
+#![allow(clippy::excessive_precision)]
+
+use glam::DVec3;
+
+/// Kronrod nodes on [−1, 1] (the positive half; the last is the centre).
+const XGK: [f64; 8] = [
+    0.991_455_371_120_812_639_206_854_697_526_329,
+    0.949_107_912_342_758_524_526_189_684_047_851,
+    0.864_864_423_359_769_072_789_712_788_640_926,
+    0.741_531_185_599_394_439_863_864_773_280_788,
+    0.586_087_235_467_691_130_294_144_845_693_013,
+    0.405_845_151_377_397_166_906_606_412_076_961,
+    0.207_784_955_007_898_467_600_689_403_773_245,
+    0.0,
+];
+/// Kronrod weights for [`XGK`].
+const WGK: [f64; 8] = [
+    0.022_935_322_010_529_224_963_732_008_058_970,
+    0.063_092_092_629_978_553_290_700_663_189_204,
+    0.104_790_010_322_250_183_839_876_322_541_518,
+    0.140_653_259_715_525_918_745_189_590_510_238,
+    0.169_004_726_639_267_902_826_583_426_598_550,
+    0.190_350_578_064_785_409_913_256_402_421_014,
+    0.204_432_940_075_298_892_414_161_999_234_649,
+    0.209_482_141_084_727_828_012_999_174_891_714,
+];
+/// Gauss weights for the odd-indexed Kronrod nodes XGK[1], XGK[3], XGK[5], XGK[7].
+const WG: [f64; 4] = [
+    0.129_484_966_168_869_693_270_611_432_679_082,
+    0.279_705_391_489_276_667_901_467_771_423_780,
+    0.381_830_050_505_118_944_950_369_775_488_975,
+    0.417_959_183_673_469_387_755_102_040_816_327,
+];
+
+fn norm(v: DVec3) -> f64 {
+    v.abs().max_element()
+}
+
+/// The Kronrod estimate of ∫ₐᵇ f and |Kronrod − Gauss| (largest channel).
+pub fn gk15(f: &mut impl FnMut(f64) -> DVec3, a: f64, b: f64) -> (DVec3, f64) {
+    let c = 0.5 * (a + b);
+    let h = 0.5 * (b - a);
+    let fc = f(c);
+    let mut k = fc * WGK[7];
+    let mut g = fc * WG[3];
+    for j in 0..7 {
+        let dx = h * XGK[j];
+        let s = f(c - dx) + f(c + dx);
+        k += s * WGK[j];
+        if j % 2 == 1 {
+            g += s * WG[j / 2];
+        }
+    }
+    (k * h, norm((k - g) * h))
+}
+
+/// The 15 Gauss–Kronrod nodes on [0, 1], ascending, with their Kronrod weights and Gauss
+/// weights (0 at the nodes that are not Gauss nodes): the WGSL kernel's outer rule, passed to it
+/// through the generated prelude.
+pub fn gk15_unit() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let mut rows: Vec<(f64, f64, f64)> = Vec::with_capacity(15);
+    for j in 0..8 {
+        let wg = if j % 2 == 1 { WG[j / 2] } else { 0.0 };
+        rows.push((0.5 * (1.0 - XGK[j]), 0.5 * WGK[j], 0.5 * wg));
+        if j < 7 {
+            rows.push((0.5 * (1.0 + XGK[j]), 0.5 * WGK[j], 0.5 * wg));
+        }
+    }
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    (
+        rows.iter().map(|r| r.0).collect(),
+        rows.iter().map(|r| r.1).collect(),
+        rows.iter().map(|r| r.2).collect(),
+    )
+}
+
+/// n-point Gauss–Legendre nodes and weights on [0, 1] (ascending nodes).
+pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    for i in 0..n.div_ceil(2) {
+        // Initial guess for the i-th largest root of Pₙ on [−1, 1].
+        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, z);
+            for k in 2..=n {
+                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
+                p0 = p1;
+                p1 = p2;
+            }
+            let p = if n == 1 { z } else { p1 };
+            let pm1 = if n == 1 { 1.0 } else { p0 };
+            dp = n as f64 * (z * p - pm1) / (z * z - 1.0);
+            let dz = p / dp;
+            z -= dz;
+            if dz.abs() < 1e-16 {
+                break;
+            }
+        }
+        let wi = 2.0 / ((1.0 - z * z) * dp * dp);
+        // Map [−1, 1] → [0, 1].
+        x[n - 1 - i] = 0.5 * (1.0 + z);
+        x[i] = 0.5 * (1.0 - z);
+        w[n - 1 - i] = 0.5 * wi;
+        w[i] = 0.5 * wi;
+    }
+    (x, w)
+}
+
+// ---------------------------------------------------------------------------------------------
+// The irradiance kernel's rule
+// ---------------------------------------------------------------------------------------------
+
+/// Irradiance kernel: Gauss–Legendre points of the elevation integral of a sphere cap cut by the
+/// horizon (`cap_sliver`).
+pub const IRR_GL_CAP: usize = 12;
+/// Irradiance kernel: Gauss–Legendre points per inner span.
+/// (The WGSL writes the inner rule's 10 nodes out: changing this needs `inner_rule` changed.)
+pub const IRR_GL_INNER: usize = 10;
+/// Irradiance kernel: each inner span is integrated adaptively: the rule on the span against the
+/// rule on its halves; halves whose difference exceeds `IRR_INNER_TOL` of their value are split
+/// again, at most `IRR_INNER_DEPTH` times (the order is chosen per light and receiver).
+pub const IRR_INNER_TOL: f64 = 1e-5;
+pub const IRR_INNER_DEPTH: usize = 6;
+/// Irradiance kernel: each outer span is integrated by the 7-point Gauss / 15-point Kronrod
+/// pair; a span whose Gauss and Kronrod values differ by more than `IRR_OUTER_TOL` of the
+/// Kronrod value is halved, at most `IRR_OUTER_DEPTH` times. (Kronrod's error is far below that
+/// difference, which measures Gauss's: the test `kernel_rule_in_f64_is_within_1e_5_of_the_reference`
+/// holds the whole rule to 1e-5.)
+pub const IRR_OUTER_TOL: f64 = 1e-3;
+pub const IRR_OUTER_DEPTH: usize = 5;
+/// Irradiance kernel: samples per elliptic arc when bracketing cone crossings.
+pub const IRR_ARC_SAMPLES: u32 = 24;
+/// Irradiance kernel: an unshaped rect uses Lambert's formula only where its edge terms cannot
+/// cancel much in f32: (d / smaller half-extent) · (d / height above its plane) ≤ this. The
+/// terms of a rect that is far, thin or seen near its plane cancel like each factor (measured on
+/// lavapipe: 1.8e-4 at 590, a 0.2 × 2 rect 5 m away at 5° above its plane); past it, the
+/// quadrature (all positive terms) is used.
+pub const IRR_LAMBERT_COND: f64 = 16.0;
+
+/// A tan map is used on a piece when the line's closest approach (a pole at distance `width`
+/// off the real axis) lies within this Bernstein-ellipse parameter of the piece (both rules).
+pub const TAN_MAP_RHO: f64 = 3.0;
+/// A tan-mapped piece spanning more than this many radians of u is cut into equal spans, so
+/// that the kernel's rule resolves both the near-field peak and the piece's ends.
+pub const MAX_U_SPAN: f64 = 0.8;
+
+/// The `u32` constants of this module the WGSL prelude declares, by name.
+pub fn wgsl_u32_constants() -> Vec<(&'static str, u32)> {
+    vec![
+        ("IRR_GL_CAP", IRR_GL_CAP as u32),
+        ("IRR_GL_INNER", IRR_GL_INNER as u32),
+        ("IRR_INNER_DEPTH", IRR_INNER_DEPTH as u32),
+        ("IRR_OUTER_DEPTH", IRR_OUTER_DEPTH as u32),
+        ("IRR_ARC_SAMPLES", IRR_ARC_SAMPLES),
+    ]
+}
+
+/// The `f32` constants of this module the WGSL prelude declares, by name.
+pub fn wgsl_f32_constants() -> Vec<(&'static str, f64)> {
+    vec![
+        ("IRR_LAMBERT_COND", IRR_LAMBERT_COND),
+        ("IRR_INNER_TOL", IRR_INNER_TOL),
+        ("IRR_OUTER_TOL", IRR_OUTER_TOL),
+        ("IRR_TAN_MAP_RHO", TAN_MAP_RHO),
+        ("IRR_MAX_U_SPAN", MAX_U_SPAN),
+    ]
+}
+
+/// The `f32` arrays the WGSL prelude declares (module-scope `var<private>` so that they can be
+/// indexed at run time): the irradiance kernel's rules on [0, 1].
+pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
+    let (xo, wo) = gauss_legendre(IRR_GL_CAP);
+    let (xi, wi) = gauss_legendre(IRR_GL_INNER);
+    let gk = gk15_unit();
+    vec![
+        ("IRR_GL_CAP_X", xo),
+        ("IRR_GL_CAP_W", wo),
+        ("IRR_GL_INNER_X", xi),
+        ("IRR_GL_INNER_W", wi),
+        ("IRR_GK_X", gk.0),
+        ("IRR_GK_WK", gk.1),
+        ("IRR_GK_WG", gk.2),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        for n in [1usize, 2, 5, 8, 12, 16] {
+            let (x, w) = gauss_legendre(n);
+            assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+            for k in 0..2 * n {
+                let q: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(k as i32)).sum();
+                assert!((q - 1.0 / (k as f64 + 1.0)).abs() < 1e-14, "n={n} k={k}");
+            }
+            assert!(x.windows(2).all(|p| p[0] < p[1]));
+        }
+    }
+
+    #[test]
+    fn gk15_unit_matches_gk15() {
+        let (x, wk, wg) = gk15_unit();
+        assert_eq!(x.len(), 15);
+        assert!(x.windows(2).all(|p| p[0] < p[1]));
+        assert!((wk.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        assert!((wg.iter().sum::<f64>() - 1.0).abs() < 1e-15);
+        let f = |t: f64| (3.0 * t).sin() + t * t;
+        let k: f64 = x.iter().zip(&wk).map(|(x, w)| w * f(*x)).sum();
+        let g: f64 = x.iter().zip(&wg).map(|(x, w)| w * f(*x)).sum();
+        let (kk, e) = gk15(&mut |t| DVec3::splat(f(t)), 0.0, 1.0);
+        assert!((k - kk.x).abs() < 1e-15 && ((k - g).abs() - e).abs() < 1e-15);
+    }
+
+}

@@ -1,0 +1,320 @@
+//! Opening a stage with openusd and reading its light prims at one time, as plain data.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use openusd::usd::{self as ousd, PrimPredicate, TimeCode};
+use openusd_schemas::geom::{XformCache, Xformable, XformableExt};
+
+use super::diagnostics::{check_composition, open_error, stage_error};
+use super::values::{convert, reject_spline, value_at, visible_at};
+use super::xform::{needs_own_xform, world_as_usd_core, xform_error};
+use crate::error::{LuxError, Result};
+use crate::model::schema;
+use crate::model::{Input, Value};
+
+/// Prim types that are lights.
+pub const LIGHT_TYPES: &[&str] = &[
+    "DistantLight",
+    "SphereLight",
+    "DiskLight",
+    "RectLight",
+    "CylinderLight",
+    "DomeLight",
+    "DomeLight_1",
+    "PortalLight",
+    "GeometryLight",
+    "PluginLight",
+];
+
+/// API schemas that make a prim of any type a light.
+pub const LIGHT_APIS: &[&str] = &["MeshLightAPI", "VolumeLightAPI"];
+
+/// The time attributes are read at.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Time {
+    /// A numeric time code, interpolated between samples as USD does (linear for floating
+    /// types, slerp for quaternions, held for bool, token and asset).
+    Code(f64),
+    /// USD's `EarliestTime`: every attribute (and xformOp) at its own earliest time sample, or
+    /// its default value when it has none.
+    Earliest,
+}
+
+impl Time {
+    fn code(self) -> TimeCode {
+        match self {
+            Time::Code(t) => TimeCode::new(t),
+            Time::Earliest => TimeCode::EARLIEST,
+        }
+    }
+}
+
+/// Stage metadata.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageInfo {
+    /// `Y` when unauthored, as USD does.
+    pub up_axis: String,
+    /// 0.01 when unauthored, as USD does.
+    pub meters_per_unit: f64,
+    /// The root layer's `startTimeCode`, when authored.
+    pub start_time_code: Option<f64>,
+    /// The root layer's `endTimeCode`, when authored.
+    pub end_time_code: Option<f64>,
+}
+
+/// One light prim resolved at one time.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct LightPrim {
+    pub path: String,
+    /// The prim's type name (`Mesh`, `Volume`, ... for MeshLightAPI / VolumeLightAPI prims).
+    pub usd_type: String,
+    /// The composed API schemas, as usd-core's `GetAppliedSchemas()` lists them (built-ins
+    /// included, e.g. `LightAPI`), followed by authored names the schema registry does not know
+    /// (e.g. a renderer's own `HoudiniViewportLightAPI`), which usd-core drops.
+    pub applied_schemas: Vec<String>,
+    /// `MeshLightAPI` or `VolumeLightAPI` when that is what makes the prim a light.
+    pub light_api: Option<String>,
+    /// False when `visibility` is `invisible` on the prim or an imageable ancestor.
+    pub visible: bool,
+    /// Local-to-world, USD row-vector convention; every entry NaN when it cannot be computed.
+    pub world: [[f64; 4]; 4],
+    /// Why `world` cannot be computed (e.g. `!invert!` of a singular `transform` op), naming
+    /// the prim; the light is then listed but not evaluated.
+    pub transform_error: Option<String>,
+    /// Every attribute of `schema::attrs_for(usd_type, applied_schemas)`, in that order.
+    pub inputs: Vec<Input>,
+}
+
+/// What does not change with time: found once at open.
+struct LightSite {
+    prim: ousd::Prim,
+    path: String,
+    usd_type: String,
+    applied_schemas: Vec<String>,
+    light_api: Option<String>,
+    attrs: Vec<schema::SchemaAttr>,
+    /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
+    /// usd-core between samples (see [`needs_own_xform`]); its world matrix is composed here.
+    own_xform_chain: bool,
+}
+
+/// An open stage and its light prims.
+pub struct UsdStage {
+    file: PathBuf,
+    info: StageInfo,
+    lights: Vec<LightSite>,
+    // Keeps the composed stage alive for the prim handles above.
+    _stage: ousd::Stage,
+}
+
+impl UsdStage {
+    /// Opens `path` with every payload loaded. A missing or unreadable file is
+    /// [`LuxError::Io`]; a malformed one [`LuxError::Format`] (with the line for `.usda`); a
+    /// sublayer, reference or payload that cannot be found or read is an error naming that layer.
+    pub fn open(path: &Path) -> Result<UsdStage> {
+        // The filesystem's own error (not found, permission denied) is the clearest message.
+        let io = |source| LuxError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let meta = std::fs::metadata(path).map_err(io)?;
+        if meta.is_dir() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a directory, not a USD file",
+            )));
+        }
+        std::fs::File::open(path).map_err(io)?;
+        let name = path.to_str().ok_or_else(|| LuxError::Format {
+            path: path.to_path_buf(),
+            line: None,
+            reason: "the path is not valid UTF-8, which openusd requires".into(),
+        })?;
+        let stage = ousd::Stage::builder()
+            .schema_registry(openusd_schemas::schema_registry())
+            .load(ousd::InitialLoadSet::LoadAll)
+            .open(name)
+            .map_err(|e| open_error(path, e))?;
+        let e = |e: openusd::Error| stage_error(path, e);
+
+        let up_axis = stage
+            .stage_metadata("upAxis")
+            .map_err(e)?
+            .and_then(|v| v.cast::<String>().ok())
+            .unwrap_or_else(|| "Y".to_string());
+        let meters_per_unit = stage
+            .stage_metadata("metersPerUnit")
+            .map_err(e)?
+            .and_then(|v| v.cast::<f64>().ok())
+            .unwrap_or(0.01);
+        let (start_time_code, end_time_code) = {
+            let root = stage.root_layer();
+            (
+                root.has_start_time_code().then(|| root.start_time_code()),
+                root.has_end_time_code().then(|| root.end_time_code()),
+            )
+        };
+        let info = StageInfo {
+            up_axis,
+            meters_per_unit,
+            start_time_code,
+            end_time_code,
+        };
+
+        // Default predicate (active, loaded, defined, non-abstract) as usd-core's Traverse(),
+        // descending into instances: a light inside an instanced asset lights the scene too.
+        let mut paths = Vec::new();
+        stage
+            .traverse(PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone()))
+            .map_err(e)?;
+        check_composition(path, &stage)?;
+
+        let mut lights = Vec::new();
+        let mut own_xform: HashMap<String, bool> = HashMap::new();
+        for p in paths {
+            let prim = stage.prim(&p).map_err(|err| e(err.into()))?;
+            let usd_type = prim
+                .type_name()
+                .map_err(e)?
+                .map(|t| t.as_str().to_string())
+                .unwrap_or_default();
+            let applied_schemas: Vec<String> = prim
+                .api_schemas()
+                .map_err(e)?
+                .iter()
+                .map(|t| t.as_str().to_string())
+                .collect();
+            let light_api = if LIGHT_TYPES.contains(&usd_type.as_str()) {
+                None
+            } else {
+                match applied_schemas
+                    .iter()
+                    .find(|s| LIGHT_APIS.contains(&s.as_str()))
+                {
+                    Some(api) => Some(api.clone()),
+                    None => continue,
+                }
+            };
+            let applied: Vec<&str> = applied_schemas.iter().map(String::as_str).collect();
+            let attrs = schema::attrs_for(&usd_type, &applied);
+            for a in &attrs {
+                reject_spline(&p, &prim.attribute(a.name))?;
+            }
+            let mut own_xform_chain = false;
+            let mut cur = Some(prim.clone());
+            while let Some(q) = cur.filter(|q| !q.path().is_abs_root()) {
+                let key = q.path().to_string();
+                let own = match own_xform.get(&key) {
+                    Some(own) => *own,
+                    None => {
+                        if let Some(x) = Xformable::from_prim(q.clone()).map_err(e)? {
+                            let (ops, _) =
+                                x.ordered_xform_ops().map_err(|err| xform_error(&p, err))?;
+                            for op in &ops {
+                                reject_spline(&p, op.attribute())?;
+                            }
+                        }
+                        let own = needs_own_xform(&q).map_err(|err| xform_error(&p, err))?;
+                        own_xform.insert(key, own);
+                        own
+                    }
+                };
+                own_xform_chain |= own;
+                cur = q.parent();
+            }
+            lights.push(LightSite {
+                path: p.to_string(),
+                prim,
+                usd_type,
+                applied_schemas,
+                light_api,
+                attrs,
+                own_xform_chain,
+            });
+        }
+        // Reading attributes can compose more (e.g. the prims an inherit arc names).
+        check_composition(path, &stage)?;
+        Ok(UsdStage {
+            file: path.to_path_buf(),
+            info,
+            lights,
+            _stage: stage,
+        })
+    }
+
+    pub fn info(&self) -> &StageInfo {
+        &self.info
+    }
+
+    /// The file the stage was opened from.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// Every light prim, in traversal order, resolved at `time`.
+    pub(crate) fn lights_at(&self, time: Time) -> Result<Vec<LightPrim>> {
+        let tc = time.code();
+        let e = |err: openusd::Error| stage_error(&self.file, err);
+        let mut cache = XformCache::new(tc);
+        let mut out = Vec::with_capacity(self.lights.len());
+        for site in &self.lights {
+            let visible = visible_at(&site.prim, tc).map_err(e)?;
+            let world = match site.own_xform_chain {
+                false => cache.local_to_world_transform(&site.prim),
+                true => world_as_usd_core(&mut cache, &site.prim, tc),
+            };
+            // One broken transform must not hide the stage's other lights: it is reported
+            // with the light instead of failing the load.
+            let (world, transform_error) = match world {
+                Ok(m) => (m.into(), None),
+                Err(err) => (
+                    [[f64::NAN; 4]; 4],
+                    Some(format!(
+                        "{}: world transform cannot be computed: {err}",
+                        site.path
+                    )),
+                ),
+            };
+            let mut inputs = Vec::with_capacity(site.attrs.len());
+            for a in &site.attrs {
+                inputs.push(self.input(site, a, tc)?);
+            }
+            out.push(LightPrim {
+                path: site.path.clone(),
+                usd_type: site.usd_type.clone(),
+                applied_schemas: site.applied_schemas.clone(),
+                light_api: site.light_api.clone(),
+                visible,
+                world,
+                transform_error,
+                inputs,
+            });
+        }
+        Ok(out)
+    }
+
+    /// One attribute at `tc`: its authored value converted to the kind of its table fallback,
+    /// or the table fallback when nothing is authored.
+    fn input(&self, site: &LightSite, a: &schema::SchemaAttr, tc: TimeCode) -> Result<Input> {
+        let e = |err: openusd::Error| stage_error(&self.file, err);
+        let attr = site.prim.attribute(a.name);
+        let authored = attr.has_authored_value().map_err(e)?;
+        let value = if authored {
+            match value_at(&attr, tc).map_err(e)? {
+                Some(v) => convert(&site.path, a, v)?,
+                // A blocked value at this time: usd-core reports no value at all; luxeval has
+                // to evaluate something, and a block means "no opinion", so the fallback.
+                None => Value::fallback(a.fallback),
+            }
+        } else {
+            Value::fallback(a.fallback)
+        };
+        Ok(Input {
+            name: a.name.to_string(),
+            value,
+            authored,
+        })
+    }
+}
+
