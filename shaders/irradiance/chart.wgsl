@@ -1,5 +1,5 @@
-// Plane charts of the directions a receiver sees a light in. Twin of
-// src/cpu/irradiance/chart.rs, which carries the derivations.
+// Plane charts of the directions a receiver sees a light in.
+// Twin of src/cpu/irradiance/chart.rs, which carries the derivations.
 //
 // f32: the region and its arcs live in one flat struct (no enums with data in WGSL); an
 //   invalid chart has jac = 0 where the CPU returns None.

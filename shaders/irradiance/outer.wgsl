@@ -1,5 +1,5 @@
-// The outer (across lines) integral of the chart quadrature, and treatAsLine. Twin of
-// src/cpu/irradiance/outer.rs, which carries the derivations.
+// The outer (across lines) integral of the chart quadrature, and treatAsLine.
+// Twin of src/cpu/irradiance/outer.rs, which carries the derivations.
 //
 // f32: the kernel's outer rule: per span the Gauss–Kronrod 7/15 pair, halved while Gauss and
 //   Kronrod differ by more than IRR_OUTER_TOL of the Kronrod value, at most IRR_OUTER_DEPTH

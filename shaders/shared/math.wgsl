@@ -1,5 +1,7 @@
 // Numerical primitives with accuracy the WGSL builtins do not promise.
 //
+// No CPU twin: these stand in for f64 builtins (atan2, glam's any_orthonormal_pair).
+//
 // WGSL only bounds atan/atan2 to 4096 ULP, and lavapipe's atan2 errs by ~1e-6 rad, which the
 // angle-space cone smoothstep turns into 1e-4 relative errors near a soft cone edge. This atan2
 // is within ~2e-7 rad of the true value on any device (measured against f64 in tests/math.rs).

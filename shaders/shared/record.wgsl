@@ -1,5 +1,8 @@
 // The GPU light record and the query bindings shared by every kernel.
 //
+// No CPU twin: the record is packed by src/gpu/record.rs, whose layout tests/wgsl.rs checks
+//   against naga; the bindings have no CPU counterpart.
+//
 // The record's Rust twin is `Record` in src/gpu/record.rs; tests/wgsl.rs asserts both layouts
 // against naga's layouter. The constants KIND_* and FLAG_* come from a prelude that
 // src/gpu/shaders.rs generates from the Rust constants, so they are never retyped here.

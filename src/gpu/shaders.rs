@@ -136,10 +136,17 @@ fn f32_literal(v: f64) -> String {
 
 /// The complete WGSL module for `kernel`.
 pub fn compose(kernel: Kernel) -> String {
+    compose_file(kernel.file()).unwrap_or_default()
+}
+
+/// The prelude, the modules `path` imports and `path` itself: a module naga can parse on its
+/// own (None when `path` is not one of [`SOURCES`]).
+pub fn compose_file(path: &str) -> Option<String> {
+    let path = SOURCES.iter().map(|(p, _)| *p).find(|p| *p == path)?;
     let mut out = prelude();
     let mut seen = HashSet::new();
-    append(kernel.file(), &mut out, &mut seen);
-    out
+    append(path, &mut out, &mut seen);
+    Some(out)
 }
 
 fn append(path: &'static str, out: &mut String, seen: &mut HashSet<&'static str>) {
