@@ -34,21 +34,21 @@
 // The data flow of DESIGN.md §1, each module depending only on those above it:
 // model → usd → prepare → cpu | gpu → query → io, falloff → the CLI (src/bin/luxeval).
 // `rules` holds what the WGSL kernels and their f64 counterparts share; neither backend owns it.
-pub(crate) mod error;
-pub(crate) mod model;
-#[cfg(feature = "usd")]
-pub(crate) mod usd;
-pub(crate) mod prepare;
-pub(crate) mod rules;
-pub(crate) mod cpu;
-pub(crate) mod gpu;
-pub(crate) mod query;
-pub mod io;
-pub mod falloff;
-#[cfg(any(test, feature = "testkit"))]
-pub mod testkit;
 #[cfg(any(test, feature = "testkit"))]
 pub mod check;
+pub(crate) mod cpu;
+pub(crate) mod error;
+pub mod falloff;
+pub(crate) mod gpu;
+pub mod io;
+pub(crate) mod model;
+pub(crate) mod prepare;
+pub(crate) mod query;
+pub(crate) mod rules;
+#[cfg(any(test, feature = "testkit"))]
+pub mod testkit;
+#[cfg(feature = "usd")]
+pub(crate) mod usd;
 
 /// Compiles and runs the README's examples as doctests.
 #[cfg(all(doctest, feature = "usd"))]

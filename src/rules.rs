@@ -231,5 +231,4 @@ mod tests {
         let (kk, e) = gk15(&mut |t| DVec3::splat(f(t)), 0.0, 1.0);
         assert!((k - kk.x).abs() < 1e-15 && ((k - g).abs() - e).abs() < 1e-15);
     }
-
 }

@@ -26,8 +26,8 @@ fn dvec(v: [f32; 3]) -> DVec3 {
 #[test]
 fn a11_floor_maps_gpu_match_cpu() {
     let Some(eval) = common::gpu() else { return };
-    let full = !common::is_llvmpipe(&eval)
-        || std::env::var("LUXEVAL_A11_FULL").is_ok_and(|v| v == "1");
+    let full =
+        !common::is_llvmpipe(&eval) || std::env::var("LUXEVAL_A11_FULL").is_ok_and(|v| v == "1");
     let device = eval.device_name();
     let stride = if full { 1 } else { 4 };
     let plane = Plane::new(
@@ -93,7 +93,9 @@ fn a11_floor_maps_gpu_match_cpu() {
                             err,
                             format!(
                                 "{name} frame {frame} {} at {x:?}: cpu {} gpu {:?}",
-                                p.light().path, cpu[i], gpu[k]
+                                p.light().path,
+                                cpu[i],
+                                gpu[k]
                             ),
                         );
                     }

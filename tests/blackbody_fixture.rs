@@ -2,7 +2,6 @@
 
 use luxeval::TemperatureMode;
 
-
 fn rows() -> Vec<(f64, [f64; 3], [f64; 3])> {
     let text = include_str!("data/blackbody_usdcore.json");
     let v: serde_json::Value = serde_json::from_str(text).expect("fixture is JSON");

@@ -7,8 +7,8 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use luxeval::io::npy;
 use luxeval::Scene;
+use luxeval::io::npy;
 use luxeval::{Accumulate, Evaluator};
 
 fn luxeval(args: &[&str]) -> Output {

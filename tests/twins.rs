@@ -20,7 +20,11 @@ fn header(src: &str) -> String {
 fn gpu_only(header: &str) -> Vec<String> {
     let mut out = Vec::new();
     for line in header.lines() {
-        if let Some(rest) = line.trim_start_matches("//").trim().strip_prefix("GPU-only ") {
+        if let Some(rest) = line
+            .trim_start_matches("//")
+            .trim()
+            .strip_prefix("GPU-only ")
+        {
             let names = rest.split(':').next().unwrap_or("");
             out.extend(names.split(',').map(|n| n.trim().to_string()));
         }

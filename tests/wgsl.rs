@@ -138,8 +138,5 @@ fn inner_rule_is_written_out_with_every_node() {
             "node {k} missing from inner_rule"
         );
     }
-    assert_eq!(
-        body.matches("inner_node(").count(),
-        IRR_GL_INNER
-    );
+    assert_eq!(body.matches("inner_node(").count(), IRR_GL_INNER);
 }

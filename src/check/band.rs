@@ -13,8 +13,7 @@ use crate::query::Reference;
 use crate::testkit::samples::local_extent;
 
 /// Distance of an emission direction from the light's discontinuities, in radians.
-pub fn emission_margin(
-    r: &Reference, e: DVec3) -> f64 {
+pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
     let p = &r.p;
     let e = e.normalize();
     let mut m = f64::INFINITY;
@@ -46,8 +45,7 @@ pub fn emission_margin(
 
 /// Distance of a radiance ray from the light's discontinuities (dimensionless: radians, or a
 /// fraction of the shape's size).
-pub fn radiance_margin(
-    r: &Reference, x: DVec3, w: DVec3) -> f64 {
+pub fn radiance_margin(r: &Reference, x: DVec3, w: DVec3) -> f64 {
     let p = &r.p;
     let w = w.normalize();
     let m_emit = emission_margin(r, -w);
@@ -130,8 +128,7 @@ pub const F32_ROUNDING: f64 = f32::EPSILON as f64 / 2.0;
 /// angle): rect edges, disk rim, the sphere's contact ellipse, the cylinder's front patch
 /// (tangent generators and front arcs of the end rings); the origin of a point light and the
 /// ends of a line light. Empty when x sees nothing (inside a sphere or a cylinder's tube).
-pub fn irradiance_outline(
-    r: &Reference, x: DVec3) -> Vec<DVec3> {
+pub fn irradiance_outline(r: &Reference, x: DVec3) -> Vec<DVec3> {
     let p = &r.p;
     let m = p.linear;
     let o = p.origin;
@@ -246,8 +243,7 @@ pub fn irradiance_outline(
 ///   `IRRADIANCE_SLIVER_FACTOR·η`) of the smallest emission angle at which x sees the light
 ///   (x in the outer sliver of the penumbra, where the lit part of the light is a sliver and
 ///   the factor vanishes there).
-pub fn irradiance_margin(
-    r: &Reference, x: DVec3, n: DVec3) -> f64 {
+pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
     let p = &r.p;
     let n = n.normalize();
     let scale = |v: f64, band: f64| v.abs() / band * BAND;
@@ -356,4 +352,3 @@ pub fn irradiance_margin(
     }
     m
 }
-

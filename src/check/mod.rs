@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use crate::cpu::{self, dvec};
 use crate::error::Result;
 use crate::query::{Accumulate, Evaluator, PreparedScene, Reference};
-use crate::testkit::{Rng, irradiance_samples, radiance_samples, emission_samples};
+use crate::testkit::{Rng, emission_samples, irradiance_samples, radiance_samples};
 pub use band::{
     F32_ROUNDING, IRRADIANCE_SLIVER_FACTOR, emission_margin, irradiance_margin, radiance_margin,
 };
@@ -204,7 +204,13 @@ pub fn check_with(
             })
             .collect();
         rows.push(compare(r, Query::Irradiance, ni, |i| {
-            (reference[i].0, reference[i].1, got[i], pts[i], Some(nrms[i]))
+            (
+                reference[i].0,
+                reference[i].1,
+                got[i],
+                pts[i],
+                Some(nrms[i]),
+            )
         }));
     }
     rows.retain(|r| r.samples > 0);
@@ -220,12 +226,7 @@ pub fn check_with(
 
 type SampleEval = (DVec3, f64, [f32; 3], [f32; 3], Option<[f32; 3]>);
 
-fn compare(
-    r: &Reference,
-    query: Query,
-    n: usize,
-    f: impl Fn(usize) -> SampleEval,
-) -> QueryReport {
+fn compare(r: &Reference, query: Query, n: usize, f: impl Fn(usize) -> SampleEval) -> QueryReport {
     let mut report = QueryReport {
         light: r.light().path.clone(),
         light_type: r.light().kind.usd_type(),
@@ -261,4 +262,3 @@ fn compare(
     report.pass = report.max_rel_error <= TOLERANCE;
     report
 }
-

@@ -227,7 +227,7 @@ pub struct Ctx<'a, R> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::model::Light;
     use crate::prepare::TemperatureMode;
@@ -237,7 +237,8 @@ mod tests {
         Prepared::new(l, TemperatureMode::Spec).unwrap()
     }
 
-    fn rel(a: f64, b: f64) -> f64 {
+    /// Relative difference, 0 for equal values.
+    pub(crate) fn rel(a: f64, b: f64) -> f64 {
         if a == b {
             0.0
         } else {

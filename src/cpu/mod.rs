@@ -89,8 +89,10 @@ pub fn irradiance_batch(
     normals: &[[f32; 3]],
     per_light: bool,
 ) -> Vec<DVec3> {
-    batch(lights, points.len(), per_light, |l, i| match unit(normals[i]) {
-        Some(n) => irradiance::irradiance(l, dvec(points[i]), n),
-        None => DVec3::ZERO,
+    batch(lights, points.len(), per_light, |l, i| {
+        match unit(normals[i]) {
+            Some(n) => irradiance::irradiance(l, dvec(points[i]), n),
+            None => DVec3::ZERO,
+        }
     })
 }

@@ -30,14 +30,8 @@ pub const SOURCES: &[(&str, &str)] = &[
         "shared/roots.wgsl",
         include_str!("../../shaders/shared/roots.wgsl"),
     ),
-    (
-        "emission.wgsl",
-        include_str!("../../shaders/emission.wgsl"),
-    ),
-    (
-        "radiance.wgsl",
-        include_str!("../../shaders/radiance.wgsl"),
-    ),
+    ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
+    ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
     (
         "irradiance.wgsl",
         include_str!("../../shaders/irradiance.wgsl"),
@@ -106,10 +100,13 @@ fn source(path: &str) -> &'static str {
 
 /// The prelude of shared constants.
 pub fn prelude() -> String {
-    let mut s = String::from(
-        "// Generated from src/gpu/record.rs (WGSL_CONSTANTS) and src/rules.rs.\n",
-    );
-    for (name, value) in WGSL_CONSTANTS.iter().copied().chain(rules::wgsl_u32_constants()) {
+    let mut s =
+        String::from("// Generated from src/gpu/record.rs (WGSL_CONSTANTS) and src/rules.rs.\n");
+    for (name, value) in WGSL_CONSTANTS
+        .iter()
+        .copied()
+        .chain(rules::wgsl_u32_constants())
+    {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
     for (name, value) in rules::wgsl_f32_constants() {

@@ -9,8 +9,8 @@
 
 use glam::{DMat3, DMat4, DVec3};
 
-use crate::error::{LuxError, Result};
 use super::schema;
+use crate::error::{LuxError, Result};
 
 /// LightAPI inputs shared by every light (spec/001).
 #[derive(Clone, Debug, PartialEq)]

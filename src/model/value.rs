@@ -67,7 +67,6 @@ impl std::fmt::Display for Value {
     }
 }
 
-
 impl Value {
     /// The value of a schema fallback (an unauthored attribute).
     pub fn fallback(f: Fallback) -> Value {

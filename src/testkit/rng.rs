@@ -48,4 +48,3 @@ impl Rng {
         (r * phi.cos() * t + r * phi.sin() * b + z * axis).normalize()
     }
 }
-

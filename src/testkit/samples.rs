@@ -25,8 +25,7 @@ pub(crate) fn local_extent(l: &Light) -> DVec3 {
 
 /// Emission directions for one light: half uniform, half concentrated where the light is
 /// interesting (around its axis, its cone edge, its horizon).
-pub fn emission_samples(
-    r: &Reference, n: usize, rng: &mut Rng) -> Vec<[f32; 3]> {
+pub fn emission_samples(r: &Reference, n: usize, rng: &mut Rng) -> Vec<[f32; 3]> {
     let p = &r.p;
     (0..n)
         .map(|i| {
@@ -52,11 +51,7 @@ pub fn emission_samples(
 /// Radiance rays for one light: origins around the light (up to a few sizes away), aimed at
 /// random points of a box slightly larger than the shape, so that hits, misses and silhouettes
 /// all occur; for distant lights, rays around the direction toward the light.
-pub fn radiance_samples(
-    r: &Reference,
-    n: usize,
-    rng: &mut Rng,
-) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+pub fn radiance_samples(r: &Reference, n: usize, rng: &mut Rng) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
     let p = &r.p;
     let l = &p.light;
     let ext = local_extent(l);
@@ -71,10 +66,7 @@ pub fn radiance_samples(
                     rng.range(-10.0, 10.0),
                     rng.range(-10.0, 10.0),
                 );
-                (
-                    x,
-                    rng.cone(-p.axis, (2.0 * p.distant_half_angle).max(1e-3)),
-                )
+                (x, rng.cone(-p.axis, (2.0 * p.distant_half_angle).max(1e-3)))
             }
             LightType::Dome => (
                 DVec3::new(
@@ -170,4 +162,3 @@ pub fn irradiance_samples(
     }
     (points, normals)
 }
-

@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use openusd::usd as ousd;
 use openusd::sdf;
+use openusd::usd as ousd;
 
 use crate::error::{LuxError, Result};
 

@@ -1,13 +1,13 @@
 //! Attribute values as usd-core resolves them: openusd's, except where openusd 0.8 gives other
 //! numbers (a sample held before a block), and refusing what it cannot evaluate (splines).
 
-use openusd::usd::{self as ousd, TimeCode};
 use openusd::sdf;
+use openusd::usd::{self as ousd, TimeCode};
 use openusd_schemas::geom::Imageable;
 
 use crate::error::{LuxError, Result};
-use crate::model::schema::{self, Fallback};
 use crate::model::Value;
+use crate::model::schema::{self, Fallback};
 
 /// openusd 0.8 parses a spline-valued attribute (`float x.spline = {...}`, USD 25.05+) but
 /// resolves it as unauthored, so its value would silently be the fallback; usd-core evaluates
@@ -45,7 +45,10 @@ pub(super) fn reject_spline(light: &sdf::Path, attr: &ousd::Attribute) -> Result
 /// `attr`'s value at `tc` as usd-core resolves it: openusd's, except where openusd has none
 /// and usd-core holds the sample before a block (see [`held_before_block`]). `None` where
 /// usd-core has no value either (a blocked value).
-pub(super) fn value_at(attr: &ousd::Attribute, tc: TimeCode) -> openusd::Result<Option<sdf::Value>> {
+pub(super) fn value_at(
+    attr: &ousd::Attribute,
+    tc: TimeCode,
+) -> openusd::Result<Option<sdf::Value>> {
     if let Some(v) = attr.get_at::<sdf::Value>(tc)? {
         return Ok(Some(v));
     }
@@ -135,4 +138,3 @@ pub(super) fn convert(light: &str, a: &schema::SchemaAttr, v: sdf::Value) -> Res
         },
     })
 }
-

@@ -56,13 +56,7 @@ pub struct FalloffArgs {
 }
 
 pub fn run(a: &FalloffArgs) -> CliResult {
-    let plane = Plane::new(
-        a.origin.into(),
-        a.u.into(),
-        a.v.into(),
-        a.res.0,
-        a.res.1,
-    )?;
+    let plane = Plane::new(a.origin.into(), a.u.into(), a.v.into(), a.res.0, a.res.1)?;
     let style = falloff::png::Style {
         scale: match a.scale {
             ScaleArg::Log => falloff::png::Scale::Log,

@@ -56,4 +56,3 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
     }
     Ok(())
 }
-

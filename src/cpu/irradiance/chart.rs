@@ -192,4 +192,3 @@ impl Chart {
 pub fn arc_at(arc: &Arc, t: f64) -> DVec3 {
     arc.c + arc.u * t.cos() + arc.v * t.sin()
 }
-

@@ -163,15 +163,8 @@ pub fn point_irradiance(p: &Prepared, x: DVec3, n: DVec3, radius: f64) -> DVec3 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cpu::irradiance::tests::rel;
     use crate::cpu::quadrature::{Tolerance, integrate};
-
-    fn rel(a: f64, b: f64) -> f64 {
-        if a == b {
-            0.0
-        } else {
-            (a - b).abs() / b.abs().max(a.abs())
-        }
-    }
 
     #[test]
     fn asin_series_matches_direct() {
@@ -248,5 +241,4 @@ mod tests {
             assert!(rel(e, q) < 1e-10, "α={alpha} γ={gamma}: {e} vs {q}");
         }
     }
-
 }

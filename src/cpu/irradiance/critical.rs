@@ -185,7 +185,11 @@ pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
     // The outer integrand peaks where a curve bounding the inner intervals (a region edge, a
     // cone edge, the focus line) comes nearest to x: split there too.
     for &xs in &segs {
-        push_y(&mut ys, -(w0 + e1 * xs).dot(e2) / e2.length_squared(), chart);
+        push_y(
+            &mut ys,
+            -(w0 + e1 * xs).dot(e2) / e2.length_squared(),
+            chart,
+        );
     }
     for arc in &arcs {
         arc_nearest(&mut ys, chart, arc);

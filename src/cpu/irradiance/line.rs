@@ -128,4 +128,3 @@ pub fn unshaped_segment(
     let prim = |u: f64| np * (0.5 * u + 0.25 * (2.0 * u).sin()) + ne * 0.5 * u.sin().powi(2);
     (width / (m * m) * (prim(u1) - prim(u0))).max(0.0)
 }
-

@@ -42,7 +42,13 @@ fn outer_pole(chart: &Chart, y0: f64, y1: f64) -> (f64, f64) {
 
 /// `∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY` over the chart's region, split at `ys` (the critical
 /// Ys of `critical::critical_ys`, which include the ends of the region's Y-range).
-pub fn chart_integral<R: Rule>(p: &Prepared, chart: &Chart, n: DVec3, ys: &[f64], rule: &R) -> DVec3 {
+pub fn chart_integral<R: Rule>(
+    p: &Prepared,
+    chart: &Chart,
+    n: DVec3,
+    ys: &[f64],
+    rule: &R,
+) -> DVec3 {
     if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
         return DVec3::ZERO;
     }
@@ -104,4 +110,3 @@ pub fn line_irradiance<R: Rule>(
     };
     p.base * line_integral(&ctx, p.origin - x, m * DVec3::X, -hl, hl) * weight
 }
-

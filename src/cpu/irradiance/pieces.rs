@@ -145,4 +145,3 @@ pub fn graded_parts(t0: f64, t1: f64, g0: bool, g1: bool) -> Vec<(f64, f64, bool
         ],
     }
 }
-
