@@ -69,6 +69,16 @@ pub enum LuxError {
         source: std::io::Error,
     },
 
+    /// A file a light references (an IES profile, a texture) cannot be read or parsed.
+    #[error("light {light}: {attr} @{path}@: {source}")]
+    Asset {
+        light: String,
+        attr: String,
+        path: String,
+        #[source]
+        source: AssetError,
+    },
+
     /// A file's content is malformed or unsupported.
     #[error("{}{}: {reason}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     Format {
@@ -76,6 +86,24 @@ pub enum LuxError {
         line: Option<usize>,
         reason: String,
     },
+}
+
+/// Why a referenced file cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum AssetError {
+    /// The stage resolves the path to no existing file.
+    #[error("cannot be resolved: no such file beside the layer that authors it")]
+    Unresolved,
+    /// Reading it failed.
+    #[error("{path}: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// An IES (LM-63) or EULUMDAT profile that cannot be read (the message names the line).
+    #[error(transparent)]
+    Ies(#[from] crate::assets::ies::IesError),
 }
 
 /// What went wrong on the GPU, keeping wgpu's own error.
@@ -136,6 +164,7 @@ impl LuxError {
                 | LuxError::InvalidTransform { .. }
                 | LuxError::InvalidInput { .. }
                 | LuxError::Io { .. }
+                | LuxError::Asset { .. }
                 | LuxError::Format { .. }
         )
     }

@@ -33,13 +33,16 @@
 
 // The data flow of DESIGN.md §1, each module depending only on those above it:
 // model → usd → prepare → cpu | gpu → query → io, falloff → the CLI (src/bin/luxeval).
+// `assets` (readers of referenced files) is a leaf that `prepare` uses.
 // `rules` holds what the WGSL kernels and their f64 counterparts share; neither backend owns it.
 #[cfg(any(test, feature = "testkit"))]
 pub mod check;
+pub(crate) mod assets;
 pub(crate) mod cpu;
 pub(crate) mod error;
 pub mod falloff;
 pub(crate) mod gpu;
+pub mod ies;
 pub mod io;
 pub(crate) mod model;
 pub(crate) mod prepare;

@@ -701,6 +701,7 @@ fn random_shaping(rng: &mut Rng) -> Shaping {
             0.0
         },
         focus_tint: DVec3::new(rng.f64(), rng.f64(), rng.f64()),
+        ies: None,
     }
 }
 
@@ -959,6 +960,7 @@ fn point_and_line_sources() {
         cone_softness: 0.3,
         focus: 1.5,
         focus_tint: DVec3::new(0.2, 0.5, 1.0),
+        ies: None,
     };
     let cs = c.clone().with_shaping(sh.clone());
     let got = cpu_e(&cs, x, n);

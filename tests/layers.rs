@@ -8,9 +8,10 @@ use std::path::{Path, PathBuf};
 
 /// Each layer and the crate modules it may name.
 const ALLOWED: &[(&str, &[&str])] = &[
+    ("assets", &["assets"]),
     ("model", &["error", "model"]),
     ("usd", &["error", "model", "usd"]),
-    ("prepare", &["error", "model", "prepare"]),
+    ("prepare", &["assets", "error", "model", "prepare"]),
     ("rules", &["rules"]),
     ("cpu", &["error", "model", "prepare", "rules", "cpu"]),
     ("gpu", &["error", "model", "prepare", "rules", "gpu"]),
@@ -19,6 +20,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
         &["error", "model", "prepare", "cpu", "gpu", "query"],
     ),
     ("io", &["error", "io"]),
+    ("ies", &["assets", "prepare", "cpu", "ies"]),
     ("falloff", &["error", "io", "query", "falloff"]),
     (
         "check",

@@ -55,7 +55,7 @@ fn every_wgsl_function_has_its_cpu_twin_in_the_same_order() {
         let Some(rust_path) = head
             .find("Twin of ")
             .and_then(|i| head[i + "Twin of ".len()..].split_whitespace().next())
-            .map(|w| w.trim_end_matches([',', '.', ';']))
+            .map(|w| w.trim_end_matches([',', '.', ';', ':']))
         else {
             problems.push(format!("{path}: no \"Twin of src/cpu/….rs\" in its header"));
             continue;

@@ -77,6 +77,7 @@ fn record_layout_matches_naga() {
         ("world_y", offset_of!(Record, world) + 16),
         ("world_z", offset_of!(Record, world) + 32),
         ("irr", offset_of!(Record, irr)),
+        ("ies", offset_of!(Record, ies)),
         ("kind", offset_of!(Record, kind)),
         ("flags", offset_of!(Record, flags)),
         ("pad0", offset_of!(Record, pad)),
@@ -139,4 +140,43 @@ fn inner_rule_is_written_out_with_every_node() {
         );
     }
     assert_eq!(body.matches("inner_node(").count(), IRR_GL_INNER);
+}
+
+/// No kernel uses WGSL's builtin atan2 (off by ~3e-6 rad on lavapipe); math.wgsl's
+/// atan2_accurate stands in for it everywhere.
+#[test]
+fn no_shader_uses_the_builtin_atan2() {
+    for (path, src) in SOURCES {
+        let code: String = src
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//"))
+            .collect::<Vec<_>>()
+            .join("\n");
+        assert!(
+            !code.replace("atan2_accurate", "").contains("atan2"),
+            "{path} uses the builtin atan2"
+        );
+    }
+}
+
+/// The IES interval search is a binary search bounded by a constant (lavapipe ends an
+/// invocation's loops after 65,535 iterations in total): one bounded `for`, no `loop`/`while`.
+#[test]
+fn ies_interval_search_is_bounded() {
+    let src = SOURCES
+        .iter()
+        .find(|(name, _)| *name == "shared/ies.wgsl")
+        .unwrap()
+        .1;
+    let code: String = src
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert!(!code.contains("loop") && !code.contains("while"));
+    assert_eq!(code.matches("for (").count(), 1);
+    let body = &code[code.find("fn find_interval(").unwrap()..];
+    let body = &body[..body.find("\n}").unwrap()];
+    assert!(body.contains("k < IES_SEARCH_STEPS"), "{body}");
+    assert!(luxeval::testkit::ies_replay::SEARCH_STEPS >= 32);
 }

@@ -34,6 +34,9 @@ struct Record {
     world_z: vec4<f32>,
     // Irradiance: (diffuse, |det M|, cos θ of kink A, cos θ of kink B) (FLAG_KINK_A/B).
     irr: vec4<f32>,
+    // IES (FLAG_IES): (atlas base of the profile, an exact integer in f32; angleScale;
+    // normalisation or tilt scale; 0).
+    ies: vec4<f32>,
     kind: u32,
     flags: u32,
     pad0: u32,
@@ -64,6 +67,8 @@ struct Params {
 // Float triples: directions (radiance) or receiver normals (irradiance); unused by emission.
 @group(0) @binding(3) var<storage, read> in_b: array<f32>;
 @group(0) @binding(4) var<storage, read_write> out_rgb: array<f32>;
+// Every IES profile of the scene (shared/ies.wgsl reads it; layout in src/gpu/ies_atlas.rs).
+@group(0) @binding(5) var<storage, read> ies_atlas: array<f32>;
 
 fn sample_index(gid: vec3<u32>) -> u32 {
     return gid.x + gid.y * params.row_stride;

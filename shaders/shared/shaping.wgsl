@@ -10,6 +10,7 @@
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
+// #import shared/ies.wgsl
 
 // θoff in radians: atan2(|e × a|, e · a), accurate near 0 where acos is not.
 fn off_axis_angle(axis: vec3<f32>, e: vec3<f32>) -> f32 {
@@ -57,5 +58,5 @@ fn shaping(light: Record, e: vec3<f32>) -> vec3<f32> {
     let axis = light.axis.xyz;
     let theta = off_axis_angle(axis, e);
     return focus_factor(light.focus_tint.w, light.focus_tint.xyz, dot(e, axis))
-        * cone_factor(theta, light.cone.x, light.cone.y);
+        * cone_factor(theta, light.cone.x, light.cone.y) * ies_of(light, e);
 }

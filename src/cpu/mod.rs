@@ -3,7 +3,7 @@
 //!
 //! Each module that implements a concept evaluated per direction has a WGSL twin of the same
 //! name under `shaders/` (`emission`, `radiance`, `irradiance` and its parts in
-//! `irradiance/`; `shaping`, `shapes` and `roots` in `shaders/shared/`), with the same function
+//! `irradiance/`; `shaping`, `shapes`, `roots` and `ies` in `shaders/shared/`), with the same function
 //! names in the same order (`tests/twins.rs` checks it). `quadrature` is the reference's own
 //! adaptive integrator.
 //!
@@ -11,6 +11,7 @@
 //! vectors; the batch entry points below normalise their inputs, as the kernels' entry points do.
 
 pub mod emission;
+pub mod ies;
 pub mod irradiance;
 pub mod quadrature;
 pub mod radiance;

@@ -7,10 +7,13 @@
 //!   clamped to [0, 1]; θoff > θcone is always 0 ("guaranteed to be zero"); at softness 0 the
 //!   cut-off is hard and the boundary itself is lit;
 //! - focus: `f = |cos θoff|^focus`, `L ⊙= lerp(focusTint, 1, f)` = tint + f·(1 − tint);
-//!   focus ≤ 0 is ignored.
+//!   focus ≤ 0 is ignored;
+//! - IES: the profile's value along the light-space direction multiplies as candela (§6 I7,
+//!   [`super::ies`]).
 
 use glam::DVec3;
 
+use super::ies::ies_of;
 use crate::prepare::Prepared;
 
 /// θoff in radians, in [0, π].
@@ -54,7 +57,12 @@ pub fn shaping(p: &Prepared, e: DVec3) -> DVec3 {
     };
     let cos = e.dot(p.axis);
     let theta = off_axis_angle(p.axis, e);
-    focus_factor(s.focus, s.focus_tint, cos) * cone_factor(theta, s.cone, s.start)
+    let f = focus_factor(s.focus, s.focus_tint, cos) * cone_factor(theta, s.cone, s.start);
+    // DESIGN.md §6 I7: the IES value multiplies as candela, like the other factors.
+    match &p.ies {
+        Some(_) => f * ies_of(p, e),
+        None => f,
+    }
 }
 
 #[cfg(test)]

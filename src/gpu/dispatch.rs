@@ -7,9 +7,10 @@ use crate::error::{GpuFailure, LuxError, Result};
 use super::record::{Params, Record, WORKGROUP_SIZE};
 use super::{GpuContext, Kernel};
 
-/// A prepared scene's light records on the device.
+/// A prepared scene's light records and IES atlas on the device.
 pub(crate) struct GpuLights {
     buffer: wgpu::Buffer,
+    ies_atlas: wgpu::Buffer,
     count: usize,
 }
 
@@ -37,8 +38,9 @@ pub(crate) struct Scratch {
 }
 
 impl GpuContext {
-    /// Uploads the records of a prepared scene (None when there are no lights).
-    pub fn upload(&self, records: &[Record]) -> Result<Option<GpuLights>> {
+    /// Uploads the records and the IES atlas of a prepared scene (None when there are no
+    /// lights).
+    pub fn upload(&self, records: &[Record], ies_atlas: &[f32]) -> Result<Option<GpuLights>> {
         if records.is_empty() {
             return Ok(None);
         }
@@ -61,8 +63,29 @@ impl GpuContext {
         });
         self.queue
             .write_buffer(&buffer, 0, bytemuck::cast_slice(records));
+        let atlas_bytes = std::mem::size_of_val(ies_atlas) as u64;
+        if atlas_bytes > self.limits.max_storage_buffer_binding_size {
+            return Err(LuxError::input(
+                "IES profiles",
+                format!(
+                    "the scene's IES profiles need {atlas_bytes} bytes, over this device's storage binding limit of {} bytes; split the stage with --light",
+                    self.limits.max_storage_buffer_binding_size
+                ),
+            ));
+        }
+        let ies_atlas_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ies atlas"),
+            size: atlas_bytes.max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        if !ies_atlas.is_empty() {
+            self.queue
+                .write_buffer(&ies_atlas_buffer, 0, bytemuck::cast_slice(ies_atlas));
+        }
         Ok(Some(GpuLights {
             buffer,
+            ies_atlas: ies_atlas_buffer,
             count: records.len(),
         }))
     }
@@ -170,6 +193,7 @@ impl GpuContext {
                 // Emission reads no second input; bind the first again (read-only aliasing).
                 entry(3, buf_b.as_ref().unwrap_or(&buf_a)),
                 entry(4, &buf_out),
+                entry(5, &lights.ies_atlas),
             ],
         });
         Scratch {

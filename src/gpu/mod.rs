@@ -4,6 +4,7 @@
 //! and `prepare` only, never on `cpu`.
 
 pub(crate) mod dispatch;
+pub(crate) mod ies_atlas;
 pub(crate) mod record;
 pub(crate) mod shaders;
 
@@ -159,6 +160,7 @@ impl GpuContext {
                 layout_entry(2, wgpu::BufferBindingType::Storage { read_only: true }),
                 layout_entry(3, wgpu::BufferBindingType::Storage { read_only: true }),
                 layout_entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
+                layout_entry(5, wgpu::BufferBindingType::Storage { read_only: true }),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -34,6 +34,8 @@ pub const FLAG_FOCUS_GRADED: u32 = 64;
 pub const FLAG_DARK: u32 = 128;
 /// The shaping is not smooth at the axis directions (`prepare::Profile::axis_singular`).
 pub const FLAG_AXIS_SINGULAR: u32 = 256;
+/// ShapingAPI carries an IES profile (`ies`: atlas base, angleScale, scale).
+pub const FLAG_IES: u32 = 512;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -55,6 +57,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_FOCUS_GRADED", FLAG_FOCUS_GRADED),
     ("FLAG_DARK", FLAG_DARK),
     ("FLAG_AXIS_SINGULAR", FLAG_AXIS_SINGULAR),
+    ("FLAG_IES", FLAG_IES),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
 ];
 
@@ -73,6 +76,9 @@ pub struct Record {
     pub world: [[f32; 4]; 3],
     /// Irradiance: (diffuse, |det M|, cos θ of kink A, cos θ of kink B).
     pub irr: [f32; 4],
+    /// IES (FLAG_IES): (atlas base of the profile, exact in f32; angleScale; normalisation or
+    /// tilt scale; 0).
+    pub ies: [f32; 4],
     pub kind: u32,
     pub flags: u32,
     pub pad: [u32; 2],
@@ -95,8 +101,9 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w as f32]
 }
 
-/// Rounds a prepared light's f64 constants to its GPU record.
-pub fn pack(p: &Prepared) -> Record {
+/// Rounds a prepared light's f64 constants to its GPU record; `ies_base` is where its IES
+/// profile starts in the scene's atlas (`gpu::ies_atlas`).
+pub fn pack(p: &Prepared, ies_base: Option<u32>) -> Record {
     let m = p.to_local;
     // Local = M⁻¹·(x − o): row i is (row_i(M⁻¹), −row_i(M⁻¹)·o).
     let row = |i: usize| v4(m.row(i), -m.row(i).dot(p.origin));
@@ -145,6 +152,10 @@ pub fn pack(p: &Prepared) -> Record {
         r.flags |= FLAG_SHAPING;
         r.focus_tint = v4(s.focus_tint, s.focus);
         r.cone = [s.cone as f32, s.start as f32, 0.0, 0.0];
+    }
+    if let (Some(ies), Some(base)) = (&p.ies, ies_base) {
+        r.flags |= FLAG_IES;
+        r.ies = [base as f32, ies.angle_scale as f32, ies.scale as f32, 0.0];
     }
     let (kind, size) = match p.light.kind {
         LightType::Distant { .. } => {

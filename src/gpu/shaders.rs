@@ -1,10 +1,12 @@
 //! WGSL composition: each kernel file names the modules it needs with `// #import path` lines;
 //! the composer inlines them once each, in dependency order, after a prelude of the constants
-//! shared with Rust: the record's kinds and flags ([`super::record::WGSL_CONSTANTS`]) and the
+//! shared with Rust: the record's kinds and flags ([`super::record::WGSL_CONSTANTS`]), the IES
+//! atlas codes ([`super::ies_atlas::wgsl_constants`]) and the
 //! quadrature rules and tuning constants of [`crate::rules`]. No constant is retyped in WGSL.
 
 use std::collections::HashSet;
 
+use super::ies_atlas;
 use super::record::WGSL_CONSTANTS;
 use crate::rules;
 
@@ -29,6 +31,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     (
         "shared/roots.wgsl",
         include_str!("../../shaders/shared/roots.wgsl"),
+    ),
+    (
+        "shared/ies.wgsl",
+        include_str!("../../shaders/shared/ies.wgsl"),
     ),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
@@ -101,11 +107,12 @@ fn source(path: &str) -> &'static str {
 /// The prelude of shared constants.
 pub fn prelude() -> String {
     let mut s =
-        String::from("// Generated from src/gpu/record.rs (WGSL_CONSTANTS) and src/rules.rs.\n");
+        String::from("// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs and src/rules.rs.\n");
     for (name, value) in WGSL_CONSTANTS
         .iter()
         .copied()
         .chain(rules::wgsl_u32_constants())
+        .chain(ies_atlas::wgsl_constants())
     {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }

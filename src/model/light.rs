@@ -9,6 +9,8 @@
 
 use glam::{DMat3, DMat4, DVec3};
 
+use super::asset::Asset;
+
 use super::schema;
 use crate::error::{LuxError, Result};
 
@@ -55,6 +57,39 @@ pub struct Shaping {
     pub cone_angle: f64,
     /// `inputs:shaping:cone:softness`, clamped to [0, 1] when evaluated.
     pub cone_softness: f64,
+    /// `inputs:shaping:ies:*`, where `ies:file` is authored (DESIGN.md §6 I1–I7).
+    pub ies: Option<Ies>,
+}
+
+/// ShapingAPI's IES inputs (spec/002; DESIGN.md §6).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Ies {
+    /// `inputs:shaping:ies:file`: an LM-63 or EULUMDAT file (detected by content).
+    pub file: Asset,
+    /// `inputs:shaping:ies:angleScale` (§6 I4).
+    pub angle_scale: f64,
+    /// `inputs:shaping:ies:normalize`: divide by the profile's mean intensity (§6 I6).
+    pub normalize: bool,
+}
+
+impl Ies {
+    /// The profile in `file` with the schema's fallbacks for angleScale and normalize.
+    pub fn new(file: Asset) -> Self {
+        Ies {
+            file,
+            angle_scale: schema::shaping_api::IES_ANGLE_SCALE,
+            normalize: schema::shaping_api::IES_NORMALIZE,
+        }
+    }
+}
+
+/// The stage's up axis (`upAxis` metadata): what "down" means for an IES profile's TILT
+/// (DESIGN.md §6 I5) and what DomeLight_1's `poleAxis = scene` follows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UpAxis {
+    #[default]
+    Y,
+    Z,
 }
 
 impl Default for Shaping {
@@ -67,6 +102,7 @@ impl Default for Shaping {
             focus_tint: DVec3::from_array(f::FOCUS_TINT),
             cone_angle: f::CONE_ANGLE,
             cone_softness: f::CONE_SOFTNESS,
+            ies: None,
         }
     }
 }
@@ -149,6 +185,8 @@ pub struct Light {
     pub inputs: LightInputs,
     /// `Some` where ShapingAPI is applied.
     pub shaping: Option<Shaping>,
+    /// The up axis of the stage the light belongs to (Y for lights built in code).
+    pub stage_up: UpAxis,
 }
 
 impl Light {
@@ -165,6 +203,7 @@ impl Light {
             world: DMat4::IDENTITY,
             inputs,
             shaping: None,
+            stage_up: UpAxis::Y,
         }
     }
 
@@ -226,6 +265,11 @@ impl Light {
     }
     pub fn with_shaping(mut self, shaping: Shaping) -> Self {
         self.shaping = Some(shaping);
+        self
+    }
+    /// Sets the stage's up axis (TILT of IES profiles, DomeLight_1 `poleAxis = scene`).
+    pub fn with_stage_up(mut self, up: UpAxis) -> Self {
+        self.stage_up = up;
         self
     }
     /// Sets the local-to-world transform (column-vector convention).
@@ -302,6 +346,9 @@ impl Light {
             }
             finite("inputs:shaping:cone:angle", s.cone_angle)?;
             finite("inputs:shaping:cone:softness", s.cone_softness)?;
+            if let Some(ies) = &s.ies {
+                finite("inputs:shaping:ies:angleScale", ies.angle_scale)?;
+            }
         }
         self.validate_transform()
     }

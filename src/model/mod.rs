@@ -2,9 +2,11 @@
 //! built in code), with the one table of UsdLux schema fallbacks and the resolved values of
 //! authored inputs. Depends on nothing else in the crate (DESIGN.md §1).
 
+pub mod asset;
 pub mod light;
 pub mod schema;
 pub mod value;
 
-pub use light::{Light, LightInputs, LightType, Shaping};
+pub use asset::Asset;
+pub use light::{Ies, Light, LightInputs, LightType, Shaping, UpAxis};
 pub use value::{Input, Value};

@@ -5,17 +5,35 @@
 //! evaluates these in f64; the GPU packer rounds them once into its record. Nothing here
 //! depends on either backend.
 
+pub mod assets;
 pub mod blackbody;
+pub mod ies;
 pub mod normalize;
 pub mod profile;
+
+use std::sync::Arc;
 
 use glam::{DMat3, DVec3};
 
 use crate::error::{LuxError, Result};
-use crate::model::{Light, LightType, Shaping};
+use crate::model::{Light, LightType, Shaping, UpAxis};
+use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
 pub use profile::{Kink, Profile};
+
+/// A light's IES profile as both backends evaluate it (DESIGN.md §6 I7): the factor along a
+/// light-space emission direction e is `scale · Î(e)` with Î the profile's bilinear interpolant
+/// after angleScale.
+#[derive(Clone, Debug)]
+pub struct PreparedIes {
+    pub profile: Arc<ies::Profile>,
+    /// `ies:angleScale` (§6 I4).
+    pub angle_scale: f64,
+    /// `1/mean` with `ies:normalize` (the multipliers and tilt cancel, §6 I6), else the tilt
+    /// factor at the light's tilt (§6 I5).
+    pub scale: f64,
+}
 
 /// ShapingAPI's inputs as the evaluation uses them (DESIGN.md §2 "Shaping", spec/002).
 #[derive(Clone, Debug, PartialEq)]
@@ -73,11 +91,18 @@ pub struct Prepared {
     pub profile: Profile,
     /// A distant light's θmax (half its angular diameter, radians); 0 for other types.
     pub distant_half_angle: f64,
+    /// The IES profile of ShapingAPI, where authored (and the light shapeable).
+    pub ies: Option<PreparedIes>,
 }
 
 impl Prepared {
     /// Validates `light` and computes its constants for `mode`.
     pub fn new(light: &Light, mode: TemperatureMode) -> Result<Self> {
+        Self::with_assets(light, mode, &mut AssetCache::default())
+    }
+
+    /// [`Prepared::new`], loading referenced files through `cache`.
+    pub fn with_assets(light: &Light, mode: TemperatureMode, cache: &mut AssetCache) -> Result<Self> {
         light.validate()?;
         let linear = light.linear();
         let to_local = linear.inverse();
@@ -116,6 +141,27 @@ impl Prepared {
             LightType::Distant { angle } => normalize::distant_half_angle(angle),
             _ => 0.0,
         };
+        let ies = match evaluated.shaping.as_ref().and_then(|s| s.ies.as_ref()) {
+            Some(i) if evaluated.kind.is_shapeable() => {
+                let profile = cache.ies(&i.file).map_err(|source| LuxError::Asset {
+                    light: light.path.clone(),
+                    attr: "inputs:shaping:ies:file".into(),
+                    path: i.file.authored.clone(),
+                    source,
+                })?;
+                let scale = if i.normalize {
+                    profile.inverse_mean()
+                } else {
+                    profile.tilt_factor(tilt_angle(axis, light.stage_up))
+                };
+                Some(PreparedIes {
+                    profile,
+                    angle_scale: i.angle_scale,
+                    scale,
+                })
+            }
+            _ => None,
+        };
         Ok(Prepared {
             base,
             size_factor,
@@ -129,6 +175,7 @@ impl Prepared {
             shaping,
             profile,
             distant_half_angle,
+            ies,
             light: evaluated,
         })
     }
@@ -147,19 +194,34 @@ pub fn base_radiance(light: &Light, mode: TemperatureMode) -> DVec3 {
     scalar * i.color * tint
 }
 
-/// Whether ShapingAPI's factor is exactly 1 along every direction: no focus (or a white tint) and
-/// a cone whose smoothstep starts at or beyond 180° (luxtest authors cone 180, softness 0, to mean
-/// "no cone"). Such a ShapingAPI is dropped from [`Prepared::light`]: the values are the same,
-/// and irradiance can use its closed forms.
+/// Whether ShapingAPI's factor is exactly 1 along every direction: no focus (or a white tint), a
+/// cone whose smoothstep starts at or beyond 180° (luxtest authors cone 180, softness 0, to mean
+/// "no cone") and no IES profile. Such a ShapingAPI is dropped from [`Prepared::light`]: the
+/// values are the same, and irradiance can use its closed forms.
 pub fn shaping_is_identity(s: &Shaping) -> bool {
     let no_focus = s.focus <= 0.0 || s.focus_tint == DVec3::ONE;
     let start_deg = (1.0 - s.cone_softness.clamp(0.0, 1.0)) * s.cone_angle;
-    no_focus && start_deg >= 180.0
+    no_focus && start_deg >= 180.0 && s.ies.is_none()
 }
 
-/// Prepares every light, failing on the first invalid one.
+/// The tilt angle τ of DESIGN.md §6 I5 in degrees: between the light's world primary axis and
+/// the stage's world down (−Y for `upAxis` Y, −Z for Z).
+pub fn tilt_angle(axis: DVec3, up: UpAxis) -> f64 {
+    let down = match up {
+        UpAxis::Y => DVec3::NEG_Y,
+        UpAxis::Z => DVec3::NEG_Z,
+    };
+    axis.cross(down).length().atan2(axis.dot(down)).to_degrees()
+}
+
+/// Prepares every light, failing on the first invalid one; a file referenced by several lights
+/// is loaded once.
 pub fn prepare(lights: &[Light], mode: TemperatureMode) -> Result<Vec<Prepared>> {
-    lights.iter().map(|l| Prepared::new(l, mode)).collect()
+    let mut cache = AssetCache::default();
+    lights
+        .iter()
+        .map(|l| Prepared::with_assets(l, mode, &mut cache))
+        .collect()
 }
 
 /// The scale s when `m` is a similarity (s times an orthogonal matrix) to 1e-12, else None.

@@ -6,8 +6,8 @@ use glam::DVec3;
 
 use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
-use crate::error::Result;
-use crate::gpu::{GpuLights, Kernel, Scratch, record};
+use crate::error::{LuxError, Result};
+use crate::gpu::{GpuLights, Kernel, Scratch, ies_atlas, record};
 use crate::model::Light;
 use crate::prepare::{self, Prepared, TemperatureMode};
 
@@ -42,8 +42,14 @@ impl PreparedScene {
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
-                let records: Vec<record::Record> = lights.iter().map(record::pack).collect();
-                g.upload(&records)?
+                let (atlas, bases) = ies_atlas::scene_atlas(&lights)
+                    .map_err(|e| LuxError::input("IES profiles", e.to_string()))?;
+                let records: Vec<record::Record> = lights
+                    .iter()
+                    .zip(bases)
+                    .map(|(p, base)| record::pack(p, base))
+                    .collect();
+                g.upload(&records, &atlas.data)?
             }
         };
         Ok(PreparedScene {

@@ -127,6 +127,7 @@ pub fn random_light(ty: usize, xf: &str, rng: &mut Rng, id: usize) -> Light {
             } else {
                 rng.range(-0.2, 1.3)
             },
+            ies: None,
         });
     }
     l

@@ -12,7 +12,7 @@ use serde::Serialize;
 
 use super::stage::{self as usd, UsdStage};
 use crate::error::{LuxError, Result};
-use crate::model::{Input, Light, LightInputs, LightType, Shaping, Value};
+use crate::model::{Asset, Ies, Input, Light, LightInputs, LightType, Shaping, UpAxis, Value};
 
 /// Which time the stage was read at.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -170,12 +170,17 @@ impl UsdStage {
             }
             TimeRule::Earliest => usd::Time::Earliest,
         };
+        let info = self.info();
+        let up = if info.up_axis == "Z" {
+            UpAxis::Z
+        } else {
+            UpAxis::Y
+        };
         let lights = self
             .lights_at(at)?
             .into_iter()
-            .map(SceneLight::from_prim)
+            .map(|p| SceneLight::from_prim(p, up))
             .collect();
-        let info = self.info();
         Ok(Scene {
             file: self.file().to_path_buf(),
             up_axis: info.up_axis.clone(),
@@ -205,8 +210,8 @@ fn describe_time(rule: TimeRule) -> String {
 }
 
 impl SceneLight {
-    fn from_prim(p: usd::LightPrim) -> SceneLight {
-        let (light, warning) = match convert(&p) {
+    fn from_prim(p: usd::LightPrim, up: UpAxis) -> SceneLight {
+        let (light, warning) = match convert(&p, up) {
             Ok((light, caveat)) => (Some(light), caveat),
             Err(why) => (None, Some(why)),
         };
@@ -268,6 +273,17 @@ impl Reader<'_> {
             _ => None,
         }
     }
+    /// The asset `name` refers to (authored and resolved paths), `None` when empty.
+    fn asset_ref(&self, name: &str) -> Option<Asset> {
+        match self.get(name) {
+            Ok(Value::Asset { authored, resolved }) if !authored.is_empty() => Some(Asset {
+                authored: authored.clone(),
+                resolved: resolved.clone(),
+                bytes: None,
+            }),
+            _ => None,
+        }
+    }
     fn kind(&self, name: &str, want: &str, got: &Value) -> String {
         format!(
             "{}: {name} holds {got:?}, expected a {want} (schema table mismatch)",
@@ -277,7 +293,10 @@ impl Reader<'_> {
 }
 
 /// The light luxeval evaluates for `p`, with an optional caveat; or why it is not evaluated.
-fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), String> {
+fn convert(
+    p: &usd::LightPrim,
+    up: UpAxis,
+) -> std::result::Result<(Light, Option<String>), String> {
     let r = Reader { p };
     let path = &p.path;
     let ty = p.usd_type.as_str();
@@ -346,11 +365,6 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
         other => return Err(format!("{path}: {other} is not a light type luxeval knows")),
     };
     let shaped = p.applied_schemas.iter().any(|s| s == "ShapingAPI");
-    if shaped && let Some(file) = r.asset("inputs:shaping:ies:file") {
-        return Err(format!(
-            "{path}: ShapingAPI ies:file is not supported yet (@{file}@)"
-        ));
-    }
     let inputs = LightInputs {
         intensity: r.float("inputs:intensity")?,
         exposure: r.float("inputs:exposure")?,
@@ -367,6 +381,15 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
             focus_tint: r.color("inputs:shaping:focusTint")?,
             cone_angle: r.float("inputs:shaping:cone:angle")?,
             cone_softness: r.float("inputs:shaping:cone:softness")?,
+            // DESIGN.md §6 I7: IES inputs are read only where ShapingAPI is applied.
+            ies: match r.asset_ref("inputs:shaping:ies:file") {
+                Some(file) => Some(Ies {
+                    file,
+                    angle_scale: r.float("inputs:shaping:ies:angleScale")?,
+                    normalize: r.bool("inputs:shaping:ies:normalize")?,
+                }),
+                None => None,
+            },
         })
     } else {
         None
@@ -376,7 +399,7 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
     let mut light = Light::new(kind).with_path(path.clone());
     light.inputs = inputs;
     light.shaping = shaping;
-    Ok((light.with_usd_matrix(p.world), caveat))
+    Ok((light.with_usd_matrix(p.world).with_stage_up(up), caveat))
 }
 
 #[cfg(test)]
@@ -428,7 +451,7 @@ mod tests {
             "DomeLight",
             "DomeLight_1",
         ] {
-            let (light, caveat) = convert(&prim(ty, &[])).unwrap();
+            let (light, caveat) = convert(&prim(ty, &[]), UpAxis::Y).unwrap();
             assert_eq!(caveat, None);
             let expected = Light::new(LightType::fallback(ty).unwrap())
                 .with_path(format!("/Lights/{ty}"))
@@ -440,10 +463,10 @@ mod tests {
 
     #[test]
     fn shaping_only_where_applied() {
-        let (plain, _) = convert(&prim("DiskLight", &[])).unwrap();
+        let (plain, _) = convert(&prim("DiskLight", &[]), UpAxis::Y).unwrap();
         assert_eq!(plain.shaping, None);
         let mut p = prim("DiskLight", &["ShapingAPI"]);
-        let (defaults, _) = convert(&p).unwrap();
+        let (defaults, _) = convert(&p, UpAxis::Y).unwrap();
         assert_eq!(defaults.shaping, Some(Shaping::default()));
         set(&mut p, "inputs:shaping:cone:angle", Value::Float(30.0));
         set(
@@ -451,7 +474,7 @@ mod tests {
             "inputs:shaping:focusTint",
             Value::Color([1.0, 0.5, 0.0]),
         );
-        let (authored, _) = convert(&p).unwrap();
+        let (authored, _) = convert(&p, UpAxis::Y).unwrap();
         let s = authored.shaping.unwrap();
         assert_eq!(s.cone_angle, 30.0);
         assert_eq!(s.focus_tint, DVec3::new(1.0, 0.5, 0.0));
@@ -468,7 +491,7 @@ mod tests {
                 resolved: None,
             },
         );
-        let e = convert(&rect).unwrap_err();
+        let e = convert(&rect, UpAxis::Y).unwrap_err();
         assert!(
             e.contains("/Lights/RectLight") && e.contains("texture:file"),
             "{e}"
@@ -483,8 +506,12 @@ mod tests {
                 resolved: None,
             },
         );
-        let e = convert(&ies).unwrap_err();
-        assert!(e.contains("ies:file"), "{e}");
+        // IES inputs are read where ShapingAPI is applied; an unresolved file is reported when
+        // the light is prepared (naming the prim and the file), not skipped here.
+        let (l, _) = convert(&ies, UpAxis::Y).unwrap();
+        let i = l.shaping.unwrap().ies.unwrap();
+        assert_eq!((i.file.authored.as_str(), i.file.resolved), ("a.ies", None));
+        assert_eq!((i.angle_scale, i.normalize), (0.0, false));
 
         // An authored but empty asset path is no texture.
         let mut empty = prim("DomeLight", &[]);
@@ -496,28 +523,28 @@ mod tests {
                 resolved: None,
             },
         );
-        assert!(convert(&empty).is_ok());
+        assert!(convert(&empty, UpAxis::Y).is_ok());
 
         for ty in ["PortalLight", "GeometryLight", "PluginLight"] {
-            let e = convert(&prim(ty, &[])).unwrap_err();
+            let e = convert(&prim(ty, &[]), UpAxis::Y).unwrap_err();
             assert!(e.contains(ty) && e.contains("/Lights/"), "{e}");
         }
         let mut mesh = prim("Mesh", &["MeshLightAPI"]);
         mesh.light_api = Some("MeshLightAPI".into());
-        let e = convert(&mesh).unwrap_err();
+        let e = convert(&mesh, UpAxis::Y).unwrap_err();
         assert!(e.contains("MeshLightAPI"), "{e}");
     }
 
     #[test]
     fn shaping_on_distant_is_a_caveat() {
-        let (light, caveat) = convert(&prim("DistantLight", &["ShapingAPI"])).unwrap();
+        let (light, caveat) = convert(&prim("DistantLight", &["ShapingAPI"]), UpAxis::Y).unwrap();
         assert!(light.shaping.is_some());
         assert!(caveat.unwrap().contains("no effect"));
     }
 
     #[test]
     fn evaluable_filters_and_rejects_unknown_selection() {
-        let mut hidden = SceneLight::from_prim(prim("SphereLight", &[]));
+        let mut hidden = SceneLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
         hidden.path = "/Lights/Hidden".into();
         hidden.visible = false;
         let scene = Scene {
@@ -526,8 +553,8 @@ mod tests {
             meters_per_unit: 0.01,
             time: TimeRule::Earliest,
             lights: vec![
-                SceneLight::from_prim(prim("DiskLight", &[])),
-                SceneLight::from_prim(prim("PortalLight", &[])),
+                SceneLight::from_prim(prim("DiskLight", &[]), UpAxis::Y),
+                SceneLight::from_prim(prim("PortalLight", &[]), UpAxis::Y),
                 hidden,
             ],
         };
@@ -550,7 +577,7 @@ mod tests {
 
     #[test]
     fn json_shape() {
-        let l = SceneLight::from_prim(prim("SphereLight", &[]));
+        let l = SceneLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
         let v = serde_json::to_value(&l).unwrap();
         assert_eq!(v["evaluable"], serde_json::json!(true));
         assert_eq!(v["inputs"][0]["value"], serde_json::json!(1.0));

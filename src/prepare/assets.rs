@@ -1,0 +1,61 @@
+//! Loading the files lights reference, once per prepared scene: a profile referenced by several
+//! lights is read, parsed and packed once.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use super::ies::Profile;
+use crate::assets::ies::parse_any;
+use crate::assets::package;
+use crate::error::AssetError;
+use crate::model::Asset;
+
+/// Profiles already loaded, by resolved path (or by address for in-memory contents).
+#[derive(Default)]
+pub struct AssetCache {
+    profiles: HashMap<String, Arc<Profile>>,
+}
+
+impl AssetCache {
+    /// The IES profile in `asset` (LM-63 or EULUMDAT, detected by content; a `TILT=<file>` is
+    /// read beside it, also inside a package).
+    pub fn ies(&mut self, asset: &Asset) -> Result<Arc<Profile>, AssetError> {
+        let key = match (&asset.bytes, &asset.resolved) {
+            (Some(b), _) => format!("<bytes {:p}>", b.as_ptr()),
+            (None, Some(r)) => r.clone(),
+            (None, None) => return Err(AssetError::Unresolved),
+        };
+        if let Some(p) = self.profiles.get(&key) {
+            return Ok(p.clone());
+        }
+        let bytes: Vec<u8> = match (&asset.bytes, &asset.resolved) {
+            (Some(b), _) => b.to_vec(),
+            (None, Some(r)) => package::read(r).map_err(|source| AssetError::Io {
+                path: r.clone(),
+                source,
+            })?,
+            (None, None) => return Err(AssetError::Unresolved),
+        };
+        let here = asset.display().to_string();
+        let resolver = |name: &str| -> Result<Vec<u8>, String> {
+            match &asset.resolved {
+                Some(r) => {
+                    let path = package::sibling(r, name);
+                    package::read(&path).map_err(|e| format!("{path}: {e}"))
+                }
+                None => Err(format!(
+                    "TILT={name}: {here} was given in memory, so no file beside it can be read"
+                )),
+            }
+        };
+        let profile = parse_any(&bytes, &resolver)
+            .and_then(|f| Profile::new(&f))
+            .map_err(|mut e| {
+                e.file.get_or_insert(here.clone());
+                e
+            })?;
+        let profile = Arc::new(profile);
+        self.profiles.insert(key, profile.clone());
+        Ok(profile)
+    }
+}
