@@ -6,9 +6,14 @@
 use glam::DVec3;
 
 use super::{BAND, CONE_BAND};
+use crate::cpu::ies::{
+    fold_mirror, ies_factor, photometric_angles, scale_polar_angle, type_c_angles,
+};
 use crate::cpu::radiance;
 use crate::cpu::shaping::off_axis_angle;
 use crate::model::LightType;
+use crate::prepare::Prepared;
+use crate::prepare::ies::{HFold, PhotometricType, VFold};
 use crate::query::Reference;
 use crate::testkit::samples::local_extent;
 
@@ -40,7 +45,100 @@ pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
             m = m.min((off_axis_angle(p.axis, e) - cone).abs() / (CONE_BAND * cone) * BAND);
         }
     }
-    m
+    m.min(ies_margin(p, e))
+}
+
+/// How far the GPU's light-space direction may be from the exact one: f32 rounding of the
+/// direction and of the world-to-light map, amplified by the map's condition (radians).
+const IES_DIRECTION_ROUNDING: f64 = 2e-6;
+
+/// Distance (radians, conservatively) of unit emission direction `e` from where f32 cannot
+/// resolve the light's IES factor to the tolerance:
+/// - the jumps of the profile (DESIGN.md §6 I3, I4): the ends of its angle ranges beyond which
+///   it is 0 (not the poles of type C, nor a mirror fold, which are continuous) and angleScale's
+///   window θ' ∈ [0°, 180°]. A distance along an azimuth-like angle is scaled by the cosine of
+///   the other angle (it shrinks toward its poles); angleScale s stretches polar distances by
+///   1/|s|;
+/// - near a zero of the interpolant (a profile falling to 0 toward a range end, or at a mirror
+///   plane): the factor's relative change over `IES_DIRECTION_ROUNDING`, which the GPU's f32
+///   direction legitimately makes, scaled so that it reaches `BAND` where that change is half the
+///   tolerance (as a soft cone edge is excluded where its factor vanishes).
+fn ies_margin(p: &Prepared, e: DVec3) -> f64 {
+    let Some(ies) = &p.ies else {
+        return f64::INFINITY;
+    };
+    let prof = &ies.profile;
+    let el = (p.to_local * e).normalize();
+    let f0 = ies_factor(prof, el, ies.angle_scale);
+    let (t1, t2) = el.any_orthonormal_pair();
+    let mut change: f64 = 0.0;
+    for d in [t1, -t1, t2, -t2] {
+        let f = ies_factor(prof, (el + d * IES_DIRECTION_ROUNDING).normalize(), ies.angle_scale);
+        change = change.max((f - f0).abs());
+    }
+    let sensitivity = if change == 0.0 {
+        f64::INFINITY
+    } else if f0 == 0.0 {
+        0.0
+    } else {
+        BAND * (0.5 * super::TOLERANCE) / (change / f0)
+    };
+    sensitivity.min(ies_jumps(p, el))
+}
+
+/// The distance part of [`ies_margin`] for the light-space direction `el`.
+fn ies_jumps(p: &Prepared, el: DVec3) -> f64 {
+    let Some(ies) = &p.ies else {
+        return f64::INFINITY;
+    };
+    let prof = &ies.profile;
+    let s = ies.angle_scale;
+    let stretch = if s != 0.0 { s.abs().min(1.0) } else { 1.0 };
+    let mut deg = f64::INFINITY;
+    if s != 0.0 {
+        let t = scale_polar_angle(type_c_angles(el).1, s);
+        deg = deg.min(t.abs().min((t - 180.0).abs()));
+    }
+    let Some((h, v)) = photometric_angles(prof.kind, el, s) else {
+        return deg.to_radians() * stretch;
+    };
+    let (h0, h1) = (prof.h[0], prof.h[prof.h.len() - 1]);
+    let (v0, v1) = (prof.v[0], prof.v[prof.v.len() - 1]);
+    let near = |x: f64, a: f64| (x - a).abs();
+    match prof.kind {
+        PhotometricType::C => {
+            if v0 > 0.0 {
+                deg = deg.min(near(v, v0));
+            }
+            if v1 < 180.0 {
+                deg = deg.min(near(v, v1));
+            }
+        }
+        PhotometricType::B | PhotometricType::A => {
+            let hq = fold_mirror(h, prof.h_fold == HFold::Mirror);
+            let vq = fold_mirror(v, prof.v_fold == VFold::Mirror);
+            // B: H is a cone angle about Y, V a plane through Y; A: V a cone angle about Z, H
+            // a plane through Z.
+            let (h_w, v_w) = match prof.kind {
+                PhotometricType::B => (1.0, h.to_radians().cos().abs()),
+                _ => (v.to_radians().cos().abs(), 1.0),
+            };
+            let mut dh = f64::INFINITY;
+            match prof.h_fold {
+                HFold::Constant if prof.kind == PhotometricType::A => dh = near(hq.abs(), 90.0),
+                HFold::Constant => {}
+                HFold::Mirror => dh = near(hq, h1),
+                _ => dh = near(hq, h0).min(near(hq, h1)),
+            }
+            let dv = if prof.v_fold == VFold::Mirror {
+                near(vq, v1)
+            } else {
+                near(vq, v0).min(near(vq, v1))
+            };
+            deg = deg.min(dh * h_w).min(dv * v_w);
+        }
+    }
+    deg.to_radians() * stretch
 }
 
 /// Distance of a radiance ray from the light's discontinuities (dimensionless: radians, or a

@@ -8,6 +8,7 @@
 pub mod assets;
 pub mod blackbody;
 pub mod ies;
+pub mod ies_kinks;
 pub mod normalize;
 pub mod profile;
 
@@ -33,6 +34,8 @@ pub struct PreparedIes {
     /// `1/mean` with `ies:normalize` (the multipliers and tilt cancel, §6 I6), else the tilt
     /// factor at the light's tilt (§6 I5).
     pub scale: f64,
+    /// Where the factor is not smooth, in the light's frame (for the irradiance quadrature).
+    pub kinks: ies_kinks::IesKinks,
 }
 
 /// ShapingAPI's inputs as the evaluation uses them (DESIGN.md §2 "Shaping", spec/002).
@@ -155,6 +158,7 @@ impl Prepared {
                     profile.tilt_factor(tilt_angle(axis, light.stage_up))
                 };
                 Some(PreparedIes {
+                    kinks: ies_kinks::ies_kinks(&profile, i.angle_scale),
                     profile,
                     angle_scale: i.angle_scale,
                     scale,

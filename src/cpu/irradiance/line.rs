@@ -45,6 +45,19 @@ pub fn line_integral<R: Rule>(ctx: &Ctx<R>, a: DVec3, e1: DVec3, x0: f64, x1: f6
     if ctx.p.profile.axis_singular {
         bps.extend(axis_approach(ctx.p.axis, a, e1).map(|xa| (xa, false)));
     }
+    if let Some(ies) = &ctx.p.ies {
+        // The profile's grid lines, in the light's frame: the line maps to a line there.
+        let (al, el) = (ctx.p.to_local * a, ctx.p.to_local * e1);
+        for &(axis, cos) in &ies.kinks.cones {
+            bps.extend(cone_roots_on_line(axis, cos, al, el).into_iter().map(|x| (x, false)));
+        }
+        for &m in &ies.kinks.planes {
+            let den = m.dot(el);
+            if den != 0.0 {
+                bps.push((-m.dot(al) / den, false));
+            }
+        }
+    }
     bps.retain(|b| b.0 >= lo && b.0 <= hi);
     bps.sort_by(|p, q| p.0.total_cmp(&q.0));
     // The line's closest approach to x: X* and the width √m/|e1|, m = |a × e1|²/|e1|².
