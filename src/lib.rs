@@ -44,6 +44,7 @@ pub mod falloff;
 pub(crate) mod gpu;
 pub mod ies;
 pub mod io;
+pub mod plot;
 pub(crate) mod model;
 pub(crate) mod prepare;
 pub(crate) mod query;

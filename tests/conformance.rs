@@ -46,6 +46,7 @@ fn gpu_matches_cpu_on_randomised_lights() {
         // receivers per light under the spec mode here; tests below cover it in depth.
         let counts = check::Samples {
             emission: samples_per_query,
+            intensity: samples_per_query,
             radiance: samples_per_query,
             irradiance: if k == 0 { 12 } else { 0 },
         };
@@ -198,6 +199,7 @@ fn irradiance_matches_cpu_on_every_type_and_transform() {
     let prepared = references(&lights, TemperatureMode::Spec);
     let counts = check::Samples {
         emission: 0,
+        intensity: 0,
         radiance: 0,
         irradiance: 40,
     };

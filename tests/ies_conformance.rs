@@ -41,6 +41,7 @@ fn gpu_matches_cpu_on_ies_shaped_lights() {
             .collect();
         let counts = check::Samples {
             emission: 160,
+            intensity: 160,
             radiance: 160,
             // Irradiance on continuous profiles (kinks only): the quadratures do not split at
             // a profile's jumps.

@@ -20,11 +20,12 @@ const ALLOWED: &[(&str, &[&str])] = &[
         &["error", "model", "prepare", "cpu", "gpu", "query"],
     ),
     ("io", &["error", "io"]),
-    ("ies", &["assets", "prepare", "cpu", "ies"]),
-    ("falloff", &["error", "io", "query", "falloff"]),
+    ("ies", &["assets", "prepare", "cpu", "plot", "ies"]),
+    ("plot", &["error", "io", "plot"]),
+    ("falloff", &["error", "io", "query", "plot", "falloff"]),
     (
         "check",
-        &["error", "model", "cpu", "query", "testkit", "check"],
+        &["error", "model", "prepare", "cpu", "query", "testkit", "check"],
     ),
 ];
 

@@ -43,7 +43,8 @@ fn split_package(path: &str) -> Option<(&str, &str)> {
     Some((&inner[..open], &inner[open + 1..]))
 }
 
-fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+/// A file's bytes, refusing one larger than [`MAX_ASSET_BYTES`].
+pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
     let file = std::fs::File::open(path)?;
     if file.metadata()?.is_dir() {
         return Err(Error::new(ErrorKind::IsADirectory, "is a directory"));

@@ -51,6 +51,7 @@ pub enum Query {
     Emission,
     Radiance,
     Irradiance,
+    Intensity,
 }
 
 /// One light's result for one query.
@@ -125,16 +126,21 @@ pub struct Samples {
     pub emission: usize,
     pub radiance: usize,
     pub irradiance: usize,
+    /// Intensity is checked on the first this many emission directions (it draws none of its
+    /// own, so adding it changes no other sample).
+    pub intensity: usize,
 }
 
 impl Samples {
-    /// `n` emission directions and radiance rays, and `n/4` (rounded up) irradiance receivers:
-    /// each irradiance sample is a quadrature on both sides, ~100× the cost of the others.
+    /// `n` emission directions (also used for intensity) and radiance rays, and `n/4` (rounded
+    /// up) irradiance receivers: each irradiance sample is a quadrature on both sides, ~100× the
+    /// cost of the others.
     pub fn per_query(n: usize) -> Self {
         Samples {
             emission: n,
             radiance: n,
             irradiance: n.div_ceil(4),
+            intensity: n,
         }
     }
 }
@@ -172,6 +178,20 @@ pub fn check_with(
             let e = dvec(dirs[i]).normalize();
             (
                 cpu::emission::emission(p, e),
+                emission_margin(r, e),
+                got[i],
+                dirs[i],
+                None,
+            )
+        }));
+        // Intensity, on the same directions: `L(ω)·A⊥(ω)`, whose discontinuities are the
+        // emission's (the one-sided horizon zeroes both).
+        let ni = counts.intensity.min(dirs.len());
+        let got = scene.intensity(&dirs[..ni], Accumulate::Sum)?;
+        rows.push(compare(r, Query::Intensity, ni, |i| {
+            let e = dvec(dirs[i]).normalize();
+            (
+                cpu::intensity::intensity(p, e),
                 emission_margin(r, e),
                 got[i],
                 dirs[i],

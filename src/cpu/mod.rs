@@ -2,17 +2,19 @@
 //! model and `prepare` only, never on `gpu`.
 //!
 //! Each module that implements a concept evaluated per direction has a WGSL twin of the same
-//! name under `shaders/` (`emission`, `radiance`, `irradiance` and its parts in
+//! name under `shaders/` (`emission`, `radiance`, `intensity`, `irradiance` and its parts in
 //! `irradiance/`; `shaping`, `shapes`, `roots` and `ies` in `shaders/shared/`), with the same function
 //! names in the same order (`tests/twins.rs` checks it). `quadrature` is the reference's own
-//! adaptive integrator.
+//! adaptive integrator; `power` integrates intensity over the sphere.
 //!
 //! Contract shared with the kernels: directions passed to the per-light functions are unit
 //! vectors; the batch entry points below normalise their inputs, as the kernels' entry points do.
 
 pub mod emission;
 pub mod ies;
+pub mod intensity;
 pub mod irradiance;
+pub mod power;
 pub mod quadrature;
 pub mod radiance;
 pub mod roots;
@@ -67,6 +69,13 @@ where
 pub fn emission_batch(lights: &[Prepared], dirs: &[[f32; 3]], per_light: bool) -> Vec<DVec3> {
     batch(lights, dirs.len(), per_light, |l, i| {
         emission::emission(l, dvec(dirs[i]).normalize())
+    })
+}
+
+/// intensity(light, ω) for every light and direction (see [`intensity::intensity`]).
+pub fn intensity_batch(lights: &[Prepared], dirs: &[[f32; 3]], per_light: bool) -> Vec<DVec3> {
+    batch(lights, dirs.len(), per_light, |l, i| {
+        intensity::intensity(l, dvec(dirs[i]).normalize())
     })
 }
 

@@ -6,7 +6,6 @@
 //! with `u` to the right and `v` up. Pixel (column i, row j), row 0 at the top of the image, is
 //! evaluated at its centre: `origin + (i + ½)/W·u + (1 − (j + ½)/H)·v`.
 
-mod font;
 pub mod png;
 mod viridis;
 

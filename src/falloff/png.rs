@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use super::font;
+use crate::plot::font;
 use super::viridis::VIRIDIS;
 use super::{Map, Plane};
 use crate::error::{LuxError, Result};

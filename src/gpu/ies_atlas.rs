@@ -29,9 +29,12 @@ use crate::prepare::ies::{HFold, Profile, VFold};
 pub const HEADER_LEN: usize = 8;
 /// Largest atlas length whose offsets and counts are exact in f32.
 pub const MAX_LEN: usize = 1 << 24;
-/// Steps of the WGSL binary search: enough for any grid of up to 2³² angles, and a bound the
-/// shader compiler sees (lavapipe stops an invocation after 65,535 loop iterations in total).
-pub const SEARCH_STEPS: u32 = 32;
+/// Written-out steps of the WGSL binary search (no loop: lavapipe stops an invocation's loops
+/// after 65,535 iterations in total, and irradiance looks a profile up thousands of times):
+/// enough for any grid of up to 2^16 + 1 angles, which the packer enforces.
+pub const SEARCH_STEPS: u32 = 16;
+/// The longest angle grid the shader's search covers.
+pub const MAX_ANGLES: usize = (1 << SEARCH_STEPS) + 1;
 
 /// Packed profiles: `data` is the `ies_atlas` buffer, `bases[k]` the header of profile k.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,6 +49,8 @@ pub enum AtlasError {
     TooLarge(usize),
     #[error("profile {profile}: candela value {value} does not fit in an f32")]
     NotF32 { profile: usize, value: f64 },
+    #[error("profile {profile}: {count} angles on one axis, more than the {MAX_ANGLES} the GPU lookup covers")]
+    TooManyAngles { profile: usize, count: usize },
 }
 
 /// Packs `profiles` in order (layout in the module documentation).
@@ -60,6 +65,9 @@ pub fn pack_atlas(profiles: &[&Profile]) -> Result<Atlas, AtlasError> {
     let mut data = Vec::with_capacity(len.max(1));
     let mut bases = Vec::with_capacity(profiles.len());
     for (k, p) in profiles.iter().enumerate() {
+        if let Some(count) = [p.h.len(), p.v.len()].into_iter().find(|&n| n > MAX_ANGLES) {
+            return Err(AtlasError::TooManyAngles { profile: k, count });
+        }
         let base = data.len();
         let h_off = base + HEADER_LEN;
         let v_off = h_off + p.h.len();

@@ -39,6 +39,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
     (
+        "intensity.wgsl",
+        include_str!("../../shaders/intensity.wgsl"),
+    ),
+    (
         "irradiance.wgsl",
         include_str!("../../shaders/irradiance.wgsl"),
     ),
@@ -74,16 +78,23 @@ pub enum Kernel {
     Emission,
     Radiance,
     Irradiance,
+    Intensity,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 3] = [Kernel::Emission, Kernel::Radiance, Kernel::Irradiance];
+    pub const ALL: [Kernel; 4] = [
+        Kernel::Emission,
+        Kernel::Radiance,
+        Kernel::Irradiance,
+        Kernel::Intensity,
+    ];
 
     pub fn file(self) -> &'static str {
         match self {
             Kernel::Emission => "emission.wgsl",
             Kernel::Radiance => "radiance.wgsl",
             Kernel::Irradiance => "irradiance.wgsl",
+            Kernel::Intensity => "intensity.wgsl",
         }
     }
 
@@ -92,6 +103,7 @@ impl Kernel {
             Kernel::Emission => "emission_main",
             Kernel::Radiance => "radiance_main",
             Kernel::Irradiance => "irradiance_main",
+            Kernel::Intensity => "intensity_main",
         }
     }
 }

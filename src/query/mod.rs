@@ -120,6 +120,17 @@ impl Evaluator {
         self.prepare(lights)?.emission(dirs, acc)
     }
 
+    /// intensity(light, ω) for every direction (DESIGN.md §3).
+    pub fn intensity(
+        &self,
+        lights: &[Light],
+        dirs: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> Result<Vec<[f32; 3]>> {
+        check_directions("directions", dirs)?;
+        self.prepare(lights)?.intensity(dirs, acc)
+    }
+
     /// radiance(x, ω) for every (point, direction) pair (DESIGN.md §3).
     pub fn radiance(
         &self,

@@ -57,6 +57,22 @@ impl Reference {
         cpu::radiance::radiance(&self.p, x, w.normalize())
     }
 
+    /// intensity along `e` (any non-zero length; normalised here): `∫ L cos dA` far-field.
+    pub fn intensity(&self, e: DVec3) -> DVec3 {
+        cpu::intensity::intensity(&self.p, e.normalize())
+    }
+
+    /// The emitting surface's projected area along `e` (any non-zero length).
+    pub fn projected_area(&self, e: DVec3) -> f64 {
+        cpu::intensity::projected_area(&self.p, e.normalize())
+    }
+
+    /// The total emitted power, RGB (lm per channel for L in nits): the integral of the
+    /// intensity over the sphere; `None` for distant and dome lights.
+    pub fn flux(&self) -> Option<DVec3> {
+        cpu::power::flux(&self.p)
+    }
+
     /// irradiance at `x` on a receiver with normal `n` (any length; 0 for a zero normal),
     /// `diffuse` applied.
     pub fn irradiance(&self, x: DVec3, n: DVec3) -> DVec3 {

@@ -84,6 +84,22 @@ impl PreparedScene {
         })
     }
 
+    /// intensity(light, ω) for every direction (DESIGN.md §3): the far-field RGB intensity
+    /// `∫ L cos dA` along ω (cd for L in nits); 0 for distant and dome lights.
+    pub fn intensity(&self, dirs: &[[f32; 3]], acc: Accumulate) -> Result<Vec<[f32; 3]>> {
+        check_directions("directions", dirs)?;
+        let per_light = acc == Accumulate::PerLight;
+        self.run(Kernel::Intensity, dirs, None, per_light, || {
+            cpu::intensity_batch(&self.lights, dirs, per_light)
+        })
+    }
+
+    /// Each light's total emitted power (RGB, lm per channel for L in nits): the integral of
+    /// its intensity over the sphere, in f64 (`None` for distant and dome lights, at infinity).
+    pub fn flux(&self) -> Vec<Option<DVec3>> {
+        self.lights.iter().map(cpu::power::flux).collect()
+    }
+
     /// radiance(x, ω) for every (point, direction) pair (DESIGN.md §3): ω points from x toward
     /// the light.
     pub fn radiance(

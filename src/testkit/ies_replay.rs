@@ -152,16 +152,13 @@ pub fn replay_ies_factor(atlas: &[f32], base: u32, e: Vec3, angle_scale: f32) ->
         if n == 1 {
             return Some((0, 0.0));
         }
-        let (mut lo, mut hi) = (0u64, n - 1);
+        // The shader's written-out steps: halve the cell count, keep grid[lo] ≤ x.
+        let (mut lo, mut len) = (0u64, n - 1);
         for _ in 0..SEARCH_STEPS {
-            if hi - lo <= 1 {
-                break;
-            }
-            let mid = (lo + hi) / 2;
-            if at(off + mid) <= x {
-                lo = mid
-            } else {
-                hi = mid
+            let half = len / 2;
+            len -= half;
+            if half > 0 && at(off + lo + half) <= x {
+                lo += half;
             }
         }
         let g0 = at(off + lo);

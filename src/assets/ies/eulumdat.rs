@@ -112,12 +112,12 @@ pub fn read_file(path: &Path) -> Result<IesFile, IesError> {
         e.file = Some(name.clone());
         e
     };
-    let bytes =
-        std::fs::read(path).map_err(|e| with_file(IesError::whole_file(K::Io(e.to_string()))))?;
+    let bytes = crate::assets::package::read_file(path)
+        .map_err(|e| with_file(IesError::whole_file(K::Io(e.to_string()))))?;
     let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolver = |tilt: &str| {
         let p = dir.join(tilt);
-        std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()))
+        crate::assets::package::read_file(&p).map_err(|e| format!("{}: {e}", p.display()))
     };
     parse_any(&bytes, &resolver).map_err(with_file)
 }

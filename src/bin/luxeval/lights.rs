@@ -3,16 +3,51 @@
 
 use std::path::Path;
 
-use luxeval::Scene;
+use luxeval::{Reference, Scene, SceneLight, TemperatureMode};
 
 use crate::exit::{CliResult, Failure};
+
+/// Lumens per watt at 555 nm: the photometric watts a luminous flux stands for.
+const LUMENS_PER_WATT: f64 = 683.0;
+
+/// A light's total emitted power (DESIGN.md §3 "intensity" integrated over the sphere): RGB
+/// flux, its luminance in lumens (lights in nits) and watts at 683 lm/W; `Ok(None)` for lights
+/// at infinity (distant, dome) or not evaluated; `Err` when the light cannot be prepared (a
+/// missing IES file, ...).
+fn power(l: &SceneLight) -> Result<Option<serde_json::Value>, String> {
+    let Some(light) = &l.light else {
+        return Ok(None);
+    };
+    let r = Reference::new(light, TemperatureMode::default()).map_err(|e| e.to_string())?;
+    Ok(r.flux().map(|f| {
+        let lumens = 0.2126 * f.x + 0.7152 * f.y + 0.0722 * f.z;
+        serde_json::json!({
+            "rgb": f.to_array(),
+            "lumens": lumens,
+            "watts": lumens / LUMENS_PER_WATT,
+        })
+    }))
+}
 
 pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
     let scene = Scene::load(path, time)?;
     if json {
+        let mut v = serde_json::to_value(&scene).map_err(|e| Failure::runtime(e.to_string()))?;
+        if let Some(lights) = v.get_mut("lights").and_then(|l| l.as_array_mut()) {
+            for (json, l) in lights.iter_mut().zip(&scene.lights) {
+                let (p, err) = match power(l) {
+                    Ok(p) => (p.unwrap_or(serde_json::Value::Null), None),
+                    Err(e) => (serde_json::Value::Null, Some(e)),
+                };
+                json["power"] = p;
+                if let Some(e) = err {
+                    json["power_error"] = e.into();
+                }
+            }
+        }
         outln!(
             "{}",
-            serde_json::to_string_pretty(&scene).map_err(|e| Failure::runtime(e.to_string()))?
+            serde_json::to_string_pretty(&v).map_err(|e| Failure::runtime(e.to_string()))?
         );
         return Ok(());
     }
@@ -35,6 +70,22 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
         }
         if let Some(w) = &l.warning {
             outln!("  warning: {w}");
+        }
+        match power(l) {
+            Ok(Some(p)) => {
+                let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+                let rgb = &p["rgb"];
+                outln!(
+                    "  power  {:.6} lm ({:.6} W at 683 lm/W; RGB flux ({:.6}, {:.6}, {:.6}))",
+                    num(&p["lumens"]),
+                    num(&p["watts"]),
+                    num(&rgb[0]),
+                    num(&rgb[1]),
+                    num(&rgb[2])
+                )
+            }
+            Ok(None) => {}
+            Err(e) => outln!("  power  cannot be computed: {e}"),
         }
         for row in &l.world {
             outln!(

@@ -14,6 +14,7 @@ mod bench;
 mod check;
 mod exit;
 mod falloff;
+mod ies;
 mod info;
 mod lights;
 mod open;
@@ -105,11 +106,30 @@ enum Command {
         #[arg(short, long, value_name = "OUT.npy")]
         output: PathBuf,
     },
+    /// intensity(light, ω): far-field RGB intensity ∫ L cos dA of each light along each direction
+    /// ω (cd for lights in nits); 0 for distant and dome lights, which are at infinity.
+    Intensity {
+        #[command(flatten)]
+        common: QueryArgs,
+        /// Directions, float (N, 3); normalised before use.
+        #[arg(long, value_name = "D.npy")]
+        dirs: PathBuf,
+        /// Output: float32 (N, 3), or (L, N, 3) with --per-light.
+        #[arg(short, long, value_name = "OUT.npy")]
+        output: PathBuf,
+        /// Also write a polar candela plot of the one selected light (--light) in its own
+        /// frame's C0–C180 and C90–C270 planes (luminance, cd), as PNG.
+        #[arg(long, value_name = "PLOT.png")]
+        png: Option<PathBuf>,
+    },
     Falloff(falloff::FalloffArgs),
     /// Run every query on the CPU reference and on the GPU for randomised samples of every light
     /// in the stage, and print the largest relative errors per light and query. Exits 1 when any
     /// is over tolerance (1e-4 away from the documented excluded band).
     Check(check::CheckArgs),
+    /// Report on an IES (LM-63) or EULUMDAT photometric file: header, integrated flux against
+    /// the header's lumens, peak, beam and field angles, and optionally a polar candela plot.
+    Ies(ies::IesArgs),
     /// Measure the throughput of the GPU and CPU paths on a synthetic set of lights.
     Bench(bench::BenchArgs),
 }
@@ -173,7 +193,21 @@ fn run(cli: Cli) -> CliResult {
             },
             &output,
         ),
+        Command::Intensity {
+            common,
+            dirs,
+            output,
+            png,
+        } => query::run(
+            &common,
+            query::Query::Intensity {
+                dirs: &dirs,
+                png: png.as_deref(),
+            },
+            &output,
+        ),
         Command::Falloff(a) => falloff::run(&a),
+        Command::Ies(a) => ies::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Bench(a) => bench::run(a),
     }

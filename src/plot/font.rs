@@ -1,8 +1,20 @@
-//! A 5×7 bitmap font for the labels of falloff PNGs (colour-bar values in lux, the plane's
-//! extent), so that image output needs no font file. Unknown characters draw as a box.
+//! A 5×7 bitmap font for the labels of luxeval's PNGs (falloff colour bars, candela plots), so
+//! that image output needs no font file. Unknown characters draw as a box.
 
 /// Glyph rows, top to bottom; '#' is ink.
 const GLYPHS: &[(char, [&str; 7])] = &[
+    (
+        '°',
+        [
+            ".##..", "#..#.", "#..#.", ".##..", ".....", ".....", ".....",
+        ],
+    ),
+    (
+        '_',
+        [
+            ".....", ".....", ".....", ".....", ".....", ".....", "#####",
+        ],
+    ),
     (
         '0',
         [

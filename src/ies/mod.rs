@@ -3,6 +3,10 @@
 //! up its candela toward a light-space direction exactly as both backends do, and the numbers a
 //! photometric report shows. `luxeval ies FILE` prints them.
 
+mod report;
+
+pub use report::{FLUX_MISMATCH, PlaneReport, Range, Report, trimmed};
+
 pub use crate::assets::ies::eulumdat::{EulumdatInfo, LampSet, parse_eulumdat};
 pub use crate::assets::ies::lm63::{
     Format, Lm63Version, Tilt, TiltSource, TypeCCoverage, type_c_coverage,
