@@ -35,17 +35,17 @@
 // model → usd → prepare → cpu | gpu → query → io, falloff → the CLI (src/bin/luxeval).
 // `assets` (readers of referenced files) is a leaf that `prepare` uses.
 // `rules` holds what the WGSL kernels and their f64 counterparts share; neither backend owns it.
+pub(crate) mod assets;
 #[cfg(any(test, feature = "testkit"))]
 pub mod check;
-pub(crate) mod assets;
 pub(crate) mod cpu;
 pub(crate) mod error;
 pub mod falloff;
 pub(crate) mod gpu;
 pub mod ies;
 pub mod io;
-pub mod plot;
 pub(crate) mod model;
+pub mod plot;
 pub(crate) mod prepare;
 pub(crate) mod query;
 pub(crate) mod rules;
@@ -61,7 +61,7 @@ struct ReadmeDoctests;
 
 pub use error::{GpuFailure, LuxError, Result};
 pub use gpu::{AdapterSummary, DeviceLimits, adapters};
-pub use model::{Input, Light, LightInputs, LightType, Shaping, Value, schema};
+pub use model::{Asset, Ies, Input, Light, LightInputs, LightType, Shaping, UpAxis, Value, schema};
 pub use prepare::TemperatureMode;
 pub use query::{Accumulate, Evaluator, PreparedScene, Reference};
 #[cfg(feature = "usd")]

@@ -1,12 +1,12 @@
 //! The packed f32 atlas and the CPU replay of ies.wgsl's reader against the f64 lookup.
 mod ies_common;
 
-use ies_common::*;
 use glam::{DVec3, Vec3};
-use luxeval::testkit::ies_replay::{AtlasError, HEADER_LEN, pack_atlas, replay_ies_factor};
+use ies_common::*;
 use luxeval::ies::lookup::{fold_h_type_c, fold_mirror, photometric_angles};
 use luxeval::ies::{HFold, VFold};
 use luxeval::ies::{PhotometricType, Profile, ies_factor};
+use luxeval::testkit::ies_replay::{AtlasError, HEADER_LEN, pack_atlas, replay_ies_factor};
 
 /// The layout of atlas.rs, checked field by field on two small profiles.
 #[test]
@@ -211,9 +211,10 @@ fn replay_on_luxtest_profiles() {
         "test_stripes_uniform.ies",
         "test_vstripes_hquadrants_nonuniform.ies",
     ] {
-        let p =
-            Profile::new(&luxeval::ies::read_file(std::path::Path::new(&format!("{dir}/{name}"))).unwrap())
-                .unwrap();
+        let p = Profile::new(
+            &luxeval::ies::read_file(std::path::Path::new(&format!("{dir}/{name}"))).unwrap(),
+        )
+        .unwrap();
         let atlas = pack_atlas(&[&p]).unwrap();
         for _ in 0..20_000 {
             let e32: Vec3 = rng.dir().as_vec3();

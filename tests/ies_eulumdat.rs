@@ -3,8 +3,8 @@
 mod ies_common;
 
 use ies_common::*;
-use luxeval::ies::IesErrorKind as K;
 use luxeval::ies::Format;
+use luxeval::ies::IesErrorKind as K;
 use luxeval::ies::{Profile, ies_factor};
 
 /// An EULUMDAT file: `planes` are the stored planes (Mc1..=Mc2) in file order, cd/klm.
@@ -190,12 +190,20 @@ fn content_detection_ignores_the_extension() {
         ("a.ldt", &ldt, Format::Eulumdat),
         ("a.ies", &ldt, Format::Eulumdat),
         ("a.txt", &ldt, Format::Eulumdat),
-        ("b.ldt", &lm63, Format::Lm63(luxeval::ies::Lm63Version::V2002)),
+        (
+            "b.ldt",
+            &lm63,
+            Format::Lm63(luxeval::ies::Lm63Version::V2002),
+        ),
         ("b", &lm63, Format::Lm63(luxeval::ies::Lm63Version::V2002)),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
-        assert_eq!(luxeval::ies::read_file(&path).unwrap().format, want, "{name}");
+        assert_eq!(
+            luxeval::ies::read_file(&path).unwrap().format,
+            want,
+            "{name}"
+        );
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -5,8 +5,8 @@ mod ies_common;
 
 use std::f64::consts::PI;
 
-use ies_common::*;
 use glam::DVec3;
+use ies_common::*;
 use luxeval::ies::ies_factor;
 
 /// A constant profile's mean is the constant over 0–180 (so normalize gives 1 everywhere).

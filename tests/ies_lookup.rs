@@ -3,8 +3,8 @@
 //! wherever the direction lands; a transposed or mirrored frame gives a different number.
 mod ies_common;
 
-use ies_common::*;
 use glam::DVec3;
+use ies_common::*;
 use luxeval::ies::ies_factor;
 
 const C_LINEAR: fn(f64, f64) -> f64 = |h, v| 100.0 + h + v;

@@ -2,13 +2,14 @@
 //! pmolodo/luxtest, CC-BY-4.0, CRLF line ends).
 mod ies_common;
 
-use ies_common::*;
 use glam::DVec3;
+use ies_common::*;
 use luxeval::ies::{Profile, ies_factor};
 
 fn load(name: &str) -> Profile {
     let path = format!("{}/tests/data/luxtest/{name}", env!("CARGO_MANIFEST_DIR"));
-    let file = luxeval::ies::read_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let file =
+        luxeval::ies::read_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
     Profile::new(&file).unwrap()
 }
 

@@ -25,7 +25,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("falloff", &["error", "io", "query", "plot", "falloff"]),
     (
         "check",
-        &["error", "model", "prepare", "cpu", "query", "testkit", "check"],
+        &[
+            "error", "model", "prepare", "cpu", "query", "testkit", "check",
+        ],
     ),
 ];
 

@@ -178,5 +178,9 @@ fn ies_lookup_has_no_loop() {
     let body = &code[code.find("fn find_interval(").unwrap()..];
     let body = &body[..body.find("\n}").unwrap()];
     let steps = body.matches("search_step(").count();
-    assert_eq!(steps as u32, luxeval::testkit::ies_replay::SEARCH_STEPS, "{body}");
+    assert_eq!(
+        steps as u32,
+        luxeval::testkit::ies_replay::SEARCH_STEPS,
+        "{body}"
+    );
 }

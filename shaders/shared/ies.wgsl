@@ -27,12 +27,18 @@
 //    hi − lo > 1 and finds the same interval.
 // 5. Counts and offsets are read from f32 atlas values (u32(x)): exact because the packer refuses
 //    atlases of 2^24 floats or more.
+// 6. IES_ENABLED is a pipeline-overridable constant: each kernel is built without the lookup
+//    (false) for scenes with no profile, and the irradiance kernel always without it (it
+//    integrates no IES-shaped light, see shaders/irradiance.wgsl). Inlined at every shaping call
+//    of the irradiance quadrature, the lookup took lavapipe's compiler minutes.
 // Not divergences (checked): at a frame's poles (both atan2 arguments zero) atan2_accurate gives
 // 0 and the CPU twin returns 0 explicitly (f64::atan2(0, −0) would be π); the folds 360 − H,
 // 180 − H and 540 − H are exact in f32 on their ranges (Sterbenz).
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
+
+override IES_ENABLED: bool = true;
 
 const IES_DEG_PER_RAD: f32 = 57.2957795130823;
 const IES_RAD_PER_DEG: f32 = 0.0174532925199433;
@@ -262,7 +268,7 @@ fn ies_factor(base: u32, e: vec3<f32>, s: f32) -> f32 {
 // The IES factor of a light record along unit world emission direction e (1 without FLAG_IES);
 // twin of cpu::ies::ies_of.
 fn ies_of(light: Record, e: vec3<f32>) -> f32 {
-    if !has_flag(light, FLAG_IES) {
+    if !IES_ENABLED || !has_flag(light, FLAG_IES) {
         return 1.0;
     }
     let el = normalize(to_local_dir(light, e));

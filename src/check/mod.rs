@@ -13,6 +13,8 @@
 //! - for radiance, a shape's silhouette: the hit point or the closest approach within `BAND` of
 //!   the boundary (as a fraction of the shape's size), grazing rays, and ray origins within
 //!   `BAND` of the surface;
+//! - for intensity, also directions that see a rect or disk nearly edge-on or a cylinder
+//!   nearly end-on (the projected area is a vanishing cosine): see [`intensity_margin`];
 //! - for irradiance, receivers that see only a sliver of the light (at the receiver's horizon,
 //!   at the light's own plane, at a cone edge) or sit on the light: see [`irradiance_margin`].
 //!
@@ -28,7 +30,8 @@ use crate::error::Result;
 use crate::query::{Accumulate, Evaluator, PreparedScene, Reference};
 use crate::testkit::{Rng, emission_samples, irradiance_samples, radiance_samples};
 pub use band::{
-    F32_ROUNDING, IRRADIANCE_SLIVER_FACTOR, emission_margin, irradiance_margin, radiance_margin,
+    F32_ROUNDING, IRRADIANCE_SLIVER_FACTOR, emission_margin, intensity_margin, irradiance_margin,
+    radiance_margin,
 };
 
 /// Relative tolerance of GPU (f32) against CPU (f64).
@@ -185,14 +188,14 @@ pub fn check_with(
             )
         }));
         // Intensity, on the same directions: `L(ω)·A⊥(ω)`, whose discontinuities are the
-        // emission's (the one-sided horizon zeroes both).
+        // emission's (the one-sided horizon zeroes both), plus the edge-on sliver.
         let ni = counts.intensity.min(dirs.len());
         let got = scene.intensity(&dirs[..ni], Accumulate::Sum)?;
         rows.push(compare(r, Query::Intensity, ni, |i| {
             let e = dvec(dirs[i]).normalize();
             (
                 cpu::intensity::intensity(p, e),
-                emission_margin(r, e),
+                intensity_margin(r, e),
                 got[i],
                 dirs[i],
                 None,
@@ -212,8 +215,14 @@ pub fn check_with(
                 Some(dirs[i]),
             )
         }));
-        // Irradiance: the CPU values (quadratures) are computed in parallel.
-        let ni = counts.irradiance;
+        // Irradiance: the CPU values (quadratures) are computed in parallel. Not for
+        // IES-shaped lights: the GPU path takes their irradiance from the CPU reference
+        // (PreparedScene::irradiance), so there is nothing to compare.
+        let ni = if p.ies.is_some() {
+            0
+        } else {
+            counts.irradiance
+        };
         let (pts, nrms) = irradiance_samples(r, ni, &mut rng);
         let got = scene.irradiance(&pts, &nrms, Accumulate::Sum)?;
         let reference: Vec<(DVec3, f64)> = (0..ni)

@@ -5,11 +5,11 @@
 
 use std::path::Path;
 
-use crate::plot::font;
 use super::viridis::VIRIDIS;
 use super::{Map, Plane};
 use crate::error::{LuxError, Result};
 use crate::io::write_atomic;
+use crate::plot::font;
 
 /// How values map to colours.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -12,6 +12,8 @@ pub(crate) struct GpuLights {
     buffer: wgpu::Buffer,
     ies_atlas: wgpu::Buffer,
     count: usize,
+    /// Whether any light has an IES profile (the pipelines with the lookup are needed).
+    has_ies: bool,
 }
 
 /// The buffers of one size class: a chunk capacity (a power of two, or the device's largest
@@ -87,6 +89,9 @@ impl GpuContext {
             buffer,
             ies_atlas: ies_atlas_buffer,
             count: records.len(),
+            has_ies: records
+                .iter()
+                .any(|r| r.flags & super::record::FLAG_IES != 0),
         }))
     }
 
@@ -109,7 +114,9 @@ impl GpuContext {
         if n == 0 || count == 0 {
             return Ok(out);
         }
-        let pipeline = self.pipeline(kernel)?;
+        // The irradiance kernel integrates no IES-shaped light (the host does, see
+        // PreparedScene::irradiance), so it never needs the lookup.
+        let pipeline = self.pipeline(kernel, lights.has_ies && kernel != Kernel::Irradiance)?;
         let capacity = self.chunk_capacity(count, per_light);
         let per_group = self.lights_per_dispatch(kernel).max(1);
         let key = ScratchKey {

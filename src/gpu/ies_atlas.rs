@@ -49,7 +49,9 @@ pub enum AtlasError {
     TooLarge(usize),
     #[error("profile {profile}: candela value {value} does not fit in an f32")]
     NotF32 { profile: usize, value: f64 },
-    #[error("profile {profile}: {count} angles on one axis, more than the {MAX_ANGLES} the GPU lookup covers")]
+    #[error(
+        "profile {profile}: {count} angles on one axis, more than the {MAX_ANGLES} the GPU lookup covers"
+    )]
     TooManyAngles { profile: usize, count: usize },
 }
 
@@ -129,15 +131,15 @@ pub fn scene_atlas(lights: &[Prepared]) -> Result<(Atlas, Vec<Option<u32>>), Atl
     let index: Vec<Option<usize>> = lights
         .iter()
         .map(|p| {
-            p.ies.as_ref().map(|i| {
-                match distinct.iter().position(|d| Arc::ptr_eq(d, &i.profile)) {
+            p.ies.as_ref().map(
+                |i| match distinct.iter().position(|d| Arc::ptr_eq(d, &i.profile)) {
                     Some(k) => k,
                     None => {
                         distinct.push(&i.profile);
                         distinct.len() - 1
                     }
-                }
-            })
+                },
+            )
         })
         .collect();
     let profiles: Vec<&Profile> = distinct.iter().map(|p| p.as_ref()).collect();

@@ -74,7 +74,7 @@ pub(crate) struct GpuContext {
     pub(crate) limits: wgpu::Limits,
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<Kernel, wgpu::ComputePipeline>>,
+    pipelines: Mutex<HashMap<(Kernel, bool), wgpu::ComputePipeline>>,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -179,13 +179,15 @@ impl GpuContext {
         })
     }
 
-    /// The pipeline of `kernel`, compiled on first use.
-    pub fn pipeline(&self, kernel: Kernel) -> Result<wgpu::ComputePipeline> {
+    /// The pipeline of `kernel`, compiled on first use; `ies` selects the variant with the IES
+    /// lookup (the WGSL override `IES_ENABLED`, see the header of shared/ies.wgsl), needed only
+    /// when the scene has a profile.
+    pub fn pipeline(&self, kernel: Kernel, ies: bool) -> Result<wgpu::ComputePipeline> {
         let mut cache = self
             .pipelines
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(p) = cache.get(&kernel) {
+        if let Some(p) = cache.get(&(kernel, ies)) {
             return Ok(p.clone());
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -195,6 +197,7 @@ impl GpuContext {
                 label: Some(kernel.file()),
                 source: wgpu::ShaderSource::Wgsl(shaders::compose(kernel).into()),
             });
+        let constants = [("IES_ENABLED", if ies { 1.0 } else { 0.0 })];
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -202,7 +205,10 @@ impl GpuContext {
                 layout: Some(&self.pipeline_layout),
                 module: &module,
                 entry_point: Some(kernel.entry_point()),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants,
+                    ..Default::default()
+                },
                 cache: None,
             });
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -211,7 +217,7 @@ impl GpuContext {
                 e,
             ));
         }
-        cache.insert(kernel, pipeline.clone());
+        cache.insert((kernel, ies), pipeline.clone());
         Ok(pipeline)
     }
 

@@ -118,8 +118,9 @@ fn source(path: &str) -> &'static str {
 
 /// The prelude of shared constants.
 pub fn prelude() -> String {
-    let mut s =
-        String::from("// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs and src/rules.rs.\n");
+    let mut s = String::from(
+        "// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs and src/rules.rs.\n",
+    );
     for (name, value) in WGSL_CONSTANTS
         .iter()
         .copied()

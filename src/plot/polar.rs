@@ -151,7 +151,15 @@ mod tests {
     fn plane_directions() {
         let [c0, c90] = c_plane_curves(|e| e.x + 10.0 * e.y, 90.0);
         // s = 90° in C0–C180 is +X; in C90–C270 it is +Y.
-        assert!(c0.samples.iter().any(|&(s, v)| s == 90.0 && (v - 1.0).abs() < 1e-12));
-        assert!(c90.samples.iter().any(|&(s, v)| s == 90.0 && (v - 10.0).abs() < 1e-12));
+        assert!(
+            c0.samples
+                .iter()
+                .any(|&(s, v)| s == 90.0 && (v - 1.0).abs() < 1e-12)
+        );
+        assert!(
+            c90.samples
+                .iter()
+                .any(|&(s, v)| s == 90.0 && (v - 10.0).abs() < 1e-12)
+        );
     }
 }

@@ -6,11 +6,11 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 
-use crate::assets::ies::{IesError, IesErrorKind as K};
 pub use crate::assets::ies::PhotometricType;
 use crate::assets::ies::lm63::{
     END_TOLERANCE_DEG, IesFile, Tilt, TypeCCoverage, coverage_and_ends,
 };
+use crate::assets::ies::{IesError, IesErrorKind as K};
 
 /// How a horizontal angle folds onto the stored grid (§6 I3). Codes are the atlas's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

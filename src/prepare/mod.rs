@@ -105,7 +105,11 @@ impl Prepared {
     }
 
     /// [`Prepared::new`], loading referenced files through `cache`.
-    pub fn with_assets(light: &Light, mode: TemperatureMode, cache: &mut AssetCache) -> Result<Self> {
+    pub fn with_assets(
+        light: &Light,
+        mode: TemperatureMode,
+        cache: &mut AssetCache,
+    ) -> Result<Self> {
         light.validate()?;
         let linear = light.linear();
         let to_local = linear.inverse();

@@ -41,9 +41,7 @@ fn grid(rng: &mut Rng, a: f64, b: f64, n: usize, spread: usize) -> Vec<f64> {
     let last = out.len() - 1;
     out[last] = b;
     // Three decimals, as files print them; keep them increasing.
-    out.iter()
-        .map(|x| (x * 1000.0).round() / 1000.0)
-        .collect()
+    out.iter().map(|x| (x * 1000.0).round() / 1000.0).collect()
 }
 
 /// A random profile of shape `SHAPES[shape]` as LM-63-2002 text. With `continuous`, the values
@@ -86,7 +84,11 @@ pub fn random_profile(rng: &mut Rng, shape: usize, continuous: bool) -> Vec<u8> 
         }
     };
     let (v0, v1) = (v[0], v[v.len() - 1]);
-    let (a, b, c) = (rng.range(0.2, 1.0), rng.range(0.0, 2.0), rng.range(0.0, 3.0));
+    let (a, b, c) = (
+        rng.range(0.2, 1.0),
+        rng.range(0.0, 2.0),
+        rng.range(0.0, 3.0),
+    );
     let mut values = Vec::new();
     for &hh in &h {
         for &vv in &v {
@@ -110,7 +112,8 @@ pub fn random_profile(rng: &mut Rng, shape: usize, continuous: bool) -> Vec<u8> 
             .collect::<Vec<_>>()
             .join(" ")
     };
-    let mut s = String::from("IESNA:LM-63-2002\r\n[TEST] luxeval testkit random profile\r\nTILT=NONE\r\n");
+    let mut s =
+        String::from("IESNA:LM-63-2002\r\n[TEST] luxeval testkit random profile\r\nTILT=NONE\r\n");
     s += &format!(
         "1 -1 1 {} {} {kind} 2 0.1 0.1 0\r\n1 1 0\r\n",
         v.len(),

@@ -6,7 +6,6 @@ use glam::Vec3;
 
 use crate::prepare::ies::{HFold, PhotometricType, VFold};
 
-
 pub use crate::gpu::ies_atlas::{
     Atlas, AtlasError, HEADER_LEN, MAX_LEN, SEARCH_STEPS, pack_atlas, wgsl_constants,
 };

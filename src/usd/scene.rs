@@ -293,10 +293,7 @@ impl Reader<'_> {
 }
 
 /// The light luxeval evaluates for `p`, with an optional caveat; or why it is not evaluated.
-fn convert(
-    p: &usd::LightPrim,
-    up: UpAxis,
-) -> std::result::Result<(Light, Option<String>), String> {
+fn convert(p: &usd::LightPrim, up: UpAxis) -> std::result::Result<(Light, Option<String>), String> {
     let r = Reader { p };
     let path = &p.path;
     let ty = p.usd_type.as_str();

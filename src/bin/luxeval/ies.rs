@@ -23,15 +23,13 @@ pub struct IesArgs {
 
 pub fn run(a: &IesArgs) -> CliResult {
     let file = ies::read_file(&a.file).map_err(|e| Failure::bad_input(e.to_string()))?;
-    let profile = Profile::new(&file).map_err(|e| {
-        Failure::bad_input(format!("{}: {e}", a.file.display()))
-    })?;
+    let profile = Profile::new(&file)
+        .map_err(|e| Failure::bad_input(format!("{}: {e}", a.file.display())))?;
     let report = Report::new(&a.file, &file, &profile);
     if let Some(png) = &a.png {
-        report.plot(&profile).write_png(
-            png,
-            &format!("polar candela plot of {}", a.file.display()),
-        )?;
+        report
+            .plot(&profile)
+            .write_png(png, &format!("polar candela plot of {}", a.file.display()))?;
     }
     for w in &report.warnings {
         eprintln!("warning: {}: {w}", a.file.display());
@@ -95,11 +93,8 @@ pub fn run(a: &IesArgs) -> CliResult {
         "  flux              {} lm integrated{}",
         trimmed(r.integrated_lumens),
         match (r.rated_lumens, r.lumen_ratio) {
-            (Some(rated), Some(ratio)) => format!(
-                "; rated {} lm ({:.1} %)",
-                trimmed(rated),
-                100.0 * ratio
-            ),
+            (Some(rated), Some(ratio)) =>
+                format!("; rated {} lm ({:.1} %)", trimmed(rated), 100.0 * ratio),
             _ => String::new(),
         }
     );

@@ -12,10 +12,21 @@ use crate::open;
 
 /// Which query, with its input files.
 pub enum Query<'a> {
-    Emission { dirs: &'a Path },
-    Radiance { points: &'a Path, dirs: &'a Path },
-    Irradiance { points: &'a Path, normals: &'a Path },
-    Intensity { dirs: &'a Path, png: Option<&'a Path> },
+    Emission {
+        dirs: &'a Path,
+    },
+    Radiance {
+        points: &'a Path,
+        dirs: &'a Path,
+    },
+    Irradiance {
+        points: &'a Path,
+        normals: &'a Path,
+    },
+    Intensity {
+        dirs: &'a Path,
+        png: Option<&'a Path>,
+    },
 }
 
 pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
@@ -80,12 +91,7 @@ fn write_rows(
 /// The polar candela plot of the one light of `scene`: its intensity's luminance (Rec.709 Y)
 /// in the light's own C0–C180 and C90–C270 planes (light-space directions mapped to world by its
 /// transform), evaluated on the scene's device.
-fn plot_light(
-    eval: &Evaluator,
-    scene: &PreparedScene,
-    args: &SceneArgs,
-    png: &Path,
-) -> CliResult {
+fn plot_light(eval: &Evaluator, scene: &PreparedScene, args: &SceneArgs, png: &Path) -> CliResult {
     let Some(light) = scene.lights().next() else {
         return Err(Failure::bad_input(format!(
             "{}: the selected light is not evaluated (see the warnings above)",

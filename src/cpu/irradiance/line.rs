@@ -49,7 +49,11 @@ pub fn line_integral<R: Rule>(ctx: &Ctx<R>, a: DVec3, e1: DVec3, x0: f64, x1: f6
         // The profile's grid lines, in the light's frame: the line maps to a line there.
         let (al, el) = (ctx.p.to_local * a, ctx.p.to_local * e1);
         for &(axis, cos) in &ies.kinks.cones {
-            bps.extend(cone_roots_on_line(axis, cos, al, el).into_iter().map(|x| (x, false)));
+            bps.extend(
+                cone_roots_on_line(axis, cos, al, el)
+                    .into_iter()
+                    .map(|x| (x, false)),
+            );
         }
         for &m in &ies.kinks.planes {
             let den = m.dot(el);
