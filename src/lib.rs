@@ -41,6 +41,7 @@ pub(crate) mod error;
 pub mod falloff;
 pub(crate) mod gpu;
 pub mod io;
+pub mod limits;
 pub(crate) mod model;
 pub(crate) mod prepare;
 pub(crate) mod query;
@@ -57,6 +58,7 @@ struct ReadmeDoctests;
 
 pub use error::{GpuFailure, LuxError, Result};
 pub use gpu::{AdapterSummary, DeviceLimits, adapters};
+pub use limits::Limits;
 pub use model::{Input, Light, LightInputs, LightType, Shaping, Value, schema};
 pub use prepare::TemperatureMode;
 pub use query::{Accumulate, Evaluator, PreparedScene, Reference};
