@@ -81,9 +81,12 @@ impl Scene {
     /// Opens `path` (`.usda`, `.usdc`, `.usdz`) with every composition arc and payload loaded and
     /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
     /// else at USD's EarliestTime (DESIGN.md §2).
+    ///
+    /// The stage is read on a thread of its own with a large stack (see [`STACK_BYTES`]), so
+    /// that a legal deep stage does not overflow the caller's stack.
     pub fn load(path: &Path, time: Option<f64>) -> Result<Scene> {
         check_time(time)?;
-        UsdStage::open(path)?.scene(time)
+        on_large_stack(|| UsdStage::open(path)?.scene(time))
     }
 
     /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
@@ -186,6 +189,34 @@ impl UsdStage {
     }
 }
 
+/// The stack of the thread that reads a stage. openusd's text parser and composition engine
+/// recurse once or more per namespace level; measured in a debug build, a 10 000-level stage
+/// needs about 140 MiB. The limit on namespace depth (docs/INPUTS.md, default 1 000) is refused
+/// before anything recurses that deep; this leaves room to raise it about tenfold. Memory is
+/// only reserved, and committed as the stack grows.
+pub const STACK_BYTES: usize = 512 << 20;
+
+/// Runs `f` on a scoped thread with a [`STACK_BYTES`] stack and returns what it returns.
+fn on_large_stack<T: Send>(f: impl FnOnce() -> Result<T> + Send) -> Result<T> {
+    std::thread::scope(|s| {
+        let handle = std::thread::Builder::new()
+            .name("luxeval-stage".into())
+            .stack_size(STACK_BYTES)
+            .spawn_scoped(s, f);
+        match handle {
+            Ok(h) => match h.join() {
+                Ok(r) => r,
+                Err(panic) => std::panic::resume_unwind(panic),
+            },
+            // No thread (out of memory or address space): read on this one.
+            Err(_) => Err(LuxError::input(
+                "stage",
+                "cannot start the thread that reads the stage (out of memory?)",
+            )),
+        }
+    })
+}
+
 fn check_time(time: Option<f64>) -> Result<()> {
     match time.filter(|t| !t.is_finite()) {
         Some(t) => Err(LuxError::input(
@@ -283,6 +314,18 @@ fn convert(p: &usd::LightPrim) -> std::result::Result<(Light, Option<String>), S
     let ty = p.usd_type.as_str();
     if let Some(why) = &p.transform_error {
         return Err(why.clone());
+    }
+    if let Some(api) = &p.light_api
+        && api == "LightAPI"
+    {
+        let on = match ty {
+            "" => "an untyped prim".to_string(),
+            ty => format!("a {ty} prim"),
+        };
+        return Err(format!(
+            "{path}: LightAPI is applied to {on}, which is not a UsdLux light type; \
+             luxeval does not evaluate it"
+        ));
     }
     if let Some(api) = &p.light_api {
         let on = match ty {
