@@ -3,12 +3,10 @@
 
 use std::path::Path;
 
-use luxeval::Scene;
-
 use crate::exit::{CliResult, Failure};
 
 pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
-    let scene = Scene::load(path, time)?;
+    let scene = crate::open::load(path, time)?;
     if json {
         outln!(
             "{}",
