@@ -365,6 +365,7 @@ cases! {
     disk_full_while_writing_exr: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "64,64", "-o", "{out}/m.exr", "--png", "{out}/m.png", "--device", "cpu"], exit: 1, fsize: Some(1000), says: &["writing", "m.exr"], ..Case::default() };
     no_adapter_with_device_gpu: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 1, env: NO_GPU, says: &["no GPU adapter"], ..Case::default() };
     no_adapter_falls_back_to_the_cpu: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy"], exit: 0, env: NO_GPU, lit: true, says: &["warning: no GPU adapter", "CPU reference"], ..Case::default() };
+    gpu_device_lost: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 1, gpu: true, env: &[("LUXEVAL_TEST_FAULT", "device-lost")], says: &["GPU", "device was lost"], ..Case::default() };
     check_without_adapter: Case { args: &["check", "{in}/ok.usda", "--samples", "10"], exit: 1, env: NO_GPU, says: &["GPU"], ..Case::default() };
 }
 
