@@ -155,18 +155,29 @@ fn run(name: &str, case: &Case) {
     let o = command(&args, case.env, case.fsize).output().unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     let context = format!("case {name}: luxeval {}\nstderr:\n{stderr}", args.join(" "));
-    for crash in ["panicked", "overflowed its stack", "fatal runtime error", "RUST_BACKTRACE"] {
+    for crash in [
+        "panicked",
+        "overflowed its stack",
+        "fatal runtime error",
+        "RUST_BACKTRACE",
+    ] {
         assert!(!stderr.contains(crash), "{context}");
     }
     assert_eq!(o.status.code(), Some(case.exit), "{context}");
     for s in case.says {
         let s = expand(s, &input, &out);
-        assert!(stderr.contains(&s), "expected {s:?} in the message; {context}");
+        assert!(
+            stderr.contains(&s),
+            "expected {s:?} in the message; {context}"
+        );
     }
     assert_eq!(snapshot(&input), before, "the inputs changed; {context}");
     let written = snapshot(&out);
     if case.exit != 0 {
-        assert!(written.is_empty(), "a failed run left {written:?}; {context}");
+        assert!(
+            written.is_empty(),
+            "a failed run left {written:?}; {context}"
+        );
         return;
     }
     let mut any_lit = false;
@@ -181,7 +192,11 @@ fn run(name: &str, case: &Case) {
     }
     assert!(!case.lit || any_lit, "the output is all zeros; {context}");
     if !case.same_as.is_empty() {
-        let args: Vec<String> = case.same_as.iter().map(|a| expand(a, &input, &out)).collect();
+        let args: Vec<String> = case
+            .same_as
+            .iter()
+            .map(|a| expand(a, &input, &out))
+            .collect();
         let r = command(&args, case.env, None).output().unwrap();
         assert!(r.status.success(), "reference run failed; {context}");
         assert_eq!(
@@ -211,7 +226,14 @@ macro_rules! cases {
 macro_rules! emission {
     ($scene:expr, $dirs:expr) => {
         &[
-            "emission", $scene, "--dirs", $dirs, "-o", "{out}/out.npy", "--device", "cpu",
+            "emission",
+            $scene,
+            "--dirs",
+            $dirs,
+            "-o",
+            "{out}/out.npy",
+            "--device",
+            "cpu",
         ]
     };
 }
@@ -245,7 +267,10 @@ fn zero_sublayer(d: &Path) {
     .unwrap();
 }
 
-const NO_GPU: &[(&str, &str)] = &[("VK_DRIVER_FILES", "/nonexistent/icd.json"), ("VK_ICD_FILENAMES", "/nonexistent/icd.json")];
+const NO_GPU: &[(&str, &str)] = &[
+    ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+    ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+];
 
 cases! {
     // --- An output path that is one of the inputs, by any spelling, or not a file ---------------

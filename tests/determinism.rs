@@ -80,7 +80,9 @@ fn subnormal_and_huge_directions_on_the_gpu_match_the_cpu() {
             (
                 "emission",
                 gpu.emission(&lights, &s, Accumulate::PerLight).unwrap(),
-                Evaluator::cpu().emission(&lights, &s, Accumulate::PerLight).unwrap(),
+                Evaluator::cpu()
+                    .emission(&lights, &s, Accumulate::PerLight)
+                    .unwrap(),
             ),
             (
                 "radiance",

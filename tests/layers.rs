@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 /// Each layer and the crate modules it may name.
 const ALLOWED: &[(&str, &[&str])] = &[
     ("model", &["error", "model"]),
-    ("usd", &["error", "model", "usd"]),
+    // `limits` is a leaf like `error`: the bounds every reader checks (docs/INPUTS.md).
+    ("limits", &["error", "limits"]),
+    ("usd", &["error", "limits", "model", "usd"]),
     ("prepare", &["error", "model", "prepare"]),
     ("rules", &["rules"]),
     ("cpu", &["error", "model", "prepare", "rules", "cpu"]),
@@ -18,7 +20,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "query",
         &["error", "model", "prepare", "cpu", "gpu", "query"],
     ),
-    ("io", &["error", "io"]),
+    ("io", &["error", "limits", "io"]),
     ("falloff", &["error", "io", "query", "falloff"]),
     (
         "check",

@@ -114,7 +114,10 @@ impl GpuContext {
         {
             *scratch = None;
             return Err(LuxError::gpu(
-                format!("the device was lost ({why}) while running {}", kernel.entry_point()),
+                format!(
+                    "the device was lost ({why}) while running {}",
+                    kernel.entry_point()
+                ),
                 GpuFailure::Lost,
             ));
         }

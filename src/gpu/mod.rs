@@ -152,8 +152,16 @@ impl GpuContext {
         let lost = Arc::new(Mutex::new(None));
         let on_lost = Arc::clone(&lost);
         device.set_device_lost_callback(move |reason, message| {
-            *on_lost.lock().unwrap_or_else(std::sync::PoisonError::into_inner) =
-                Some(format!("{reason:?}{}", if message.is_empty() { String::new() } else { format!(": {message}") }));
+            *on_lost
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(format!(
+                "{reason:?}{}",
+                if message.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {message}")
+                }
+            ));
         });
         // Fault injection for tests/bad_inputs.rs: a device that is lost once opened, to check
         // that a lost device is a runtime failure (exit 1) with a clear message, not a hang,

@@ -217,9 +217,12 @@ mod tests {
             assert!(check_outputs(&[("-o", &hard)], &[("--dirs", &a)]).is_err());
         }
         // Two outputs that do not exist yet but are one path.
-        let e = check_outputs(&[("-o", &fresh), ("--png", &dir.path().join("sub/../b.npy"))], &[])
-            .unwrap_err()
-            .to_string();
+        let e = check_outputs(
+            &[("-o", &fresh), ("--png", &dir.path().join("sub/../b.npy"))],
+            &[],
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("--png") && e.contains("-o"), "{e}");
         // A directory in the way.
         let e = check_outputs(&[("-o", &dir.path().join("sub"))], &[])

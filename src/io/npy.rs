@@ -48,7 +48,10 @@ pub fn read_vec3(path: &Path) -> Result<Vec<[f32; 3]>> {
                 if r.iter().any(|v| v.is_finite() && v.abs() > f32::MAX as f64) {
                     return Err(format_err(
                         path,
-                        format!("row {i} {r:?} does not fit float32 (largest {:e})", f32::MAX),
+                        format!(
+                            "row {i} {r:?} does not fit float32 (largest {:e})",
+                            f32::MAX
+                        ),
                     ));
                 }
                 Ok(r.map(|v| v as f32))
@@ -181,8 +184,7 @@ fn read_rows(path: &Path) -> Result<Rows> {
     }
     let mut text = vec![0u8; header_len];
     read(&mut text, "header")?;
-    let text = String::from_utf8(text)
-        .map_err(|_| format_err(path, "the header is not text"))?;
+    let text = String::from_utf8(text).map_err(|_| format_err(path, "the header is not text"))?;
     let h = parse_header(&text).map_err(|why| format_err(path, format!("header {why}")))?;
     limits.check_samples(&path.display().to_string(), h.rows)?;
     // Overflow-free: a header whose rows × 3 × itemsize wraps around is refused, not read as
@@ -204,7 +206,10 @@ fn read_rows(path: &Path) -> Result<Rows> {
             )
         })?;
     let mut data = vec![0u8; bytes as usize];
-    read(&mut data, "data (the header declares more rows than the file holds)")?;
+    read(
+        &mut data,
+        "data (the header declares more rows than the file holds)",
+    )?;
     let mut extra = [0u8; 1];
     match r.read(&mut extra) {
         Ok(0) => {}
@@ -221,7 +226,13 @@ fn read_rows(path: &Path) -> Result<Rows> {
     }
     let n = h.rows as usize;
     // Element k of the file is row k / 3, column k % 3 (C order) or row k % n, column k / n.
-    let at = |k: usize| if h.fortran { (k % n, k / n) } else { (k / 3, k % 3) };
+    let at = |k: usize| {
+        if h.fortran {
+            (k % n, k / n)
+        } else {
+            (k / 3, k % 3)
+        }
+    };
     Ok(match h.item {
         4 => {
             let mut rows = vec![[0f32; 3]; n];
@@ -266,7 +277,8 @@ fn parse_header(text: &str) -> std::result::Result<Header, String> {
     let mut shape: Option<Vec<u64>> = None;
     let mut rest = body.trim();
     while !rest.is_empty() {
-        let (key, after) = string_literal(rest).ok_or_else(|| format!("bad key in {:?}", clip(text)))?;
+        let (key, after) =
+            string_literal(rest).ok_or_else(|| format!("bad key in {:?}", clip(text)))?;
         let after = after
             .trim_start()
             .strip_prefix(':')

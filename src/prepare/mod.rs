@@ -144,7 +144,12 @@ pub const MAX_LENGTH: f64 = 1e18;
 /// is written in, naming the attribute that makes it so (docs/INPUTS.md "float32"). Both paths
 /// refuse the same lights, before any work. The radiance bound leaves room for what the queries
 /// multiply it by: the focus tint (emission, radiance) and π · diffuse (irradiance).
-fn check_fits_f32(light: &Light, base: DVec3, size_factor: f64, mode: TemperatureMode) -> Result<()> {
+fn check_fits_f32(
+    light: &Light,
+    base: DVec3,
+    size_factor: f64,
+    mode: TemperatureMode,
+) -> Result<()> {
     let i = &light.inputs;
     let tint = light
         .shaping
@@ -155,15 +160,33 @@ fn check_fits_f32(light: &Light, base: DVec3, size_factor: f64, mode: Temperatur
     if !(peak <= f32::MAX as f64) {
         // Blame the factor that contributes most (in octaves) to the overflow.
         let temp = if i.enable_color_temperature {
-            temperature_rgb(i.color_temperature, mode).abs().max_element()
+            temperature_rgb(i.color_temperature, mode)
+                .abs()
+                .max_element()
         } else {
             1.0
         };
         let factors = [
-            ("inputs:intensity", i.intensity.to_string(), i.intensity.abs()),
-            ("inputs:exposure", i.exposure.to_string(), 2f64.powf(i.exposure)),
-            ("inputs:color", format!("{:?}", i.color.to_array()), i.color.abs().max_element()),
-            ("inputs:colorTemperature", i.color_temperature.to_string(), temp),
+            (
+                "inputs:intensity",
+                i.intensity.to_string(),
+                i.intensity.abs(),
+            ),
+            (
+                "inputs:exposure",
+                i.exposure.to_string(),
+                2f64.powf(i.exposure),
+            ),
+            (
+                "inputs:color",
+                format!("{:?}", i.color.to_array()),
+                i.color.abs().max_element(),
+            ),
+            (
+                "inputs:colorTemperature",
+                i.color_temperature.to_string(),
+                temp,
+            ),
             ("inputs:normalize", "true".to_string(), 1.0 / size_factor),
             ("inputs:shaping:focusTint", format!("{tint}"), tint),
             ("inputs:diffuse", i.diffuse.to_string(), i.diffuse.abs()),
@@ -186,7 +209,9 @@ fn check_fits_f32(light: &Light, base: DVec3, size_factor: f64, mode: Temperatur
         ));
     }
     let sizes: &[(&str, f64)] = match light.kind {
-        LightType::Sphere { radius, .. } | LightType::Disk { radius } => &[("inputs:radius", radius)],
+        LightType::Sphere { radius, .. } | LightType::Disk { radius } => {
+            &[("inputs:radius", radius)]
+        }
         LightType::Rect { width, height } => &[("inputs:width", width), ("inputs:height", height)],
         LightType::Cylinder { length, radius, .. } => {
             &[("inputs:length", length), ("inputs:radius", radius)]

@@ -134,9 +134,14 @@ impl PreparedScene {
                     (Kernel::Emission, _) => {
                         g.run(kernel, lights, &mut scratch, &unit_rows(a), b, per_light)
                     }
-                    (_, Some(b)) => {
-                        g.run(kernel, lights, &mut scratch, a, Some(&unit_rows(b)), per_light)
-                    }
+                    (_, Some(b)) => g.run(
+                        kernel,
+                        lights,
+                        &mut scratch,
+                        a,
+                        Some(&unit_rows(b)),
+                        per_light,
+                    ),
                     (_, None) => g.run(kernel, lights, &mut scratch, a, b, per_light),
                 }
             }

@@ -445,7 +445,10 @@ impl Walk<'_> {
         for &l in &self.stacks[*stack] {
             let specs = &self.layers[l];
             for c in specs.children.get(path).into_iter().flatten() {
-                if !out.iter().any(|e| matches!(e, Edge::Child((_, p)) if p == c)) {
+                if !out
+                    .iter()
+                    .any(|e| matches!(e, Edge::Child((_, p)) if p == c))
+                {
                     out.push(Edge::Child((*stack, c.clone())));
                 }
             }
@@ -478,7 +481,8 @@ impl Walk<'_> {
             Done(Metrics),
         }
         let mut state: HashMap<Site, State> = HashMap::new();
-        let roots: Vec<Site> = self.edges(&(root, sdf::Path::abs_root()))
+        let roots: Vec<Site> = self
+            .edges(&(root, sdf::Path::abs_root()))
             .into_iter()
             .filter_map(|e| match e {
                 Edge::Child(s) => Some(s),
@@ -494,7 +498,10 @@ impl Walk<'_> {
                     edges: self.edges(&r),
                     site: r.clone(),
                     next: 0,
-                    m: Metrics { size: 1, ..Metrics::default() },
+                    m: Metrics {
+                        size: 1,
+                        ..Metrics::default()
+                    },
                     via: "",
                 });
             }
@@ -515,7 +522,11 @@ impl Walk<'_> {
                         && site.1.has_prefix(&top_site.1);
                     if to_descendant {
                         let closing = top_site.clone();
-                        return Err(self.cycle(&path, &closing, &format!("{via} its descendant <{}>, which composes", site.1)));
+                        return Err(self.cycle(
+                            &path,
+                            &closing,
+                            &format!("{via} its descendant <{}>, which composes", site.1),
+                        ));
                     }
                     match state.get(&site) {
                         Some(State::OnPath) => {
@@ -536,7 +547,10 @@ impl Walk<'_> {
                                 site,
                                 edges,
                                 next: 0,
-                                m: Metrics { size: 1, ..Metrics::default() },
+                                m: Metrics {
+                                    size: 1,
+                                    ..Metrics::default()
+                                },
                                 via,
                             });
                         }
@@ -639,5 +653,24 @@ fn fold(m: &mut Metrics, edge: &Edge, t: Metrics) {
             m.height = m.height.max(t.height);
             m.chain = m.chain.max(t.chain + 1);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::brace_depth;
+
+    #[test]
+    fn brace_depth_skips_strings_assets_and_comments() {
+        assert_eq!(
+            brace_depth(b"#usda 1.0\ndef \"a\" {\n def \"b\" {\n }\n}\n"),
+            2
+        );
+        // Braces inside strings, asset paths and comments do not nest prims.
+        let text = b"#usda 1.0 {{{\ndef \"a\" (doc = \"{{{{\" ) {\n string s = '''{{{\n{{'''\n \
+                     asset a = @x{y}.usda@\n asset b = @@@{{{@@@\n # {{{{\n}\n";
+        assert_eq!(brace_depth(text), 1);
+        // An unterminated string stops at its line's end.
+        assert_eq!(brace_depth(b"#usda 1.0\nstring s = \"{{\n{ {\n"), 2);
     }
 }

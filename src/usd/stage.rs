@@ -182,7 +182,10 @@ impl UsdStage {
             )
         };
         // The query time defaults to startTimeCode: a NaN there would be used silently.
-        for (name, t) in [("startTimeCode", start_time_code), ("endTimeCode", end_time_code)] {
+        for (name, t) in [
+            ("startTimeCode", start_time_code),
+            ("endTimeCode", end_time_code),
+        ] {
             if let Some(t) = t.filter(|t| !t.is_finite()) {
                 return Err(LuxError::Format {
                     path: path.to_path_buf(),

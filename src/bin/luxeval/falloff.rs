@@ -61,8 +61,7 @@ pub fn run(a: &FalloffArgs) -> CliResult {
         outputs.push(("--png", png.as_path()));
     }
     luxeval::io::check_outputs(&outputs, &[("SCENE", &a.scene.scene)])?;
-    luxeval::Limits::from_env()?
-        .check_samples("--res", u64::from(a.res.0) * u64::from(a.res.1))?;
+    luxeval::Limits::from_env()?.check_samples("--res", u64::from(a.res.0) * u64::from(a.res.1))?;
     let plane = Plane::new(a.origin.into(), a.u.into(), a.v.into(), a.res.0, a.res.1)?;
     let style = falloff::png::Style {
         scale: match a.scale {

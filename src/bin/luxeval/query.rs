@@ -44,7 +44,10 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
             let out = scene.emission(&dirs, acc)?;
             (dirs.len(), scene, out)
         }
-        Query::Radiance { points: pp, dirs: dp } => {
+        Query::Radiance {
+            points: pp,
+            dirs: dp,
+        } => {
             let points = npy::read_points(pp)?;
             let dirs = npy::read_directions(dp)?;
             same_rows(("--points", pp, points.len()), ("--dirs", dp, dirs.len()))?;
