@@ -558,7 +558,7 @@ impl Walk<'_> {
                     continue;
                 }
                 let done = path.pop().expect("top");
-                self.check_site(&done.site, &done.m, limits)?;
+                self.check_site(&done.site, &done.m)?;
                 state.insert(done.site.clone(), State::Done(done.m));
                 if let Some(parent) = path.last_mut() {
                     let mut acc = parent.m;
@@ -603,7 +603,7 @@ impl Walk<'_> {
     }
 
     /// The chain of arcs at one site must stay within what openusd composes.
-    fn check_site(&self, site: &Site, m: &Metrics, _limits: &Limits) -> Result<()> {
+    fn check_site(&self, site: &Site, m: &Metrics) -> Result<()> {
         if m.chain > MAX_ARC_DEPTH {
             return Err(LuxError::Format {
                 path: self.file.to_path_buf(),
