@@ -192,7 +192,7 @@ impl UsdStage {
 /// The stack of the thread that reads a stage. openusd's text parser and composition engine
 /// recurse once or more per namespace level: on the 8 MiB main stack a debug build overflowed
 /// at 3 000 levels and not at 1 000 (so 3–8 KiB a level), and a 10 000-level stage read with
-/// this stack (the depth limit raised) did not overflow. The depth limit (docs/INPUTS.md,
+/// this stack (the depth limit raised) had not overflowed after 20 minutes of composing. The depth limit (docs/INPUTS.md,
 /// default 1 000) is checked before anything recurses; 512 MiB leaves room to raise it far
 /// beyond what openusd composes in reasonable time. Memory is only reserved, and committed as
 /// the stack grows.
