@@ -44,6 +44,7 @@ pub mod falloff;
 pub(crate) mod gpu;
 pub mod ies;
 pub mod io;
+pub mod limits;
 pub(crate) mod model;
 pub mod plot;
 pub(crate) mod prepare;
@@ -61,6 +62,7 @@ struct ReadmeDoctests;
 
 pub use error::{GpuFailure, LuxError, Result};
 pub use gpu::{AdapterSummary, DeviceLimits, adapters};
+pub use limits::Limits;
 pub use model::{Asset, Ies, Input, Light, LightInputs, LightType, Shaping, UpAxis, Value, schema};
 pub use prepare::TemperatureMode;
 pub use query::{Accumulate, Evaluator, PreparedScene, Reference};

@@ -63,7 +63,8 @@ fn emission_on_the_bundled_scene_equals_the_library() {
     assert_eq!(shape, vec![4096, 3]);
     let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
     let lights = scene.evaluable(&[]).unwrap();
-    let dirs = npy::read_vec3(Path::new(&asset("dirs.npy"))).unwrap();
+    // The CLI normalises directions in f64 as it reads them (docs/INPUTS.md).
+    let dirs = npy::read_directions(Path::new(&asset("dirs.npy"))).unwrap();
     let want = Evaluator::cpu()
         .emission(&lights, &dirs, Accumulate::Sum)
         .unwrap();
@@ -341,7 +342,7 @@ fn irradiance_on_the_bundled_floor_equals_the_library() {
     let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
     let lights = scene.evaluable(&[]).unwrap();
     let points = npy::read_vec3(Path::new(&asset("floor_points.npy"))).unwrap();
-    let normals = npy::read_vec3(Path::new(&asset("floor_up.npy"))).unwrap();
+    let normals = npy::read_directions(Path::new(&asset("floor_up.npy"))).unwrap();
     assert_eq!(
         shape,
         vec![lights.len() as u64, points.len() as u64, 3],

@@ -10,7 +10,9 @@ use std::path::{Path, PathBuf};
 const ALLOWED: &[(&str, &[&str])] = &[
     ("assets", &["assets"]),
     ("model", &["error", "model"]),
-    ("usd", &["error", "model", "usd"]),
+    // `limits` is a leaf like `error`: the bounds every reader checks (docs/INPUTS.md).
+    ("limits", &["error", "limits"]),
+    ("usd", &["error", "limits", "model", "usd"]),
     ("prepare", &["assets", "error", "model", "prepare"]),
     ("rules", &["rules"]),
     ("cpu", &["error", "model", "prepare", "rules", "cpu"]),
@@ -19,7 +21,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "query",
         &["error", "model", "prepare", "cpu", "gpu", "query"],
     ),
-    ("io", &["error", "io"]),
+    ("io", &["error", "limits", "io"]),
     ("ies", &["assets", "prepare", "cpu", "plot", "ies"]),
     ("plot", &["error", "io", "plot"]),
     ("falloff", &["error", "io", "query", "plot", "falloff"]),

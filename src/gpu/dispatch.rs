@@ -137,6 +137,20 @@ impl GpuContext {
         let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, count, &mut out);
         let oom = pollster::block_on(oom.pop());
         let validation = pollster::block_on(validation.pop());
+        // A lost device fails every later call with validation errors about invalid buffers;
+        // the loss itself is what to report.
+        if let Some(why) = self.lost()
+            && (oom.is_some() || validation.is_some() || result.is_err())
+        {
+            *scratch = None;
+            return Err(LuxError::gpu(
+                format!(
+                    "the device was lost ({why}) while running {}",
+                    kernel.entry_point()
+                ),
+                GpuFailure::Lost,
+            ));
+        }
         if let Some(e) = oom {
             *scratch = None;
             return Err(LuxError::gpu("out of memory", e));

@@ -75,6 +75,9 @@ pub(crate) struct GpuContext {
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<(Kernel, bool), wgpu::ComputePipeline>>,
+    /// Why the device was lost, once it is (set by wgpu's device-lost callback): reported
+    /// instead of the validation errors a lost device's buffers then raise.
+    lost: Arc<Mutex<Option<String>>>,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -86,6 +89,14 @@ impl std::fmt::Debug for GpuContext {
 }
 
 impl GpuContext {
+    /// Why the device was lost, if it was.
+    pub(crate) fn lost(&self) -> Option<String> {
+        self.lost
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone()
+    }
+
     /// Opens the adapter named by `LUXEVAL_ADAPTER` (a name substring), else the default
     /// high-performance adapter. No pipeline is built yet.
     pub fn new() -> Result<Self> {
@@ -139,6 +150,27 @@ impl GpuContext {
         // wgpu's default handler panics; errors are caught by scopes around each dispatch, and
         // anything that escapes them is logged rather than aborting the process.
         device.on_uncaptured_error(Arc::new(|e| log::error!("wgpu: {e}")));
+        let lost = Arc::new(Mutex::new(None));
+        let on_lost = Arc::clone(&lost);
+        device.set_device_lost_callback(move |reason, message| {
+            *on_lost
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(format!(
+                "{reason:?}{}",
+                if message.is_empty() {
+                    String::new()
+                } else {
+                    format!(": {message}")
+                }
+            ));
+        });
+        // Fault injection for tests/bad_inputs.rs: a device that is lost once opened, to check
+        // that a lost device is a runtime failure (exit 1) with a clear message, not a hang,
+        // a panic or garbage.
+        #[cfg(feature = "testkit")]
+        if std::env::var("LUXEVAL_TEST_FAULT").as_deref() == Ok("device-lost") {
+            device.destroy();
+        }
 
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("luxeval queries"),
@@ -176,6 +208,7 @@ impl GpuContext {
             layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
+            lost,
         })
     }
 

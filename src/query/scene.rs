@@ -179,7 +179,23 @@ impl PreparedScene {
                     .scratch
                     .lock()
                     .unwrap_or_else(std::sync::PoisonError::into_inner);
-                g.run(kernel, lights, &mut scratch, a, b, per_light)
+                // Directions (and normals) are normalised here in f64, as the CPU reference
+                // normalises them: the kernels' f32 `normalize` overflows on components near
+                // 1e38 and loses subnormal ones (which a device may flush to zero).
+                match (kernel, b) {
+                    (Kernel::Emission, _) => {
+                        g.run(kernel, lights, &mut scratch, &unit_rows(a), b, per_light)
+                    }
+                    (_, Some(b)) => g.run(
+                        kernel,
+                        lights,
+                        &mut scratch,
+                        a,
+                        Some(&unit_rows(b)),
+                        per_light,
+                    ),
+                    (_, None) => g.run(kernel, lights, &mut scratch, a, b, per_light),
+                }
             }
             // No lights: every row is zero.
             (Backend::Gpu(_), None) => {
@@ -188,4 +204,20 @@ impl PreparedScene {
             }
         }
     }
+}
+
+/// Rows scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The
+/// largest component is divided out first, so that neither 1e38 nor 1e-45 over- or underflows.
+fn unit_rows(rows: &[[f32; 3]]) -> Vec<[f32; 3]> {
+    rows.iter()
+        .map(|r| {
+            let d = DVec3::new(r[0] as f64, r[1] as f64, r[2] as f64);
+            let m = d.abs().max_element();
+            if m == 0.0 {
+                return *r;
+            }
+            let u = (d / m).normalize();
+            [u.x as f32, u.y as f32, u.z as f32]
+        })
+        .collect()
 }

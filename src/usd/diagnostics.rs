@@ -70,6 +70,20 @@ pub(super) fn check_composition(file: &Path, stage: &ousd::Stage) -> Result<()> 
                     reason: format!("{reason} (a sublayer of {introduced_by})"),
                 });
             }
+            // luxeval's own walk (`super::arcs`) refuses every cycle and every chain too deep
+            // for openusd before composing; one that openusd still reports would drop a prim
+            // (and its light) silently, so it is an error too.
+            D::ArcCycle(chain) => {
+                return Err(LuxError::Format {
+                    path: file.to_path_buf(),
+                    line: None,
+                    reason: format!(
+                        "composition arc cycle at prim <{}> (openusd 0.8 drops the prim; if \
+                         usd-core composes this stage, it exceeds what openusd composes)",
+                        chain.composing
+                    ),
+                });
+            }
             other => log::warn!("{}: {other}", file.display()),
         }
     }

@@ -19,6 +19,7 @@
 //! Fallbacks of unauthored attributes come from luxeval's schema table, not from openusd's
 //! registry, so there is exactly one table of them.
 
+mod arcs;
 mod diagnostics;
 pub(crate) mod scene;
 pub(crate) mod stage;

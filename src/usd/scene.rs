@@ -81,9 +81,12 @@ impl Scene {
     /// Opens `path` (`.usda`, `.usdc`, `.usdz`) with every composition arc and payload loaded and
     /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
     /// else at USD's EarliestTime (DESIGN.md §2).
+    ///
+    /// The stage is read on a thread of its own with a large stack (see [`STACK_BYTES`]), so
+    /// that a legal deep stage does not overflow the caller's stack.
     pub fn load(path: &Path, time: Option<f64>) -> Result<Scene> {
         check_time(time)?;
-        UsdStage::open(path)?.scene(time)
+        on_large_stack(path, || UsdStage::open(path)?.scene(time))
     }
 
     /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
@@ -189,6 +192,50 @@ impl UsdStage {
             lights,
         })
     }
+}
+
+/// The stack of the thread that reads a stage. openusd's text parser and composition engine
+/// recurse once or more per namespace level: on the 8 MiB main stack a debug build overflowed
+/// at 3 000 levels and not at 1 000 (so 3–8 KiB a level), and a 10 000-level stage read with
+/// this stack (the depth limit raised) had not overflowed after 20 minutes of composing. The depth limit (docs/INPUTS.md,
+/// default 1 000) is checked before anything recurses; 512 MiB leaves room to raise it far
+/// beyond what openusd composes in reasonable time. Memory is only reserved, and committed as
+/// the stack grows.
+pub const STACK_BYTES: usize = 512 << 20;
+
+/// Runs `f` on a scoped thread with a [`STACK_BYTES`] stack and returns what it returns. A
+/// panic on that thread becomes an error naming the stage: openusd 0.8 has debug assertions
+/// that malformed files reach (found by fuzz/: a `.usdc` whose path table builds an invalid
+/// variant path asserts in `sdf::Path::from_str_unchecked`), and a stage must never abort the
+/// process.
+fn on_large_stack<T: Send>(path: &Path, f: impl FnOnce() -> Result<T> + Send) -> Result<T> {
+    std::thread::scope(|s| {
+        let handle = std::thread::Builder::new()
+            .name("luxeval-stage".into())
+            .stack_size(STACK_BYTES)
+            .spawn_scoped(s, f);
+        match handle {
+            Ok(h) => match h.join() {
+                Ok(r) => r,
+                Err(panic) => {
+                    let msg = panic
+                        .downcast_ref::<String>()
+                        .map(String::as_str)
+                        .or_else(|| panic.downcast_ref::<&str>().copied())
+                        .unwrap_or("no message");
+                    Err(LuxError::input(
+                        path.display().to_string(),
+                        format!("the USD reader failed on this file (it panicked: {msg})"),
+                    ))
+                }
+            },
+            // No thread (out of memory or address space): read on this one.
+            Err(_) => Err(LuxError::input(
+                "stage",
+                "cannot start the thread that reads the stage (out of memory?)",
+            )),
+        }
+    })
 }
 
 fn check_time(time: Option<f64>) -> Result<()> {
@@ -299,6 +346,18 @@ fn convert(p: &usd::LightPrim, up: UpAxis) -> std::result::Result<(Light, Option
     let ty = p.usd_type.as_str();
     if let Some(why) = &p.transform_error {
         return Err(why.clone());
+    }
+    if let Some(api) = &p.light_api
+        && api == "LightAPI"
+    {
+        let on = match ty {
+            "" => "an untyped prim".to_string(),
+            ty => format!("a {ty} prim"),
+        };
+        return Err(format!(
+            "{path}: LightAPI is applied to {on}, which is not a UsdLux light type; \
+             luxeval does not evaluate it"
+        ));
     }
     if let Some(api) = &p.light_api {
         let on = match ty {

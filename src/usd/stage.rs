@@ -6,10 +6,12 @@ use std::path::{Path, PathBuf};
 use openusd::usd::{self as ousd, PrimPredicate, TimeCode};
 use openusd_schemas::geom::{XformCache, Xformable, XformableExt};
 
+use super::arcs::{LimitedResolver, preflight};
 use super::diagnostics::{check_composition, open_error, stage_error};
 use super::values::{convert, reject_spline, value_at, visible_at};
 use super::xform::{needs_own_xform, world_as_usd_core, xform_error};
 use crate::error::{LuxError, Result};
+use crate::limits::{ENV_MAX_FILE_BYTES, Limits, raise_hint};
 use crate::model::schema;
 use crate::model::{Input, Value};
 
@@ -126,12 +128,36 @@ impl UsdStage {
             )));
         }
         std::fs::File::open(path).map_err(io)?;
+        let limits = Limits::from_env()?;
+        // Every layer is read whole: what is not a regular file (an endless device) or is
+        // larger than the limit is refused before openusd reads it.
+        if !meta.is_file() {
+            return Err(io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "is not a regular file (a USD layer is read whole)",
+            )));
+        }
+        if meta.len() > limits.max_file_bytes {
+            return Err(LuxError::Format {
+                path: path.to_path_buf(),
+                line: None,
+                reason: format!(
+                    "{} bytes exceed the limit of {} bytes ({})",
+                    meta.len(),
+                    limits.max_file_bytes,
+                    raise_hint(ENV_MAX_FILE_BYTES)
+                ),
+            });
+        }
         let name = path.to_str().ok_or_else(|| LuxError::Format {
             path: path.to_path_buf(),
             line: None,
             reason: "the path is not valid UTF-8, which openusd requires".into(),
         })?;
+        let resolver = LimitedResolver::new(&limits);
+        preflight(path, &resolver, &limits)?;
         let stage = ousd::Stage::builder()
+            .registry(openusd::sdf::LayerRegistry::new(Box::new(resolver)))
             .schema_registry(openusd_schemas::schema_registry())
             .load(ousd::InitialLoadSet::LoadAll)
             .open(name)
@@ -155,6 +181,19 @@ impl UsdStage {
                 root.has_end_time_code().then(|| root.end_time_code()),
             )
         };
+        // The query time defaults to startTimeCode: a NaN there would be used silently.
+        for (name, t) in [
+            ("startTimeCode", start_time_code),
+            ("endTimeCode", end_time_code),
+        ] {
+            if let Some(t) = t.filter(|t| !t.is_finite()) {
+                return Err(LuxError::Format {
+                    path: path.to_path_buf(),
+                    line: None,
+                    reason: format!("{name} = {t} is not a finite time code"),
+                });
+            }
+        }
         let info = StageInfo {
             up_axis,
             meters_per_unit,
@@ -191,6 +230,9 @@ impl UsdStage {
                 match applied_schemas
                     .iter()
                     .find(|s| LIGHT_APIS.contains(&s.as_str()))
+                    // LightAPI on a prim of another type (an Xform, a renderer's own light
+                    // type): listed with a warning, never dropped silently.
+                    .or_else(|| applied_schemas.iter().find(|s| *s == "LightAPI"))
                 {
                     Some(api) => Some(api.clone()),
                     None => continue,

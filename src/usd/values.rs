@@ -110,8 +110,16 @@ pub(super) fn convert(light: &str, a: &schema::SchemaAttr, v: sdf::Value) -> Res
         )
     };
     Ok(match a.fallback {
+        // Any floating-point precision is read as usd-core reads it; an integer type is not a
+        // precision of the schema's type (usd-core's typed Get fails on it), so it is refused
+        // rather than converted silently.
         Fallback::Float(_) => Value::Float(match v {
-            sdf::Value::Bool(_) => return Err(bad("floating-point")),
+            sdf::Value::Bool(_)
+            | sdf::Value::Uchar(_)
+            | sdf::Value::Int(_)
+            | sdf::Value::Uint(_)
+            | sdf::Value::Int64(_)
+            | sdf::Value::Uint64(_) => return Err(bad("floating-point")),
             other => other.cast::<f64>().map_err(|_| bad("floating-point"))?,
         }),
         Fallback::Bool(_) => Value::Bool(match v {
@@ -123,7 +131,10 @@ pub(super) fn convert(light: &str, a: &schema::SchemaAttr, v: sdf::Value) -> Res
                 _ => return Err(bad("bool")),
             },
         }),
-        Fallback::Color(_) => Value::Color(v.cast::<[f64; 3]>().map_err(|_| bad("color3f"))?),
+        Fallback::Color(_) => Value::Color(match v {
+            sdf::Value::Vec3i(_) => return Err(bad("color3f (floating-point)")),
+            other => other.cast::<[f64; 3]>().map_err(|_| bad("color3f"))?,
+        }),
         Fallback::Token(_) => Value::Token(match v {
             sdf::Value::Token(t) => t.as_str().to_string(),
             sdf::Value::String(s) => s,

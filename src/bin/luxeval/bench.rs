@@ -41,6 +41,9 @@ struct Row {
     evals_per_second: f64,
 }
 
+/// The most timed repetitions (more would only make `bench` look hung).
+const MAX_REPEAT: usize = 1000;
+
 const QUERIES: [&str; 3] = ["emission", "radiance", "irradiance"];
 
 /// Irradiance runs on this fraction of the samples (random receivers near the lights, random
@@ -69,6 +72,24 @@ pub fn run(args: BenchArgs) -> CliResult {
             code: 2,
             message: "--samples, --cpu-samples and --lights must be at least 1".into(),
         });
+    }
+    let limits = luxeval::Limits::from_env()?;
+    limits.check_samples("--samples", args.samples as u64)?;
+    limits.check_samples("--cpu-samples", args.cpu_samples as u64)?;
+    // A stage composes to at most max_prims prims, so it has at most that many lights.
+    if args.lights as u64 > limits.max_prims {
+        return Err(Failure::bad_input(format!(
+            "--lights {} exceeds the limit of {} ({})",
+            args.lights,
+            limits.max_prims,
+            luxeval::limits::raise_hint(luxeval::limits::ENV_MAX_PRIMS)
+        )));
+    }
+    if args.repeat > MAX_REPEAT {
+        return Err(Failure::bad_input(format!(
+            "--repeat {} exceeds {MAX_REPEAT}: a median of that many runs is already stable",
+            args.repeat
+        )));
     }
     let lights = synthetic_lights(args.lights);
     let mut rng = Rng::new(7);

@@ -29,6 +29,7 @@ pub fn run(a: &CheckArgs) -> CliResult {
     if a.samples == 0 {
         return Err(Failure::bad_input("--samples must be at least 1"));
     }
+    luxeval::Limits::from_env()?.check_samples("--samples", a.samples as u64)?;
     let path = &a.scene.scene;
     let lights = open::lights(&a.scene)?;
     if lights.is_empty() {

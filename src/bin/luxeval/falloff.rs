@@ -56,6 +56,12 @@ pub struct FalloffArgs {
 }
 
 pub fn run(a: &FalloffArgs) -> CliResult {
+    let mut outputs = vec![("-o", a.output.as_path())];
+    if let Some(png) = &a.png {
+        outputs.push(("--png", png.as_path()));
+    }
+    luxeval::io::check_outputs(&outputs, &[("SCENE", &a.scene.scene)])?;
+    luxeval::Limits::from_env()?.check_samples("--res", u64::from(a.res.0) * u64::from(a.res.1))?;
     let plane = Plane::new(a.origin.into(), a.u.into(), a.v.into(), a.res.0, a.res.1)?;
     let style = falloff::png::Style {
         scale: match a.scale {
@@ -84,6 +90,7 @@ pub fn run(a: &FalloffArgs) -> CliResult {
     bar.set_message(format!("falloff on {}", eval.device_name()));
     let map = falloff::evaluate(&scene, &plane, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
+    crate::query::check_finite(&scene, map.rgb.len(), &map.rgb)?;
     let n = plane.normal();
     let comment = format!(
         "luxeval falloff: {} at {}; origin {:?} u {:?} v {:?}; normal ({}, {}, {}); {} lights on {}",

@@ -22,6 +22,9 @@ pub struct IesArgs {
 }
 
 pub fn run(a: &IesArgs) -> CliResult {
+    if let Some(png) = &a.png {
+        luxeval::io::check_outputs(&[("--png", png)], &[("FILE", &a.file)])?;
+    }
     let file = ies::read_file(&a.file).map_err(|e| Failure::bad_input(e.to_string()))?;
     let profile = Profile::new(&file)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", a.file.display())))?;

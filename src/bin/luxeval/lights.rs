@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use luxeval::{Reference, Scene, SceneLight, TemperatureMode};
+use luxeval::{Reference, SceneLight, TemperatureMode};
 
 use crate::exit::{CliResult, Failure};
 
@@ -30,7 +30,7 @@ fn power(l: &SceneLight) -> Result<Option<serde_json::Value>, String> {
 }
 
 pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
-    let scene = Scene::load(path, time)?;
+    let scene = crate::open::load(path, time)?;
     if json {
         let mut v = serde_json::to_value(&scene).map_err(|e| Failure::runtime(e.to_string()))?;
         if let Some(lights) = v.get_mut("lights").and_then(|l| l.as_array_mut()) {

@@ -9,7 +9,7 @@ use crate::exit::{CliResult, in_scene};
 /// The selected, visible, evaluable lights of the stage, validated (an invalid attribute is
 /// reported with the stage it comes from). Prints the stage's warnings.
 pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
-    let scene = Scene::load(&args.scene, args.time.time)?;
+    let scene = load(&args.scene, args.time.time)?;
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
@@ -18,6 +18,15 @@ pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
         l.validate().map_err(|e| in_scene(&args.scene, e))?;
     }
     Ok(lights)
+}
+
+/// Loads the stage; an error about a light's attribute or transform is prefixed with the stage's
+/// path (file errors already name their file).
+pub fn load(path: &std::path::Path, time: Option<f64>) -> CliResult<Scene> {
+    Scene::load(path, time).map_err(|e| match e {
+        LuxError::InvalidAttribute { .. } | LuxError::InvalidTransform { .. } => in_scene(path, e),
+        e => e.into(),
+    })
 }
 
 /// The evaluator `device` asks for: the GPU (an error when there is none), the CPU, or by

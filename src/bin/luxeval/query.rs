@@ -2,9 +2,9 @@
 
 use std::path::Path;
 
-use luxeval::io::npy;
+use luxeval::io::{self, npy};
 use luxeval::plot::polar;
-use luxeval::{Accumulate, Evaluator, PreparedScene, Reference};
+use luxeval::{Accumulate, Evaluator, Limits, PreparedScene, Reference};
 
 use crate::args::{QueryArgs, SceneArgs};
 use crate::exit::{CliResult, Failure, in_scene};
@@ -29,39 +29,75 @@ pub enum Query<'a> {
     },
 }
 
+impl Query<'_> {
+    /// The input arrays, with the options that name them.
+    fn inputs(&self) -> Vec<(&'static str, &Path)> {
+        match *self {
+            Query::Emission { dirs } => vec![("--dirs", dirs)],
+            Query::Radiance { points, dirs } => vec![("--points", points), ("--dirs", dirs)],
+            Query::Irradiance { points, normals } => {
+                vec![("--points", points), ("--normals", normals)]
+            }
+            Query::Intensity { dirs, .. } => vec![("--dirs", dirs)],
+        }
+    }
+}
+
 pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
+    let mut inputs = query.inputs();
+    inputs.push(("SCENE", &args.scene.scene));
+    let mut outputs = vec![("-o", output)];
+    if let Query::Intensity { png: Some(png), .. } = query {
+        outputs.push(("--png", png));
+    }
+    io::check_outputs(&outputs, &inputs)?;
     let acc = args.accumulate();
     // Inputs are read before the stage is opened: a bad array is reported without the cost of
-    // opening a device.
+    // opening a device. Directions and normals are normalised in f64 as they are read.
     let (n, scene, out) = match query {
         Query::Emission { dirs } => {
-            let dirs = npy::read_vec3(dirs)?;
+            let dirs = npy::read_directions(dirs)?;
             let (_, scene) = open::prepare(&args.scene, args.device)?;
+            check_output_rows(&scene, dirs.len(), args.per_light)?;
             let out = scene.emission(&dirs, acc)?;
             (dirs.len(), scene, out)
         }
-        Query::Radiance { points, dirs } => {
-            let points = npy::read_vec3(points)?;
-            let dirs = npy::read_vec3(dirs)?;
+        Query::Radiance {
+            points: pp,
+            dirs: dp,
+        } => {
+            let points = npy::read_points(pp)?;
+            let dirs = npy::read_directions(dp)?;
+            same_rows(("--points", pp, points.len()), ("--dirs", dp, dirs.len()))?;
             let (_, scene) = open::prepare(&args.scene, args.device)?;
+            check_output_rows(&scene, dirs.len(), args.per_light)?;
             let out = scene.radiance(&points, &dirs, acc)?;
             (dirs.len(), scene, out)
         }
-        Query::Irradiance { points, normals } => {
-            let points = npy::read_vec3(points)?;
-            let normals = npy::read_vec3(normals)?;
+        Query::Irradiance {
+            points: pp,
+            normals: np,
+        } => {
+            let points = npy::read_points(pp)?;
+            let normals = npy::read_directions(np)?;
+            same_rows(
+                ("--points", pp, points.len()),
+                ("--normals", np, normals.len()),
+            )?;
             let (_, scene) = open::prepare(&args.scene, args.device)?;
+            check_output_rows(&scene, points.len(), args.per_light)?;
             let out = scene.irradiance(&points, &normals, acc)?;
             (points.len(), scene, out)
         }
         Query::Intensity { dirs, png } => {
-            let dirs = npy::read_vec3(dirs)?;
+            let dirs = npy::read_directions(dirs)?;
             if png.is_some() && args.scene.lights.len() != 1 {
                 return Err(Failure::bad_input(
                     "--png plots one light: select it with --light PATH",
                 ));
             }
             let (eval, scene) = open::prepare(&args.scene, args.device)?;
+            check_output_rows(&scene, dirs.len(), args.per_light)?;
             let out = scene.intensity(&dirs, acc)?;
             if let Some(png) = png {
                 plot_light(&eval, &scene, &args.scene, png)?;
@@ -69,7 +105,62 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
             (dirs.len(), scene, out)
         }
     };
+    check_finite(&scene, n, &out)?;
     write_rows(output, args, &scene, n, &out)
+}
+
+/// Two arrays that pair up row by row, or an error naming both files.
+fn same_rows(a: (&str, &Path, usize), b: (&str, &Path, usize)) -> CliResult {
+    if a.2 != b.2 {
+        return Err(Failure::bad_input(format!(
+            "{} {} has {} rows but {} {} has {}; they pair up row by row",
+            a.0,
+            a.1.display(),
+            a.2,
+            b.0,
+            b.1.display(),
+            b.2
+        )));
+    }
+    Ok(())
+}
+
+/// `--per-light` writes lights × rows: bounded like any other array.
+fn check_output_rows(scene: &PreparedScene, n: usize, per_light: bool) -> CliResult {
+    let lights = if per_light { scene.len().max(1) } else { 1 };
+    let rows = (lights as u64).saturating_mul(n as u64);
+    Limits::from_env()?.check_samples("the output (lights × rows)", rows)?;
+    Ok(())
+}
+
+/// No NaN or infinity is ever written for finite input (docs/INPUTS.md): every per-light
+/// constant fits float32 (checked when the lights are prepared), but a sum over many lights, or
+/// the irradiance of a point-like light at a receiver almost on it, can still overflow float32.
+/// Such a result is refused, naming the row (and light), instead of writing `inf`.
+pub fn check_finite(scene: &PreparedScene, n: usize, rows: &[[f32; 3]]) -> CliResult {
+    if let Some(k) = rows.iter().position(|r| r.iter().any(|v| !v.is_finite())) {
+        let at = if rows.len() > n && n > 0 {
+            let light = scene.lights().nth(k / n).map(|l| l.path.clone());
+            format!("row {} of light {}", k % n, light.unwrap_or_default())
+        } else {
+            format!("row {k}")
+        };
+        let what = if rows[k].iter().any(|v| v.is_nan()) {
+            // NaN from finite input is a defect of luxeval, not of the input.
+            return Err(Failure::runtime(format!(
+                "internal error: the result at {at} is NaN ({:?}); please report it",
+                rows[k]
+            )));
+        } else {
+            "overflows float32"
+        };
+        return Err(Failure::bad_input(format!(
+            "the result at {at} {what} ({:?}); scale the lights' intensity down or move the \
+             receivers away from the lights",
+            rows[k]
+        )));
+    }
+    Ok(())
 }
 
 fn write_rows(
