@@ -6,11 +6,11 @@
 //   formula when (d / smaller half-extent)·(d / height above its plane) exceeds
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
-// GPU-only: an IES-shaped light gives 0 here and the host adds the CPU reference's value
+// On the host: an IES-shaped light gives 0 here and the host adds the CPU reference's value
 //   (query::PreparedScene::irradiance): this f32 quadrature does not split at a profile's angle
 //   nodes as the reference's line integrals do, and misses lit features narrower than its
 //   nodes. The pipeline is built with IES_ENABLED = false.
-// GPU-only structure: the sphere, rect, disk and cylinder cases choose their chart inside the
+// Structure (this file only): the sphere, rect, disk and cylinder cases choose their chart inside the
 //   switch and chart_integral is called once after it (the CPU calls it in each case). Every
 //   call site is inlined by the shader compiler, and one copy of the quadrature instead of four
 //   cut lavapipe's compile time from ~10 s to ~7 s (and with the IES lookup inlined, from over

@@ -277,6 +277,20 @@ fn usda_usdc_usdz_are_identical() {
                     *rz = ra.clone();
                 }
             }
+            // The light's IES asset (shaping:ies:file) resolves the same way.
+            let ies_of = |l: &luxeval::SceneLight| {
+                l.light
+                    .as_ref()
+                    .and_then(|l| l.shaping.as_ref())
+                    .and_then(|s| s.ies.as_ref())
+                    .and_then(|i| i.file.resolved.clone())
+            };
+            if let (Some(ra), Some(rz)) = (ies_of(la), ies_of(&lz)) {
+                let inner = ra.strip_prefix(&format!("{}/", dir.display())).unwrap();
+                assert_eq!(rz, format!("{}[{inner}]", dir.join("scene.usdz").display()));
+                let ies = lz.light.as_mut().unwrap().shaping.as_mut().unwrap();
+                ies.ies.as_mut().unwrap().file.resolved = Some(ra);
+            }
             assert_eq!(*la, lz, "usda vs usdz at {time:?}");
         }
         assert!(assets_checked >= 4, "{assets_checked}");
@@ -400,7 +414,6 @@ fn scene_lights_and_warnings() {
         "/World/Defaults/Portal",
         "/World/Defaults/MeshLight",
         "/World/Shaped/Textured",
-        "/World/Shaped/Ies",
         "/World/Env/Sky",
     ] {
         assert!(!paths.contains(&skipped), "{skipped} evaluated");
@@ -410,7 +423,23 @@ fn scene_lights_and_warnings() {
             scene.warnings()
         );
     }
+    // The IES-shaped light is evaluated, with its profile resolved beside the layer.
+    let ies = get("/World/Shaped/Ies")
+        .light
+        .clone()
+        .unwrap()
+        .shaping
+        .unwrap();
+    let ies = ies.ies.expect("shaping:ies:file read");
+    assert_eq!(ies.angle_scale, -0.5);
+    assert!(
+        ies.file
+            .resolved
+            .as_deref()
+            .is_some_and(|r| r.ends_with("ies/spot.ies"))
+    );
     for kept in [
+        "/World/Shaped/Ies",
         "/World/Env/Uniform",
         "/World/Untyped/UnderUntyped",
         "/World/Shaped/Cone",

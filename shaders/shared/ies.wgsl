@@ -31,6 +31,7 @@
 //    (false) for scenes with no profile, and the irradiance kernel always without it (it
 //    integrates no IES-shaped light, see shaders/irradiance.wgsl). Inlined at every shaping call
 //    of the irradiance quadrature, the lookup took lavapipe's compiler minutes.
+// GPU-only search_step: the CPU's loop body in find_interval, written out (divergence 4).
 // Not divergences (checked): at a frame's poles (both atan2 arguments zero) atan2_accurate gives
 // 0 and the CPU twin returns 0 explicitly (f64::atan2(0, −0) would be π); the folds 360 − H,
 // 180 − H and 540 − H are exact in f32 on their ranges (Sterbenz).
@@ -190,7 +191,6 @@ fn find_interval(offset: u32, n: u32, x: f32) -> IesInterval {
 }
 
 // One step of find_interval's binary search over `len` cells from `lo`.
-// GPU-only search_step: the CPU's loop body in find_interval.
 fn search_step(offset: u32, x: f32, lo: u32, len: ptr<function, u32>) -> u32 {
     let half = *len / 2u;
     *len = *len - half;
