@@ -49,15 +49,17 @@ pub fn rows<'py>(
             shape_str(&shape)
         )));
     }
-    // Returns `arr` itself when it is already C-contiguous float32 (no copy). Values beyond
-    // float32's range become ±inf, reported below, without NumPy's overflow warning.
-    let kwargs = pyo3::types::PyDict::new(py);
-    kwargs.set_item(intern!(py, "dtype"), np.getattr(intern!(py, "float32"))?)?;
+    // `arr` itself when it is already C-contiguous, aligned float32 (no copy); else one copy
+    // (an array unpickled from a buffer may be misaligned). Values beyond float32's range become
+    // ±inf, reported below, without NumPy's overflow warning.
     let quiet = pyo3::types::PyDict::new(py);
     quiet.set_item(intern!(py, "over"), intern!(py, "ignore"))?;
     let errstate = np.getattr(intern!(py, "errstate"))?.call((), Some(&quiet))?;
     errstate.call_method0(intern!(py, "__enter__"))?;
-    let f32s = np.call_method(intern!(py, "ascontiguousarray"), (&arr,), Some(&kwargs));
+    let f32s = np.call_method1(
+        intern!(py, "require"),
+        (&arr, np.getattr(intern!(py, "float32"))?, (intern!(py, "C"), intern!(py, "A"))),
+    );
     errstate.call_method1(intern!(py, "__exit__"), (py.None(), py.None(), py.None()))?;
     let f32s = f32s?;
     let f32s = f32s

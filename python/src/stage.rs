@@ -3,6 +3,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
+use std::time::Instant;
 
 use glam::DVec3;
 use luxeval::falloff::{self, Plane};
@@ -18,10 +19,48 @@ use crate::arrays::{self, Kind};
 use crate::device::{self, Device};
 use crate::errors::{self, no_panic};
 
-/// Light-samples (rows × lights) evaluated per call into the library between two checks for
-/// Ctrl-C. Irradiance costs far more per sample (quadrature) than emission and radiance.
-const CHUNK_EMISSION: usize = 1 << 20;
-const CHUNK_IRRADIANCE: usize = 1 << 16;
+/// How many rows each call into the library evaluates. Between two calls the GIL is taken back
+/// and Ctrl-C is checked, so a call should take about [`Chunks::TARGET_S`] whatever the device
+/// and the query cost (irradiance on the CPU reference costs ~10 000 times what emission on a
+/// GPU does): the first chunk is small, and each next one is sized from the last one's time.
+/// Sizes are powers of two, so that the GPU's buffers (kept per power-of-two size class) are
+/// reused from chunk to chunk once the size settles.
+struct Chunks {
+    rows: usize,
+    max: usize,
+}
+
+impl Chunks {
+    const TARGET_S: f64 = 0.25;
+    /// At most this many light-samples (rows × lights) per call: bounds the chunk's memory.
+    const MAX_SAMPLES: usize = 1 << 22;
+
+    fn new(first: usize, lights: usize) -> Chunks {
+        let max = (Self::MAX_SAMPLES / lights.max(1)).max(1);
+        Chunks {
+            rows: first.min(max).max(1),
+            max,
+        }
+    }
+
+    /// After a chunk of `rows` rows took `secs`: the size of the next one, within 4× of it.
+    fn update(&mut self, rows: usize, secs: f64) {
+        let rows = rows.max(1);
+        let ideal = if secs > 0.0 {
+            rows as f64 * Self::TARGET_S / secs
+        } else {
+            f64::INFINITY
+        };
+        let ideal = ideal.clamp((rows / 4).max(1) as f64, rows.saturating_mul(4) as f64);
+        self.rows = if ideal >= self.max as f64 {
+            self.max
+        } else {
+            // The power of two at or below the ideal size.
+            let ideal = ideal as usize;
+            1usize << (usize::BITS - 1 - ideal.leading_zeros())
+        };
+    }
+}
 
 /// A USD stage (``.usda``, ``.usdc``, ``.usdz``) and its lights, read once at one time.
 ///
@@ -211,17 +250,20 @@ impl Stage {
             (Accumulate::Sum, 1)
         };
         let mut out = zeros(width * n * 3)?;
-        let budget = match q {
-            Query::Irradiance => CHUNK_IRRADIANCE,
-            _ => CHUNK_EMISSION,
-        };
-        let chunk = (budget / l.max(1)).max(1);
+        let mut chunks = Chunks::new(
+            match q {
+                Query::Irradiance => 256,
+                _ => 1 << 14,
+            },
+            l,
+        );
         let file = self.file();
         let mut start = 0;
         while start < n {
-            let end = (start + chunk).min(n);
+            let end = (start + chunks.rows).min(n);
             let scene = &*scene;
             let out = &mut out;
+            let t0 = Instant::now();
             py.detach(|| {
                 no_panic(|| {
                     let a = &a_rows[start..end];
@@ -241,6 +283,9 @@ impl Stage {
                     Ok(())
                 })
             })?;
+            if end < n {
+                chunks.update(end - start, t0.elapsed().as_secs_f64());
+            }
             py.check_signals()?;
             start = end;
         }
@@ -543,15 +588,17 @@ impl Stage {
         let normal = plane.normal().as_vec3().to_array();
         let pixels = plane.pixels();
         let mut out = zeros(pixels * 3)?;
-        let rows_per_block =
-            (CHUNK_IRRADIANCE / (w as usize * scene.len().max(1))).max(1) as u32;
+        // Whole rows of pixels per call, sized like the queries' chunks.
+        let mut chunks = Chunks::new(256, scene.len());
         let file = self.file();
         let mut j0 = 0u32;
         while j0 < h {
-            let j1 = (j0 + rows_per_block).min(h);
+            let rows = (chunks.rows / w as usize).clamp(1, h as usize) as u32;
+            let j1 = (j0 + rows).min(h);
             let scene = &*scene;
             let plane = &plane;
             let out = &mut out;
+            let t0 = Instant::now();
             py.detach(|| {
                 no_panic(|| {
                     let points: Vec<[f32; 3]> = (j0..j1)
@@ -567,6 +614,9 @@ impl Stage {
                     Ok(())
                 })
             })?;
+            if j1 < h {
+                chunks.update((j1 - j0) as usize * w as usize, t0.elapsed().as_secs_f64());
+            }
             py.check_signals()?;
             j0 = j1;
         }

@@ -88,6 +88,6 @@ def test_bad_input_is_reported(client):
         ldask.emission(STUDIO / "missing.usda", da.ones((10, 3), chunks=5))
     # Found only in the data, on a worker: re-raised by compute() with its type and message.
     bad = np.ones((10, 3))
-    bad[7] = np.nan
+    bad[7, 0] = np.nan
     with pytest.raises(luxeval.InputError, match=r"dirs: row 2 = \[nan, 1.0, 1.0\] is not finite \(rows counted within the chunk of rows 5:10\)"):
         ldask.emission(STUDIO, da.from_array(bad, chunks=5), device="cpu").compute()
