@@ -54,11 +54,17 @@ pub fn rows<'py>(
     // ±inf, reported below, without NumPy's overflow warning.
     let quiet = pyo3::types::PyDict::new(py);
     quiet.set_item(intern!(py, "over"), intern!(py, "ignore"))?;
-    let errstate = np.getattr(intern!(py, "errstate"))?.call((), Some(&quiet))?;
+    let errstate = np
+        .getattr(intern!(py, "errstate"))?
+        .call((), Some(&quiet))?;
     errstate.call_method0(intern!(py, "__enter__"))?;
     let f32s = np.call_method1(
         intern!(py, "require"),
-        (&arr, np.getattr(intern!(py, "float32"))?, (intern!(py, "C"), intern!(py, "A"))),
+        (
+            &arr,
+            np.getattr(intern!(py, "float32"))?,
+            (intern!(py, "C"), intern!(py, "A")),
+        ),
     );
     errstate.call_method1(intern!(py, "__exit__"), (py.None(), py.None(), py.None()))?;
     let f32s = f32s?;

@@ -64,7 +64,9 @@ static WARNED: AtomicBool = AtomicBool::new(false);
 /// none. Errors other than a missing adapter are not remembered: the next call tries again.
 fn gpu(py: Python<'_>) -> PyResult<Result<Evaluator, String>> {
     let r = py.detach(|| {
-        let mut g = GPU.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut g = GPU
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
         if g.is_none() {
             match Evaluator::gpu() {
                 Ok(e) => *g = Some(Gpu::Ready(e)),

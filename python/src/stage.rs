@@ -168,7 +168,8 @@ impl Stage {
             .evaluable(&o.select)
             .map_err(|e| errors::lux(e, Some(self.file())))?;
         for l in &lights {
-            l.validate().map_err(|e| errors::lux(e, Some(self.file())))?;
+            l.validate()
+                .map_err(|e| errors::lux(e, Some(self.file())))?;
         }
         let eval = device::evaluator(py, o.device, o.mode)?;
         let mut select = o.select.clone();
@@ -249,7 +250,7 @@ impl Stage {
         } else {
             (Accumulate::Sum, 1)
         };
-        let mut out = zeros(width * n * 3)?;
+        let mut out = zeros(width.checked_mul(n).and_then(|x| x.checked_mul(3)))?;
         let mut chunks = Chunks::new(
             match q {
                 Query::Irradiance => 256,
@@ -270,9 +271,7 @@ impl Stage {
                     let rows = match q {
                         Query::Emission => scene.emission(a, acc),
                         Query::Radiance => scene.radiance(a, &b_rows.unwrap()[start..end], acc),
-                        Query::Irradiance => {
-                            scene.irradiance(a, &b_rows.unwrap()[start..end], acc)
-                        }
+                        Query::Irradiance => scene.irradiance(a, &b_rows.unwrap()[start..end], acc),
                     }
                     .map_err(|e| errors::lux(e, Some(file)))?;
                     let m = end - start;
@@ -294,12 +293,16 @@ impl Stage {
     }
 }
 
-/// A zeroed f32 buffer, or `MemoryError` rather than an abort when it cannot be allocated.
-fn zeros(len: usize) -> PyResult<Vec<f32>> {
+/// A zeroed f32 buffer of `len` values (`None`: more than `usize` can count), or `MemoryError`
+/// rather than an abort when it cannot be allocated.
+fn zeros(len: Option<usize>) -> PyResult<Vec<f32>> {
+    let too_big =
+        |what: String| PyMemoryError::new_err(format!("cannot allocate the result: {what}"));
+    let len = len.ok_or_else(|| too_big("more values than memory can address".into()))?;
     let mut v = Vec::new();
     v.try_reserve_exact(len).map_err(|_| {
-        PyMemoryError::new_err(format!(
-            "cannot allocate the result: {len} float32 values ({} bytes)",
+        too_big(format!(
+            "{len} float32 values ({} bytes)",
             len.saturating_mul(4)
         ))
     })?;
@@ -328,7 +331,10 @@ fn vec3(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DVec3> {
     let list = arr.call_method0(intern!(py, "tolist"))?;
     let v: [f64; 3] = list.extract()?;
     if v.iter().any(|c| !c.is_finite()) {
-        return Err(errors::input(format!("{name}: {} is not finite", list.str()?)));
+        return Err(errors::input(format!(
+            "{name}: {} is not finite",
+            list.str()?
+        )));
     }
     Ok(DVec3::from_array(v))
 }
@@ -359,12 +365,13 @@ impl Stage {
     #[pyo3(signature = (path, time = None))]
     fn new(py: Python<'_>, path: PathBuf, time: Option<f64>) -> PyResult<Stage> {
         if let Some(t) = time.filter(|t| !t.is_finite()) {
-            return Err(errors::input(format!("time: {t} is not a finite time code")));
+            return Err(errors::input(format!(
+                "time: {t} is not a finite time code"
+            )));
         }
         let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
-        let scene = py.detach(|| {
-            no_panic(|| Scene::load(&path, time).map_err(|e| errors::lux(e, None)))
-        })?;
+        let scene =
+            py.detach(|| no_panic(|| Scene::load(&path, time).map_err(|e| errors::lux(e, None))))?;
         let lights_json = serde_json::to_string(&scene.lights)
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
         Ok(Stage {
@@ -587,7 +594,7 @@ impl Stage {
         let scene = self.prepare_for(py, &o)?;
         let normal = plane.normal().as_vec3().to_array();
         let pixels = plane.pixels();
-        let mut out = zeros(pixels * 3)?;
+        let mut out = zeros(pixels.checked_mul(3))?;
         // Whole rows of pixels per call, sized like the queries' chunks.
         let mut chunks = Chunks::new(256, scene.len());
         let file = self.file();
