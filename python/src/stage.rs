@@ -148,6 +148,9 @@ fn parse_lights(lights: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
     Ok(out)
 }
 
+/// `Stage(path, time)`'s arguments, as pickling records them.
+type StageArgs = (String, Option<f64>);
+
 #[derive(Clone, Copy)]
 enum Query {
     Emission,
@@ -585,7 +588,8 @@ impl Stage {
         let u = vec3(py, u, "u")?;
         let v = vec3(py, v, "v")?;
         let (w, h) = resolution(res)?;
-        if !(u.cross(v).length() > 0.0) {
+        // Refuses a NaN length too (huge finite vectors can overflow to one).
+        if u.cross(v).length().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
             return Err(errors::input(format!(
                 "u/v: u = {u} and v = {v} are parallel or zero: they span no plane"
             )));
@@ -632,9 +636,7 @@ impl Stage {
             .into_any())
     }
 
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyType>, (String, Option<f64>))> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyType>, StageArgs)> {
         let me = slf.get();
         Ok((
             slf.get_type(),

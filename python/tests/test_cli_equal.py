@@ -5,6 +5,7 @@ irradiance -o OUT.npy`` on the same device, on the bundled stage and on the luxt
 from __future__ import annotations
 
 import json
+from contextlib import nullcontext
 
 import numpy as np
 import pytest
@@ -106,7 +107,11 @@ def test_luxtest_equals_cli(cli, tmp_path, device, scene):
     """Per-light emission and summed irradiance on the luxtest floor at frame 5."""
     stage = luxeval.Stage(scene, time=5)
     dirs = sphere_dirs(512, seed=5)
-    got = stage.emission(dirs, per_light=True, device=device)
+    # Scenes whose lights luxeval cannot evaluate yet (IES, textured domes) give zeros, with a
+    # warning on the first query, as the CLI gives zeros with a warning.
+    nothing = not stage.light_paths()
+    with pytest.warns(UserWarning, match="no light to evaluate") if nothing else nullcontext():
+        got = stage.emission(dirs, per_light=True, device=device)
     want = cli_query(cli, tmp_path, "emission", scene, {"dirs": dirs}, *_flags(device, True, 5))
     assert got.shape == (len(stage.light_paths()), 512, 3)
     np.testing.assert_array_equal(got, want)
