@@ -1,0 +1,41 @@
+"""luxeval: evaluate USD lights (UsdLux) on the GPU or on an f64 CPU reference.
+
+Open a stage, then ask for emission, radiance, irradiance or a falloff map with NumPy arrays::
+
+    import numpy as np
+    import luxeval
+
+    stage = luxeval.Stage("assets/studio.usda")
+    dirs = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
+    rgb = stage.emission(dirs)               # float32 (2, 3): the sum over lights
+    per = stage.emission(dirs, per_light=True)  # float32 (L, 2, 3), rows as stage.light_paths()
+
+This package mirrors the Rust library (``luxeval::Scene``, ``Evaluator``, ``PreparedScene``):
+
+- :class:`Stage` reads a stage's lights once; its queries prepare the selected lights once per
+  (``lights``, device, ``temperature_mode``) and reuse them, with the GPU pipelines and buffers.
+- :class:`InputError` (a ``ValueError``): bad input, naming the file, prim and attribute or the
+  argument. :class:`DeviceError` (a ``RuntimeError``): no GPU with ``device="gpu"``, a device
+  failure. :class:`DeviceWarning`: ``device="auto"`` found no GPU and uses the CPU reference.
+- :func:`device_name`: which device a ``device=`` argument selects.
+- :mod:`luxeval.dask` (needs ``dask`` and ``distributed``): the same queries over chunked dask
+  arrays, one opened stage per worker process.
+"""
+
+from ._luxeval import (
+    DeviceError,
+    DeviceWarning,
+    InputError,
+    Stage,
+    __version__,
+    device_name,
+)
+
+__all__ = [
+    "DeviceError",
+    "DeviceWarning",
+    "InputError",
+    "Stage",
+    "__version__",
+    "device_name",
+]

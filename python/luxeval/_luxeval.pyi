@@ -1,0 +1,122 @@
+"""Type stubs of the extension module luxeval._luxeval (re-exported by ``luxeval``)."""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Literal, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+Device = Literal["auto", "gpu", "cpu"]
+TemperatureMode = Literal["spec", "usd", "planckian"]
+Lights = Optional[Union[str, Sequence[str]]]
+Vec3 = Union[Sequence[float], npt.ArrayLike]
+
+class InputError(ValueError):
+    """Bad input: an unreadable or malformed stage, an attribute luxeval cannot evaluate, an
+    array of the wrong shape or with non-finite values, a bad argument. The message names the
+    file, the prim and the attribute, or the argument."""
+
+class DeviceError(RuntimeError):
+    """A run-time failure: no GPU adapter with device="gpu", a device that could not be opened
+    or was lost, a failed GPU computation."""
+
+class DeviceWarning(RuntimeWarning):
+    """Issued once per process when device="auto" finds no GPU adapter and falls back to the CPU
+    reference."""
+
+def device_name(device: Device = "auto") -> str:
+    """The device a query with this ``device=`` argument runs on: the GPU adapter's name and
+    backend, or ``"cpu (f64 reference)"``. Opens the GPU if it is not open yet."""
+
+class Stage:
+    """A USD stage (.usda, .usdc, .usdz) and its lights, read once at one time.
+
+    ``Stage(path, time=None)`` reads the lights at ``time`` (a USD time code); without one, at
+    the stage's ``startTimeCode`` when authored, else at each attribute's earliest time sample.
+    Raises ``InputError`` when the file is missing, unreadable or malformed (naming the file and
+    line or prim). Queries take any real dtype in C or Fortran order (C-contiguous float32 is
+    used without a copy) and return ``numpy.float32`` arrays; the lights are prepared once per
+    (lights, device, temperature_mode) and reused. Picklable: unpickling opens the stage again.
+    """
+
+    def __init__(self, path: Union[str, os.PathLike[str]], time: Optional[float] = None) -> None: ...
+    @property
+    def path(self) -> str:
+        """The stage's path, as given."""
+    @property
+    def time(self) -> Optional[float]:
+        """The time code the lights were read at; ``None`` for USD's EarliestTime."""
+    @property
+    def time_rule(self) -> Literal["given", "start_time_code", "earliest"]:
+        """Why the lights were read at ``time``."""
+    @property
+    def up_axis(self) -> str:
+        """``"Y"`` or ``"Z"`` (``"Y"`` when not authored)."""
+    @property
+    def meters_per_unit(self) -> float:
+        """The stage's metersPerUnit (0.01 when not authored)."""
+    @property
+    def lights(self) -> list[dict[str, Any]]:
+        """Every light of the stage in traversal order, as the records of
+        ``luxeval lights --json``. A new list on each access."""
+    @property
+    def warnings(self) -> list[str]:
+        """One message per light the queries skip (unsupported, invisible), naming its prim."""
+    @property
+    def prepared(self) -> list[tuple[Optional[tuple[str, ...]], Literal["gpu", "cpu"], TemperatureMode]]:
+        """The prepared light sets cached on this stage: (selection or None, device, mode)."""
+    def light_paths(self, lights: Lights = None) -> list[str]:
+        """The prim paths a query with this ``lights=`` evaluates, in ``per_light`` row order."""
+    def emission(
+        self,
+        dirs: npt.ArrayLike,
+        *,
+        per_light: bool = False,
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+    ) -> npt.NDArray[np.float32]:
+        """Radiance leaving each light along each direction (N, 3) → float32 (N, 3), or
+        (L, N, 3) with ``per_light=True``."""
+    def radiance(
+        self,
+        points: npt.ArrayLike,
+        dirs: npt.ArrayLike,
+        *,
+        per_light: bool = False,
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+    ) -> npt.NDArray[np.float32]:
+        """Radiance arriving at each point from each direction (pairs of (N, 3)) → float32
+        (N, 3), or (L, N, 3) with ``per_light=True``."""
+    def irradiance(
+        self,
+        points: npt.ArrayLike,
+        normals: npt.ArrayLike,
+        *,
+        per_light: bool = False,
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+    ) -> npt.NDArray[np.float32]:
+        """Diffuse-weighted irradiance at each point on a receiver with the given normal →
+        float32 (N, 3), or (L, N, 3) with ``per_light=True``."""
+    def falloff(
+        self,
+        origin: Vec3,
+        u: Vec3,
+        v: Vec3,
+        res: tuple[int, int],
+        *,
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+    ) -> npt.NDArray[np.float32]:
+        """The summed irradiance at the pixel centres of ``origin + s·u + t·v``, res = (W, H)
+        → float32 (H, W, 3), row 0 at the top (the ``origin + v`` side)."""
+    def __reduce__(self) -> tuple[type[Stage], tuple[str, Optional[float]]]: ...

@@ -1,0 +1,664 @@
+//! `luxeval.Stage`: a USD stage's lights read once, queried any number of times.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use glam::DVec3;
+use luxeval::falloff::{self, Plane};
+use luxeval::{Accumulate, PreparedScene, Scene, TemperatureMode, TimeRule};
+use numpy::prelude::*;
+use numpy::{PyArray1, PyReadonlyArray2};
+use pyo3::exceptions::{PyMemoryError, PyUserWarning};
+use pyo3::intern;
+use pyo3::prelude::*;
+use pyo3::types::{PyString, PyTuple, PyType};
+
+use crate::arrays::{self, Kind};
+use crate::device::{self, Device};
+use crate::errors::{self, no_panic};
+
+/// How many rows each call into the library evaluates. Between two calls the GIL is taken back
+/// and Ctrl-C is checked, so a call should take about [`Chunks::TARGET_S`] whatever the device
+/// and the query cost (irradiance on the CPU reference costs ~10 000 times what emission on a
+/// GPU does): the first chunk is small, and each next one is sized from the last one's time.
+/// Sizes are powers of two, so that the GPU's buffers (kept per power-of-two size class) are
+/// reused from chunk to chunk once the size settles.
+struct Chunks {
+    rows: usize,
+    max: usize,
+}
+
+impl Chunks {
+    const TARGET_S: f64 = 0.25;
+    /// At most this many light-samples (rows × lights) per call: bounds the chunk's memory.
+    const MAX_SAMPLES: usize = 1 << 22;
+
+    fn new(first: usize, lights: usize) -> Chunks {
+        let max = (Self::MAX_SAMPLES / lights.max(1)).max(1);
+        Chunks {
+            rows: first.min(max).max(1),
+            max,
+        }
+    }
+
+    /// After a chunk of `rows` rows took `secs`: the size of the next one, within 4× of it.
+    fn update(&mut self, rows: usize, secs: f64) {
+        let rows = rows.max(1);
+        let ideal = if secs > 0.0 {
+            rows as f64 * Self::TARGET_S / secs
+        } else {
+            f64::INFINITY
+        };
+        let ideal = ideal.clamp((rows / 4).max(1) as f64, rows.saturating_mul(4) as f64);
+        self.rows = if ideal >= self.max as f64 {
+            self.max
+        } else {
+            // The power of two at or below the ideal size.
+            let ideal = ideal as usize;
+            1usize << (usize::BITS - 1 - ideal.leading_zeros())
+        };
+    }
+}
+
+/// A USD stage (``.usda``, ``.usdc``, ``.usdz``) and its lights, read once at one time.
+///
+/// ``Stage(path, time=None)`` opens the stage with every composition arc and payload loaded and
+/// reads its lights at ``time`` (a USD time code); without one, at the stage's ``startTimeCode``
+/// when it is authored, else at each attribute's earliest time sample (USD's EarliestTime), as
+/// ``luxeval lights`` does.
+///
+/// The queries (``emission``, ``radiance``, ``irradiance``, ``falloff``) take NumPy arrays (any
+/// real dtype, C or Fortran order; C-contiguous float32 is used without a copy) and return
+/// ``numpy.float32`` arrays. The lights a query evaluates are prepared once per
+/// (``lights``, device, ``temperature_mode``) and kept on the stage: later calls reuse the
+/// prepared lights, the GPU pipelines and buffers. The GIL is released while the device works,
+/// and Ctrl-C stops a long call with ``KeyboardInterrupt`` between chunks.
+///
+/// Raises ``InputError`` (a ``ValueError``) when the file is missing, unreadable or malformed
+/// (the message names the file and line or prim), and ``TypeError`` when ``path`` is not a str
+/// or path-like object. A Stage can be pickled: unpickling opens the stage again (by its absolute
+/// path, at the same requested time).
+#[pyclass(module = "luxeval", frozen)]
+pub struct Stage {
+    /// As given.
+    path: PathBuf,
+    absolute: PathBuf,
+    /// The `time` argument (`None`: the stage's default rule).
+    requested_time: Option<f64>,
+    scene: Scene,
+    /// `scene.lights` as `luxeval lights --json` writes them.
+    lights_json: String,
+    prepared: Mutex<HashMap<Key, Arc<PreparedScene>>>,
+}
+
+/// What a prepared scene depends on.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+struct Key {
+    /// The `lights` selection, sorted (empty: every light).
+    select: Vec<String>,
+    gpu: bool,
+    mode: TemperatureMode,
+}
+
+/// The options every query takes.
+struct Options {
+    select: Vec<String>,
+    device: Device,
+    mode: TemperatureMode,
+}
+
+impl Options {
+    fn parse(lights: Option<&Bound<'_, PyAny>>, device: &str, mode: &str) -> PyResult<Options> {
+        Ok(Options {
+            select: parse_lights(lights)?,
+            device: Device::parse(device)?,
+            mode: device::parse_mode(mode)?,
+        })
+    }
+}
+
+/// `None`: every light; a str: that prim path; an iterable of str: those prim paths.
+fn parse_lights(lights: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
+    let Some(obj) = lights else {
+        return Ok(Vec::new());
+    };
+    if obj.is_none() {
+        return Ok(Vec::new());
+    }
+    if obj.is_instance_of::<PyString>() {
+        return Ok(vec![obj.extract::<String>()?]);
+    }
+    let bad = || {
+        errors::input(format!(
+            "lights: expected None, a prim path or a list of prim paths, got {}",
+            obj.repr().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    };
+    let mut out = Vec::new();
+    for item in obj.try_iter().map_err(|_| bad())? {
+        out.push(item?.extract::<String>().map_err(|_| bad())?);
+    }
+    if out.is_empty() {
+        return Err(errors::input(
+            "lights: an empty list selects no light; pass None for every light",
+        ));
+    }
+    Ok(out)
+}
+
+/// `Stage(path, time)`'s arguments, as pickling records them.
+type StageArgs = (String, Option<f64>);
+
+#[derive(Clone, Copy)]
+enum Query {
+    Emission,
+    Radiance,
+    Irradiance,
+}
+
+impl Stage {
+    fn file(&self) -> &Path {
+        &self.path
+    }
+
+    /// The prepared scene for these options, from the cache or prepared now.
+    fn prepare_for(&self, py: Python<'_>, o: &Options) -> PyResult<Arc<PreparedScene>> {
+        // Selection and attribute errors first: they cost nothing to find, a device does.
+        let lights = self
+            .scene
+            .evaluable(&o.select)
+            .map_err(|e| errors::lux(e, Some(self.file())))?;
+        for l in &lights {
+            l.validate()
+                .map_err(|e| errors::lux(e, Some(self.file())))?;
+        }
+        let eval = device::evaluator(py, o.device, o.mode)?;
+        let mut select = o.select.clone();
+        select.sort();
+        select.dedup();
+        let key = Key {
+            select,
+            gpu: eval.is_gpu(),
+            mode: o.mode,
+        };
+        if let Some(p) = self.cache().get(&key) {
+            return Ok(p.clone());
+        }
+        if lights.is_empty() {
+            let msg = format!(
+                "{}: no light to evaluate; the result is all zeros",
+                self.path.display()
+            );
+            let msg = std::ffi::CString::new(msg.replace('\0', " ")).expect("no NUL");
+            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &msg, 2)?;
+        }
+        let file = self.file();
+        let scene = py.detach(|| {
+            no_panic(|| {
+                eval.prepare(&lights)
+                    .map_err(|e| errors::lux(e, Some(file)))
+            })
+        })?;
+        let scene = Arc::new(scene);
+        Ok(self.cache().entry(key).or_insert(scene).clone())
+    }
+
+    fn cache(&self) -> std::sync::MutexGuard<'_, HashMap<Key, Arc<PreparedScene>>> {
+        self.prepared
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn query<'py>(
+        &self,
+        py: Python<'py>,
+        q: Query,
+        a: &Bound<'py, PyAny>,
+        b: Option<&Bound<'py, PyAny>>,
+        per_light: bool,
+        o: Options,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (a_name, a_kind, b_name) = match q {
+            Query::Emission => ("dirs", Kind::Direction, ""),
+            Query::Radiance => ("points", Kind::Point, "dirs"),
+            Query::Irradiance => ("points", Kind::Point, "normals"),
+        };
+        let a_arr = arrays::rows(py, a, a_name, a_kind)?;
+        let b_arr: Option<PyReadonlyArray2<'py, f32>> = match b {
+            Some(b) => Some(arrays::rows(py, b, b_name, Kind::Direction)?),
+            None => None,
+        };
+        let a_rows = arrays::as_vec3(&a_arr)?;
+        let b_rows = match &b_arr {
+            Some(b) => Some(arrays::as_vec3(b)?),
+            None => None,
+        };
+        if let Some(b_rows) = b_rows
+            && b_rows.len() != a_rows.len()
+        {
+            return Err(errors::input(format!(
+                "{a_name}/{b_name}: {} {a_name} but {} {b_name}; they pair up row by row",
+                a_rows.len(),
+                b_rows.len()
+            )));
+        }
+        let scene = self.prepare_for(py, &o)?;
+        let n = a_rows.len();
+        let l = scene.len();
+        let (acc, width) = if per_light {
+            (Accumulate::PerLight, l)
+        } else {
+            (Accumulate::Sum, 1)
+        };
+        let mut out = zeros(width.checked_mul(n).and_then(|x| x.checked_mul(3)))?;
+        let mut chunks = Chunks::new(
+            match q {
+                Query::Irradiance => 256,
+                _ => 1 << 14,
+            },
+            l,
+        );
+        let file = self.file();
+        let mut start = 0;
+        while start < n {
+            let end = (start + chunks.rows).min(n);
+            let scene = &*scene;
+            let out = &mut out;
+            let t0 = Instant::now();
+            py.detach(|| {
+                no_panic(|| {
+                    let a = &a_rows[start..end];
+                    let rows = match q {
+                        Query::Emission => scene.emission(a, acc),
+                        Query::Radiance => scene.radiance(a, &b_rows.unwrap()[start..end], acc),
+                        Query::Irradiance => scene.irradiance(a, &b_rows.unwrap()[start..end], acc),
+                    }
+                    .map_err(|e| errors::lux(e, Some(file)))?;
+                    let m = end - start;
+                    for li in 0..width {
+                        let dst = &mut out[(li * n + start) * 3..(li * n + end) * 3];
+                        dst.copy_from_slice(rows[li * m..(li + 1) * m].as_flattened());
+                    }
+                    Ok(())
+                })
+            })?;
+            if end < n {
+                chunks.update(end - start, t0.elapsed().as_secs_f64());
+            }
+            py.check_signals()?;
+            start = end;
+        }
+        let shape: Vec<usize> = if per_light { vec![l, n, 3] } else { vec![n, 3] };
+        Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+    }
+}
+
+/// A zeroed f32 buffer of `len` values (`None`: more than `usize` can count), or `MemoryError`
+/// rather than an abort when it cannot be allocated.
+fn zeros(len: Option<usize>) -> PyResult<Vec<f32>> {
+    let too_big =
+        |what: String| PyMemoryError::new_err(format!("cannot allocate the result: {what}"));
+    let len = len.ok_or_else(|| too_big("more values than memory can address".into()))?;
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|_| {
+        too_big(format!(
+            "{len} float32 values ({} bytes)",
+            len.saturating_mul(4)
+        ))
+    })?;
+    v.resize(len, 0.0);
+    Ok(v)
+}
+
+/// A 3-vector argument of `falloff`: three finite numbers.
+fn vec3(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DVec3> {
+    let np = py.import(intern!(py, "numpy"))?;
+    let arr = np
+        .call_method1(intern!(py, "asarray"), (obj, np.getattr("float64")?))
+        .map_err(|e| {
+            errors::input(format!(
+                "{name}: expected three numbers X, Y, Z: {}",
+                e.value(py)
+            ))
+        })?;
+    let shape: Vec<usize> = arr.getattr(intern!(py, "shape"))?.extract()?;
+    if shape != [3] {
+        return Err(errors::input(format!(
+            "{name}: shape {}; expected three numbers X, Y, Z",
+            arrays::shape_str(&shape)
+        )));
+    }
+    let list = arr.call_method0(intern!(py, "tolist"))?;
+    let v: [f64; 3] = list.extract()?;
+    if v.iter().any(|c| !c.is_finite()) {
+        return Err(errors::input(format!(
+            "{name}: {} is not finite",
+            list.str()?
+        )));
+    }
+    Ok(DVec3::from_array(v))
+}
+
+/// `res`: (width, height) in pixels.
+fn resolution(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
+    let bad = || {
+        errors::input(format!(
+            "res: expected (width, height), two integers ≥ 1, got {}",
+            res.repr().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    };
+    let (w, h): (i64, i64) = res.extract().map_err(|_| bad())?;
+    let w = u32::try_from(w).ok().filter(|w| *w >= 1).ok_or_else(bad)?;
+    let h = u32::try_from(h).ok().filter(|h| *h >= 1).ok_or_else(bad)?;
+    if w as u64 * h as u64 > falloff::MAX_PIXELS {
+        return Err(errors::input(format!(
+            "res: {w}×{h} is more than {} pixels",
+            falloff::MAX_PIXELS
+        )));
+    }
+    Ok((w, h))
+}
+
+#[pymethods]
+impl Stage {
+    #[new]
+    #[pyo3(signature = (path, time = None))]
+    fn new(py: Python<'_>, path: PathBuf, time: Option<f64>) -> PyResult<Stage> {
+        if let Some(t) = time.filter(|t| !t.is_finite()) {
+            return Err(errors::input(format!(
+                "time: {t} is not a finite time code"
+            )));
+        }
+        let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
+        let scene =
+            py.detach(|| no_panic(|| Scene::load(&path, time).map_err(|e| errors::lux(e, None))))?;
+        let lights_json = serde_json::to_string(&scene.lights)
+            .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
+        Ok(Stage {
+            path,
+            absolute,
+            requested_time: time,
+            scene,
+            lights_json,
+            prepared: Mutex::new(HashMap::new()),
+        })
+    }
+
+    /// The stage's path, as given.
+    #[getter]
+    fn path(&self) -> String {
+        self.path.to_string_lossy().into_owned()
+    }
+
+    /// The time code the lights were read at, or ``None`` for USD's EarliestTime (each
+    /// attribute's earliest time sample). See ``time_rule``.
+    #[getter]
+    fn time(&self) -> Option<f64> {
+        match self.scene.time {
+            TimeRule::Given(t) | TimeRule::StartTimeCode(t) => Some(t),
+            TimeRule::Earliest => None,
+        }
+    }
+
+    /// Why the lights were read at ``time``: ``"given"`` (the ``time`` argument),
+    /// ``"start_time_code"`` (the stage's ``startTimeCode``) or ``"earliest"``.
+    #[getter]
+    fn time_rule(&self) -> &'static str {
+        match self.scene.time {
+            TimeRule::Given(_) => "given",
+            TimeRule::StartTimeCode(_) => "start_time_code",
+            TimeRule::Earliest => "earliest",
+        }
+    }
+
+    /// ``"Y"`` or ``"Z"`` (``"Y"`` when the stage does not author ``upAxis``, as USD does).
+    #[getter]
+    fn up_axis(&self) -> &str {
+        &self.scene.up_axis
+    }
+
+    /// The stage's ``metersPerUnit`` (0.01 when not authored, as USD does).
+    #[getter]
+    fn meters_per_unit(&self) -> f64 {
+        self.scene.meters_per_unit
+    }
+
+    /// Every light of the stage in traversal order, evaluated or not, as dicts: the records of
+    /// ``luxeval lights --json`` (``path``, ``usd_type``, ``applied_schemas``, ``visible``,
+    /// ``world`` (row-vector, ``world[3]`` is the translation), ``inputs`` (each with ``name``,
+    /// ``value``, ``authored``), ``evaluable``, ``warning``). A new list on each access.
+    #[getter]
+    fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import(intern!(py, "json"))?
+            .call_method1(intern!(py, "loads"), (&self.lights_json,))
+    }
+
+    /// One message per light that the queries skip (unsupported type or feature, invisible),
+    /// naming its prim; ``luxeval`` prints the same lines as ``warning:`` on stderr.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.scene.warnings()
+    }
+
+    /// The prepared light sets cached on this stage, as (``lights`` selection as a sorted tuple
+    /// or ``None`` for every light, ``"gpu"`` or ``"cpu"``, ``temperature_mode``) tuples: each is
+    /// prepared by the first query with those options and reused by every later one.
+    #[getter]
+    fn prepared<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyTuple>>> {
+        let mut keys: Vec<Key> = self.cache().keys().cloned().collect();
+        keys.sort_by(|a, b| {
+            (&a.select, a.gpu, device::mode_name(a.mode)).cmp(&(
+                &b.select,
+                b.gpu,
+                device::mode_name(b.mode),
+            ))
+        });
+        keys.into_iter()
+            .map(|k| {
+                let select: Py<PyAny> = if k.select.is_empty() {
+                    py.None()
+                } else {
+                    PyTuple::new(py, &k.select)?.into_any().unbind()
+                };
+                PyTuple::new(
+                    py,
+                    [
+                        select,
+                        PyString::new(py, if k.gpu { "gpu" } else { "cpu" })
+                            .into_any()
+                            .unbind(),
+                        PyString::new(py, device::mode_name(k.mode))
+                            .into_any()
+                            .unbind(),
+                    ],
+                )
+            })
+            .collect()
+    }
+
+    /// The prim paths a query with this ``lights=`` argument evaluates, in the order of the
+    /// rows of ``per_light=True`` results: the visible, evaluable lights in stage order (the
+    /// selection filters; it does not reorder). Raises ``InputError`` when a selected path is
+    /// not a light of the stage.
+    #[pyo3(signature = (lights = None))]
+    fn light_paths(&self, lights: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
+        let select = parse_lights(lights)?;
+        Ok(self
+            .scene
+            .evaluable(&select)
+            .map_err(|e| errors::lux(e, Some(self.file())))?
+            .into_iter()
+            .map(|l| l.path)
+            .collect())
+    }
+
+    /// The radiance leaving each light along each direction: ``dirs``
+    /// points away from the light (for a dome, toward the environment), any non-zero length.
+    ///
+    /// ``dirs``: (N, 3), any real dtype. Returns float32 (N, 3), the sum over lights, or
+    /// (L, N, 3) with ``per_light=True``, in the order of ``light_paths(lights)``.
+    /// ``lights``: a prim path or a list of them (default: every visible, evaluable light).
+    /// ``device``: ``"auto"`` (the GPU, else the CPU reference with one ``DeviceWarning``),
+    /// ``"gpu"`` (``DeviceError`` without one) or ``"cpu"`` (the f64 reference, rounded to
+    /// float32). ``temperature_mode``: ``"spec"``, ``"usd"`` or ``"planckian"``.
+    /// Raises ``InputError`` for a wrong shape or dtype, a non-finite or zero row, an unknown
+    /// light, or a light attribute luxeval cannot evaluate (naming the file, prim, attribute).
+    #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec"))]
+    fn emission<'py>(
+        &self,
+        py: Python<'py>,
+        dirs: &Bound<'py, PyAny>,
+        per_light: bool,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = Options::parse(lights, device, temperature_mode)?;
+        self.query(py, Query::Emission, dirs, None, per_light, o)
+    }
+
+    /// The radiance arriving at each point from each direction:
+    /// ``dirs[i]`` points from ``points[i]`` toward the light; 0 where the ray misses it.
+    ///
+    /// ``points``, ``dirs``: (N, 3) each, paired row by row. Returns float32 (N, 3), or
+    /// (L, N, 3) with ``per_light=True``. Options and errors as ``emission``.
+    #[pyo3(signature = (points, dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[allow(clippy::too_many_arguments)]
+    fn radiance<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        dirs: &Bound<'py, PyAny>,
+        per_light: bool,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = Options::parse(lights, device, temperature_mode)?;
+        self.query(py, Query::Radiance, points, Some(dirs), per_light, o)
+    }
+
+    /// The diffuse-weighted irradiance at each point on a one-sided receiver with the given
+    /// normal: ``diffuse · ∫ radiance(x, ω) max(0, n·ω) dω``, no
+    /// occlusion (lux for lights in nits).
+    ///
+    /// ``points``, ``normals``: (N, 3) each, paired row by row; normals any non-zero length.
+    /// Returns float32 (N, 3), or (L, N, 3) with ``per_light=True``. Options and errors as
+    /// ``emission``.
+    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[allow(clippy::too_many_arguments)]
+    fn irradiance<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: &Bound<'py, PyAny>,
+        per_light: bool,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = Options::parse(lights, device, temperature_mode)?;
+        self.query(py, Query::Irradiance, points, Some(normals), per_light, o)
+    }
+
+    /// A falloff map, as ``luxeval falloff`` computes it: the summed irradiance at the pixel
+    /// centres of the rectangle ``origin + s·u + t·v`` (s, t in [0, 1]), receiver normal
+    /// ``normalize(u × v)``. ``origin``, ``u``, ``v``: three numbers each; ``res``:
+    /// (width, height). Returns float32 (height, width, 3), row 0 at the top of the image
+    /// (``origin + v`` side), column 0 at the ``origin`` side: pixel (row j, column i) is at
+    /// ``origin + (i + ½)/W·u + (1 − (j + ½)/H)·v``. Options and errors as ``emission``.
+    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[allow(clippy::too_many_arguments)]
+    fn falloff<'py>(
+        &self,
+        py: Python<'py>,
+        origin: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+        v: &Bound<'py, PyAny>,
+        res: &Bound<'py, PyAny>,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = Options::parse(lights, device, temperature_mode)?;
+        let origin = vec3(py, origin, "origin")?;
+        let u = vec3(py, u, "u")?;
+        let v = vec3(py, v, "v")?;
+        let (w, h) = resolution(res)?;
+        // Refuses a NaN length too (huge finite vectors can overflow to one).
+        if u.cross(v).length().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return Err(errors::input(format!(
+                "u/v: u = {u} and v = {v} are parallel or zero: they span no plane"
+            )));
+        }
+        let plane = Plane::new(origin, u, v, w, h).map_err(|e| errors::lux(e, None))?;
+        let scene = self.prepare_for(py, &o)?;
+        let normal = plane.normal().as_vec3().to_array();
+        let pixels = plane.pixels();
+        let mut out = zeros(pixels.checked_mul(3))?;
+        // Whole rows of pixels per call, sized like the queries' chunks.
+        let mut chunks = Chunks::new(256, scene.len());
+        let file = self.file();
+        let mut j0 = 0u32;
+        while j0 < h {
+            let rows = (chunks.rows / w as usize).clamp(1, h as usize) as u32;
+            let j1 = (j0 + rows).min(h);
+            let scene = &*scene;
+            let plane = &plane;
+            let out = &mut out;
+            let t0 = Instant::now();
+            py.detach(|| {
+                no_panic(|| {
+                    let points: Vec<[f32; 3]> = (j0..j1)
+                        .flat_map(|j| (0..w).map(move |i| (i, j)))
+                        .map(|(i, j)| plane.pixel_centre(i, j).as_vec3().to_array())
+                        .collect();
+                    let normals = vec![normal; points.len()];
+                    let rgb = scene
+                        .irradiance(&points, &normals, Accumulate::Sum)
+                        .map_err(|e| errors::lux(e, Some(file)))?;
+                    let at = j0 as usize * w as usize * 3;
+                    out[at..at + rgb.len() * 3].copy_from_slice(rgb.as_flattened());
+                    Ok(())
+                })
+            })?;
+            if j1 < h {
+                chunks.update((j1 - j0) as usize * w as usize, t0.elapsed().as_secs_f64());
+            }
+            py.check_signals()?;
+            j0 = j1;
+        }
+        Ok(PyArray1::from_vec(py, out)
+            .reshape([h as usize, w as usize, 3])?
+            .into_any())
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyType>, StageArgs)> {
+        let me = slf.get();
+        Ok((
+            slf.get_type(),
+            (
+                me.absolute.to_string_lossy().into_owned(),
+                me.requested_time,
+            ),
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        let evaluated = self.scene.evaluable(&[]).map(|l| l.len()).unwrap_or(0);
+        let at = match self.scene.time {
+            TimeRule::Given(t) => format!("time {t}"),
+            TimeRule::StartTimeCode(t) => format!("time {t} (startTimeCode)"),
+            TimeRule::Earliest => "the earliest time".into(),
+        };
+        format!(
+            "<luxeval.Stage {:?} at {at}: {} lights, {} evaluated>",
+            self.path.to_string_lossy(),
+            self.scene.lights.len(),
+            evaluated
+        )
+    }
+}
