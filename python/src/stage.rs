@@ -375,7 +375,7 @@ impl Stage {
         let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
         let scene =
             py.detach(|| no_panic(|| Scene::load(&path, time).map_err(|e| errors::lux(e, None))))?;
-        let lights_json = serde_json::to_string(&scene.lights)
+        let lights_json = lights_json(&scene)
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
         Ok(Stage {
             path,
@@ -661,4 +661,27 @@ impl Stage {
             evaluated
         )
     }
+}
+
+/// `scene.lights` exactly as `luxeval lights --json` writes them: each record with its total
+/// `power` (`Reference::power`; null for lights at infinity or not evaluated) and, when the light
+/// cannot be prepared, `power_error`.
+fn lights_json(scene: &Scene) -> serde_json::Result<String> {
+    let mut v = serde_json::to_value(&scene.lights)?;
+    if let Some(records) = v.as_array_mut() {
+        for (json, l) in records.iter_mut().zip(&scene.lights) {
+            let Some(light) = &l.light else {
+                json["power"] = serde_json::Value::Null;
+                continue;
+            };
+            match luxeval::Reference::new(light, luxeval::TemperatureMode::default()) {
+                Ok(r) => json["power"] = serde_json::json!(r.power()),
+                Err(e) => {
+                    json["power"] = serde_json::Value::Null;
+                    json["power_error"] = e.to_string().into();
+                }
+            }
+        }
+    }
+    serde_json::to_string(&v)
 }

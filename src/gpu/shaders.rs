@@ -82,6 +82,8 @@ pub enum Kernel {
 }
 
 impl Kernel {
+    /// Every kernel (tests/wgsl.rs validates each, through the `testkit` feature).
+    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
     pub const ALL: [Kernel; 4] = [
         Kernel::Emission,
         Kernel::Radiance,

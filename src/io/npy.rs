@@ -72,9 +72,10 @@ pub fn read_points(path: &Path) -> Result<Vec<[f32; 3]>> {
     Ok(rows)
 }
 
-/// Reads (N, 3) directions and normalises them in f64, so that any finite non-zero row (also one
-/// whose components are subnormal or beyond float32) becomes the float32 unit vector nearest its
-/// direction. A row that is not finite or is zero is refused, naming the file and the row.
+/// Reads (N, 3) directions. float64 rows are normalised in f64, so that any finite non-zero row
+/// (also one whose components are subnormal or beyond float32) becomes the float32 unit vector
+/// nearest its direction; float32 rows are kept as they are (the queries normalise in f64). A
+/// row that is not finite or is zero is refused, naming the file and the row.
 pub fn read_directions(path: &Path) -> Result<Vec<[f32; 3]>> {
     fn unit(path: &Path, i: usize, r: [f64; 3]) -> Result<[f32; 3]> {
         if r.iter().any(|v| !v.is_finite()) {
@@ -93,10 +94,13 @@ pub fn read_directions(path: &Path) -> Result<Vec<[f32; 3]>> {
         Ok(s.map(|v| (v / len) as f32))
     }
     match read_rows(path)? {
+        // float32 rows are checked and kept as they are: the queries normalise every direction
+        // in f64 themselves (on both paths), and a row normalised here first would round twice
+        // and differ in the last bit from the same array given to the library (Python).
         Rows::F32(rows) => rows
             .iter()
             .enumerate()
-            .map(|(i, r)| unit(path, i, r.map(f64::from)))
+            .map(|(i, r)| unit(path, i, r.map(f64::from)).map(|_| *r))
             .collect(),
         Rows::F64(rows) => rows
             .iter()

@@ -12,7 +12,7 @@ use crate::error::{LuxError, Result};
 use crate::gpu::{AdapterSummary, DeviceLimits, GpuContext};
 use crate::model::Light;
 use crate::prepare::TemperatureMode;
-pub use reference::Reference;
+pub use reference::{Power, Reference};
 pub use scene::PreparedScene;
 
 /// Where queries run.
@@ -69,6 +69,8 @@ impl Evaluator {
         self.temperature_mode
     }
 
+    /// Used by `check` (feature `testkit`).
+    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
     pub(crate) fn backend(&self) -> &Backend {
         &self.backend
     }

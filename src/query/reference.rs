@@ -73,6 +73,19 @@ impl Reference {
         cpu::power::flux(&self.p)
     }
 
+    /// [`flux`](Self::flux) as `luxeval lights --json` reports it: RGB, lumens (the
+    /// luminance of the RGB flux, Rec. 709 weights) and watts at 683 lm/W.
+    pub fn power(&self) -> Option<Power> {
+        self.flux().map(|f| {
+            let lumens = 0.2126 * f.x + 0.7152 * f.y + 0.0722 * f.z;
+            Power {
+                rgb: f.to_array(),
+                lumens,
+                watts: lumens / LUMENS_PER_WATT,
+            }
+        })
+    }
+
     /// irradiance at `x` on a receiver with normal `n` (any length; 0 for a zero normal),
     /// `diffuse` applied.
     pub fn irradiance(&self, x: DVec3, n: DVec3) -> DVec3 {
@@ -82,4 +95,18 @@ impl Reference {
         }
         cpu::irradiance::irradiance(&self.p, x, n / len)
     }
+}
+
+/// Lumens per watt at 555 nm: the photometric watts a luminous flux stands for.
+pub const LUMENS_PER_WATT: f64 = 683.0;
+
+/// A light's total emitted power ([`Reference::power`]).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Power {
+    /// RGB flux (lm per channel for lights in nits).
+    pub rgb: [f64; 3],
+    /// Luminous flux: the luminance of `rgb`.
+    pub lumens: f64,
+    /// `lumens` / 683.
+    pub watts: f64,
 }

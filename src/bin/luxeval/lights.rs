@@ -7,26 +7,15 @@ use luxeval::{Reference, SceneLight, TemperatureMode};
 
 use crate::exit::{CliResult, Failure};
 
-/// Lumens per watt at 555 nm: the photometric watts a luminous flux stands for.
-const LUMENS_PER_WATT: f64 = 683.0;
-
-/// A light's total emitted power (DESIGN.md §3 "intensity" integrated over the sphere): RGB
-/// flux, its luminance in lumens (lights in nits) and watts at 683 lm/W; `Ok(None)` for lights
-/// at infinity (distant, dome) or not evaluated; `Err` when the light cannot be prepared (a
-/// missing IES file, ...).
+/// A light's total emitted power (DESIGN.md §3 "intensity" integrated over the sphere) as
+/// JSON; `Ok(None)` for lights at infinity (distant, dome) or not evaluated; `Err` when the light
+/// cannot be prepared (a missing IES file, ...). The Python package reports the same.
 fn power(l: &SceneLight) -> Result<Option<serde_json::Value>, String> {
     let Some(light) = &l.light else {
         return Ok(None);
     };
     let r = Reference::new(light, TemperatureMode::default()).map_err(|e| e.to_string())?;
-    Ok(r.flux().map(|f| {
-        let lumens = 0.2126 * f.x + 0.7152 * f.y + 0.0722 * f.z;
-        serde_json::json!({
-            "rgb": f.to_array(),
-            "lumens": lumens,
-            "watts": lumens / LUMENS_PER_WATT,
-        })
-    }))
+    Ok(r.power().map(|p| serde_json::json!(p)))
 }
 
 pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
