@@ -144,6 +144,7 @@ fn run(name: &str, case: &Case) {
         "reference_cycle_b.usda",
         "sublayer_cycle_b.usda",
         "big_layer.usda",
+        "ies_truncated.ies",
     ] {
         std::fs::copy(corpus().join(companion), input.join(companion)).unwrap();
     }
@@ -384,6 +385,15 @@ cases! {
     npy_header_with_code: Case { args: emission!("{in}/ok.usda", "{in}/npy_header_code.npy"), exit: 2, says: &["npy_header_code.npy", "header"], ..Case::default() };
     npy_not_numpy: Case { args: emission!("{in}/ok.usda", "{in}/npy_not_numpy.npy"), exit: 2, says: &["npy_not_numpy.npy", "not a .npy file"], ..Case::default() };
     light_not_in_stage: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu", "--light", "/nope"], exit: 2, says: &["/nope", "ok.usda"], ..Case::default() };
+
+    // --- IES profiles (shaping:ies:file and `luxeval ies`) -------------------------------------
+    ies_profile_missing: Case { args: emission!("{in}/ies_missing_file.usda", "{in}/dirs.npy"), exit: 2, says: &["ies_missing_file.usda", "/L", "inputs:shaping:ies:file", "missing.ies"], ..Case::default() };
+    ies_profile_truncated_in_stage: Case { args: emission!("{in}/ies_truncated.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_truncated.ies:7", "candela"], ..Case::default() };
+    ies_without_tilt_line: Case { args: &["ies", "{in}/ies_no_tilt.ies"], exit: 2, says: &["ies_no_tilt.ies", "TILT="], ..Case::default() };
+    ies_count_not_integer: Case { args: &["ies", "{in}/ies_bad_count.ies"], exit: 2, says: &["ies_bad_count.ies:3", "integer", "3.5"], ..Case::default() };
+    ies_tilt_file_missing: Case { args: &["ies", "{in}/ies_tilt_missing.ies"], exit: 2, says: &["ies_tilt_missing.ies:2", "nothere.tilt"], ..Case::default() };
+    ies_truncated: Case { args: &["ies", "{in}/ies_truncated.ies", "--png", "{out}/p.png"], exit: 2, says: &["ies_truncated.ies:7", "missing value"], ..Case::default() };
+    ies_png_is_the_profile: Case { args: &["ies", "{in}/ies_bad_count.ies", "--png", "{in}/ies_bad_count.ies"], exit: 2, says: &["--png", "ies_bad_count.ies"], ..Case::default() };
 
     // --- Runtime failures: exit 1 ---------------------------------------------------------------
     disk_full_while_writing_npy: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 1, fsize: Some(100), says: &["writing", "out.npy"], ..Case::default() };

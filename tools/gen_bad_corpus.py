@@ -207,4 +207,21 @@ for name, method, payload in [
         z.writestr(info, payload)
 os.remove(os.path.join(OUT, "layer.usda"))
 
+# IES profiles (LM-63): no TILT line, a count that is not an integer, a TILT file that does not
+# exist, a file that ends inside the candela values; stages whose light names a missing profile
+# and the truncated one.
+IES_HEAD = "IESNA:LM-63-2002\n"
+IES_BODY = "1 -1 1 3 1 1 2 0 0 0\n1 1 100\n0 45 90\n0\n100 50 0\n"
+for name, body in [
+    ("ies_no_tilt.ies", IES_HEAD + "[TEST] x\n" + IES_BODY),
+    ("ies_bad_count.ies", IES_HEAD + "TILT=NONE\n" + IES_BODY.replace("1 3 1", "1 3.5 1", 1)),
+    ("ies_tilt_missing.ies", IES_HEAD + "TILT=nothere.tilt\n" + IES_BODY),
+    ("ies_truncated.ies", IES_HEAD + "TILT=NONE\n" + IES_BODY[: -len(" 0\n")] + "\n"),
+]:
+    with open(os.path.join(OUT, name), "w") as f:
+        f.write(body)
+for name, profile in [("ies_missing_file.usda", "missing.ies"), ("ies_truncated.usda", "ies_truncated.ies")]:
+    text(name, '\ndef SphereLight "L" (\n    prepend apiSchemas = ["ShapingAPI"]\n)\n{\n'
+         f"    asset inputs:shaping:ies:file = @{profile}@\n}}\n")
+
 print(len(os.listdir(OUT)), "files in", os.path.normpath(OUT))
