@@ -429,7 +429,9 @@ impl Stage {
     /// Every light of the stage in traversal order, evaluated or not, as dicts: the records of
     /// ``luxeval lights --json`` (``path``, ``usd_type``, ``applied_schemas``, ``visible``,
     /// ``world`` (row-vector, ``world[3]`` is the translation), ``inputs`` (each with ``name``,
-    /// ``value``, ``authored``), ``evaluable``, ``warning``). A new list on each access.
+    /// ``value``, ``authored``), ``evaluable``, ``warning``, ``power`` (``rgb``, ``lumens``,
+    /// ``watts``; ``None`` for lights at infinity or not evaluated) and, when the light cannot be
+    /// prepared, ``power_error``). A new list on each access.
     #[getter]
     fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         py.import(intern!(py, "json"))?
