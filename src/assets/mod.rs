@@ -1,6 +1,10 @@
 //! Readers of the files a stage references (DESIGN.md §1: the assets `prepare` loads): IES
-//! photometric profiles (LM-63 and EULUMDAT). Leaf modules: they depend on nothing else of
-//! luxeval, so that a reader can be fuzzed and tested on its own.
+//! photometric profiles (LM-63 and EULUMDAT) and textures (OpenEXR, PNG, JPEG, Radiance HDR).
+//! Leaf modules: they depend on nothing else of luxeval, so that a reader can be fuzzed and
+//! tested on its own.
 
 pub mod ies;
 pub mod package;
+// Dome textures (issue 9): `prepare` loads them from the next step on.
+#[allow(dead_code)]
+pub mod texture;

@@ -1,0 +1,693 @@
+//! Texture files → linear RGB `f32` images (DESIGN.md §6 "RectLight texture", last bullet, and
+//! §6 D1 "Texel grid"). Ported from the staged crate `luxeval-dome` (`src/texture.rs`).
+//!
+//! - OpenEXR (half, float or uint samples; scanline or tiled; every compression the `exr` crate
+//!   decodes, which since 1.74 includes DWAA/DWAB): linear as stored, read through the **data
+//!   window** (the display window is ignored), row 0 = data window min.y = top. RGB from the
+//!   channels `R`, `G`, `B`; a lone `Y` channel is grey; alpha and any other channel are ignored.
+//!   The largest resolution level of a mip/rip-mapped file is used.
+//! - PNG (8/16-bit), JPEG: sRGB-encoded, decoded with §6's exact piecewise formula; alpha, gAMA
+//!   and iCCP are ignored. Radiance `.hdr`: linear float.
+//! - The EXR `envmap` attribute is reported (§6 D6 `automatic` reads it).
+//!
+//! Robustness: every error names the file and keeps its cause. A file whose declared size exceeds
+//! [`MAX_PIXELS`] is refused from its header, before any pixel buffer is allocated. The third-party
+//! decoders are additionally run under `catch_unwind`, so that a decoder bug reached by a corrupt
+//! file becomes [`TextureError::DecoderPanic`] instead of aborting the caller.
+
+use std::io::Cursor;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// Largest accepted image: 2^28 pixels (16384 × 16384; a 16k × 8k latlong fits). At 12 bytes per
+/// linear RGB texel that is 3 GiB, the most a texture may claim before we refuse it.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+/// The EXR `envmap` attribute (OpenEXR `Envmap`), used by `automatic` (§6 D6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnvMap {
+    /// `ENVMAP_LATLONG`.
+    LatLong,
+    /// `ENVMAP_CUBE` (six faces stacked vertically; not a UsdLux format).
+    Cube,
+}
+
+/// A decoded texture: linear RGB, row-major, row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Image {
+    pub width: usize,
+    pub height: usize,
+    /// `width × height` texels; texel `(i, j)` (column i, row j) is `rgb[j * width + i]`.
+    pub rgb: Vec<[f32; 3]>,
+    /// The EXR `envmap` attribute when the file has one.
+    pub envmap: Option<EnvMap>,
+    /// The file it came from (for error messages downstream).
+    pub source: PathBuf,
+}
+
+/// Why a texture could not be loaded. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum TextureError {
+    #[error("{}: cannot read the file: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: unsupported OpenEXR compression `{compression}` (this reader decodes none, rle, zip, zips, piz, pxr24, b44, b44a, dwaa, dwab)", path.display())]
+    UnsupportedCompression { path: PathBuf, compression: String },
+    #[error("{}: malformed or truncated OpenEXR file: {source}", path.display())]
+    Exr {
+        path: PathBuf,
+        source: exr::error::Error,
+    },
+    #[error("{}: cannot decode the image: {source}", path.display())]
+    Decode {
+        path: PathBuf,
+        source: image::ImageError,
+    },
+    #[error("{}: declared size {width} × {height} is over the limit of {max} pixels", path.display(), max = MAX_PIXELS)]
+    TooLarge {
+        path: PathBuf,
+        width: u64,
+        height: u64,
+    },
+    #[error("{}: the image is empty ({width} × {height})", path.display())]
+    Empty {
+        path: PathBuf,
+        width: u64,
+        height: u64,
+    },
+    #[error("{}: {what}", path.display())]
+    Unsupported { path: PathBuf, what: String },
+    #[error("{}: the decoder failed on this file ({message})", path.display())]
+    DecoderPanic { path: PathBuf, message: String },
+}
+
+impl Image {
+    /// The texel at column `i`, row `j` (no bounds policy: callers apply the format's rule).
+    #[inline]
+    pub fn texel(&self, i: usize, j: usize) -> [f32; 3] {
+        self.rgb[j * self.width + i]
+    }
+
+    /// Makes every texel a finite non-negative radiance: negative values and NaN become 0, +∞
+    /// becomes `f32::MAX`. Returns how many components changed. [`load`] applies it: lossy
+    /// compressions leave tiny negatives (Blender's DWAB studio lights go down to −3.4e-4 where
+    /// the true value is 0), and a negative radiance would make irradiance negative.
+    pub fn sanitize(&mut self) -> usize {
+        let mut changed = 0;
+        for c in self.rgb.iter_mut().flat_map(|p| p.iter_mut()) {
+            let v = if c.is_nan() || *c < 0.0 {
+                0.0
+            } else {
+                c.min(f32::MAX)
+            };
+            if v.to_bits() != c.to_bits() {
+                changed += 1;
+                *c = v;
+            }
+        }
+        changed
+    }
+
+    /// An image from raw linear texels (tests and generated data). `rgb.len()` must equal
+    /// `width × height`, both non-zero.
+    pub fn from_rgb(
+        width: usize,
+        height: usize,
+        rgb: Vec<[f32; 3]>,
+        source: impl Into<PathBuf>,
+    ) -> Result<Image, TextureError> {
+        let path = source.into();
+        if width == 0 || height == 0 || rgb.len() != width * height {
+            return Err(TextureError::Unsupported {
+                path,
+                what: format!("{} texels for a {width} × {height} image", rgb.len()),
+            });
+        }
+        Ok(Image {
+            width,
+            height,
+            rgb,
+            envmap: None,
+            source: path,
+        })
+    }
+}
+
+/// Loads any supported texture file. OpenEXR is recognised by its magic number, everything else
+/// goes to the `image` decoders (PNG, JPEG, Radiance HDR, recognised from their content).
+/// Texels are then [`Image::sanitize`]d (negatives and NaN → 0).
+pub fn load(path: &Path) -> Result<Image, TextureError> {
+    let bytes = std::fs::read(path).map_err(|source| TextureError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    decode(&bytes, path)
+}
+
+/// [`load`] for contents already read (a file inside a `.usdz` package, or bytes given in
+/// memory); `source` is what errors and [`Image::source`] call it.
+pub fn decode(bytes: &[u8], source: &Path) -> Result<Image, TextureError> {
+    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
+        // Sanitised while decoding.
+        load_exr(source, bytes)
+    } else {
+        let mut img = load_ldr_or_hdr(source, bytes)?;
+        img.sanitize();
+        Ok(img)
+    }
+}
+
+fn check_size(path: &Path, width: u64, height: u64) -> Result<(), TextureError> {
+    if width == 0 || height == 0 {
+        return Err(TextureError::Empty {
+            path: path.to_owned(),
+            width,
+            height,
+        });
+    }
+    if width.saturating_mul(height) > MAX_PIXELS {
+        return Err(TextureError::TooLarge {
+            path: path.to_owned(),
+            width,
+            height,
+        });
+    }
+    Ok(())
+}
+
+/// Runs a third-party decoder, turning a panic into a typed error (see the module docs).
+fn guarded<T>(path: &Path, f: impl FnOnce() -> Result<T, TextureError>) -> Result<T, TextureError> {
+    match catch_unwind(AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(payload) => {
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "panic".into());
+            Err(TextureError::DecoderPanic {
+                path: path.to_owned(),
+                message,
+            })
+        }
+    }
+}
+
+fn compression_name(c: exr::compression::Compression) -> Option<&'static str> {
+    use exr::compression::Compression::*;
+    // The ones `exr` 1.74 decodes; HTJ2K (and anything newer) is refused by name.
+    Some(match c {
+        Uncompressed => "none",
+        RLE => "rle",
+        ZIP1 => "zips",
+        ZIP16 => "zip",
+        PIZ => "piz",
+        PXR24 => "pxr24",
+        B44 => "b44",
+        B44A => "b44a",
+        DWAA(_) => "dwaa",
+        DWAB(_) => "dwab",
+        _ => return None,
+    })
+}
+
+fn load_exr(path: &Path, bytes: &[u8]) -> Result<Image, TextureError> {
+    use exr::prelude::*;
+    let exr_err = |source| TextureError::Exr {
+        path: path.to_owned(),
+        source,
+    };
+    // Header first: refuse absurd sizes and undecodable compressions before any pixel allocation.
+    let meta = guarded(path, || {
+        exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)
+    })?;
+    let Some(header) = meta.headers.iter().find(|h| !h.deep) else {
+        return Err(TextureError::Unsupported {
+            path: path.to_owned(),
+            what: "only deep-data parts in this OpenEXR file".into(),
+        });
+    };
+    let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
+    check_size(path, w, h)?;
+    if compression_name(header.compression).is_none() {
+        return Err(TextureError::UnsupportedCompression {
+            path: path.to_owned(),
+            compression: format!("{:?}", header.compression),
+        });
+    }
+    let names: Vec<String> = header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    if header
+        .channels
+        .list
+        .iter()
+        .any(|c| c.sampling != Vec2(1, 1))
+    {
+        return Err(TextureError::Unsupported {
+            path: path.to_owned(),
+            what: format!("subsampled channels in {names:?}"),
+        });
+    }
+    let envmap = header.own_attributes.environment_map.map(|e| match e {
+        exr::meta::attribute::EnvironmentMap::LatitudeLongitude => EnvMap::LatLong,
+        exr::meta::attribute::EnvironmentMap::Cube => EnvMap::Cube,
+    });
+    let find = |n: &str| names.iter().position(|c| c == n);
+    let plan: [usize; 3] = match (find("R"), find("G"), find("B"), find("Y")) {
+        (Some(r), Some(g), Some(b), _) => [r, g, b],
+        (_, _, _, Some(y)) if find("RY").is_none() && find("BY").is_none() => [y, y, y],
+        _ => {
+            return Err(TextureError::Unsupported {
+                path: path.to_owned(),
+                what: format!("no R, G, B (or lone Y) channels; found {names:?}"),
+            });
+        }
+    };
+    let map_err = |source| match source {
+        exr::error::Error::NotSupported(ref what) if what.contains("compression") => {
+            TextureError::UnsupportedCompression {
+                path: path.to_owned(),
+                compression: what.to_string(),
+            }
+        }
+        source => exr_err(source),
+    };
+    // Negative and NaN samples become 0 as they are stored (Image::sanitize's rule, folded into
+    // the decode so that an 8k map is not walked twice).
+    // Not `clamp`: f32::clamp keeps NaN, max(0) turns it into 0.
+    #[allow(clippy::manual_clamp)]
+    let clean = |v: f32| v.max(0.0).min(f32::MAX);
+    let (width, height, rgb) = if plan[0] != plan[1] {
+        // R, G, B: exr's batched sample conversion straight into the interleaved buffer.
+        let image = guarded(path, || {
+            read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .specific_channels()
+                .required("R")
+                .required("G")
+                .required("B")
+                .collect_pixels(
+                    |size: Vec2<usize>, _| (size.0, size.1, vec![[0f32; 3]; size.0 * size.1]),
+                    move |px: &mut (usize, usize, Vec<[f32; 3]>),
+                          pos: Vec2<usize>,
+                          (r, g, b): (f32, f32, f32)| {
+                        px.2[pos.1 * px.0 + pos.0] = [clean(r), clean(g), clean(b)];
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(Cursor::new(bytes))
+                .map_err(map_err)
+        })?;
+        image.layer_data.channel_data.pixels
+    } else {
+        // A lone Y channel.
+        let image = guarded(path, || {
+            read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .specific_channels()
+                .required("Y")
+                .collect_pixels(
+                    |size: Vec2<usize>, _| (size.0, size.1, vec![[0f32; 3]; size.0 * size.1]),
+                    move |px: &mut (usize, usize, Vec<[f32; 3]>),
+                          pos: Vec2<usize>,
+                          (y,): (f32,)| {
+                        px.2[pos.1 * px.0 + pos.0] = [clean(y); 3];
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(Cursor::new(bytes))
+                .map_err(map_err)
+        })?;
+        image.layer_data.channel_data.pixels
+    };
+    // The decoded layer must be the one whose header we checked.
+    if (width as u64, height as u64) != (w, h) || rgb.len() != width * height {
+        return Err(TextureError::Unsupported {
+            path: path.to_owned(),
+            what: "the first decodable layer differs from the first header".into(),
+        });
+    }
+    Ok(self::Image {
+        width,
+        height,
+        rgb,
+        envmap,
+        source: path.to_owned(),
+    })
+}
+
+/// §6: `c = value / 255` (or `/ 65535`); linear `= c / 12.92` for `c ≤ 0.04045`, else
+/// `((c + 0.055) / 1.055)^2.4`. Evaluated in f64, rounded once to f32.
+pub fn srgb_to_linear(c: f64) -> f64 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn lut8() -> &'static [f32; 256] {
+    static T: OnceLock<[f32; 256]> = OnceLock::new();
+    T.get_or_init(|| std::array::from_fn(|v| srgb_to_linear(v as f64 / 255.0) as f32))
+}
+
+fn lut16() -> &'static [f32] {
+    static T: OnceLock<Vec<f32>> = OnceLock::new();
+    T.get_or_init(|| {
+        (0..65536)
+            .map(|v| srgb_to_linear(v as f64 / 65535.0) as f32)
+            .collect()
+    })
+}
+
+fn load_ldr_or_hdr(path: &Path, bytes: &[u8]) -> Result<Image, TextureError> {
+    use image::{DynamicImage, ImageReader, Limits};
+    let dec_err = |source| TextureError::Decode {
+        path: path.to_owned(),
+        source,
+    };
+    let reader = || {
+        ImageReader::new(Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|source| TextureError::Io {
+                path: path.to_owned(),
+                source,
+            })
+    };
+    let (w, h) = guarded(path, || reader()?.into_dimensions().map_err(dec_err))?;
+    check_size(path, w as u64, h as u64)?;
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    // The decoded buffer (at most 4 × 16-bit or 4 × f32 per pixel) plus the decoders' scratch.
+    limits.max_alloc = Some((w as u64 * h as u64 * 16).saturating_add(1 << 26));
+    let img = guarded(path, || {
+        let mut r = reader()?;
+        r.limits(limits);
+        r.decode().map_err(dec_err)
+    })?;
+    let (width, height) = (img.width() as usize, img.height() as usize);
+    let l8 = lut8();
+    let rgb: Vec<[f32; 3]> = match &img {
+        DynamicImage::ImageLuma8(b) => b.pixels().map(|p| [l8[p[0] as usize]; 3]).collect(),
+        DynamicImage::ImageLumaA8(b) => b.pixels().map(|p| [l8[p[0] as usize]; 3]).collect(),
+        DynamicImage::ImageRgb8(b) => b.pixels().map(|p| p.0.map(|v| l8[v as usize])).collect(),
+        DynamicImage::ImageRgba8(b) => b
+            .pixels()
+            .map(|p| [0, 1, 2].map(|k| l8[p[k] as usize]))
+            .collect(),
+        DynamicImage::ImageLuma16(b) => b.pixels().map(|p| [lut16()[p[0] as usize]; 3]).collect(),
+        DynamicImage::ImageLumaA16(b) => b.pixels().map(|p| [lut16()[p[0] as usize]; 3]).collect(),
+        DynamicImage::ImageRgb16(b) => b
+            .pixels()
+            .map(|p| p.0.map(|v| lut16()[v as usize]))
+            .collect(),
+        DynamicImage::ImageRgba16(b) => b
+            .pixels()
+            .map(|p| [0, 1, 2].map(|k| lut16()[p[k] as usize]))
+            .collect(),
+        // Radiance HDR decodes to linear float.
+        DynamicImage::ImageRgb32F(b) => b.pixels().map(|p| p.0).collect(),
+        DynamicImage::ImageRgba32F(b) => b.pixels().map(|p| [p[0], p[1], p[2]]).collect(),
+        other => {
+            return Err(TextureError::Unsupported {
+                path: path.to_owned(),
+                what: format!("pixel layout {:?}", other.color()),
+            });
+        }
+    };
+    if rgb.len() != width * height {
+        return Err(TextureError::Unsupported {
+            path: path.to_owned(),
+            what: "decoded size differs from the header".into(),
+        });
+    }
+    Ok(Image {
+        width,
+        height,
+        rgb,
+        envmap: None,
+        source: path.to_owned(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(name: &str) -> (tempfile::TempDir, PathBuf) {
+        let d = tempfile::tempdir().unwrap();
+        let p = d.path().join(name);
+        (d, p)
+    }
+
+    fn crc32(data: &[u8]) -> u32 {
+        let mut c = !0u32;
+        for &b in data {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 {
+                    0xEDB8_8320 ^ (c >> 1)
+                } else {
+                    c >> 1
+                };
+            }
+        }
+        !c
+    }
+
+    /// A small ZIP-compressed half RGB EXR, as the Blender `*_zip_half.exr` copies are.
+    fn small_exr(w: usize, h: usize) -> Vec<u8> {
+        use exr::prelude::*;
+        let ch = SpecificChannels::rgb(|pos: Vec2<usize>| {
+            (
+                f16::from_f32(pos.0 as f32 * 0.25),
+                f16::from_f32(pos.1 as f32),
+                f16::from_f32(0.5),
+            )
+        });
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named("t"),
+            Encoding::SMALL_LOSSLESS,
+            ch,
+        );
+        let mut out = Cursor::new(Vec::new());
+        exr::prelude::Image::from_layer(layer)
+            .write()
+            .to_buffered(&mut out)
+            .unwrap();
+        out.into_inner()
+    }
+
+    /// Byte offset of an attribute's value in an EXR header.
+    fn attr_value(bytes: &[u8], name: &str) -> usize {
+        let key = [name.as_bytes(), &[0]].concat();
+        let at = bytes
+            .windows(key.len())
+            .position(|w| w == key.as_slice())
+            .expect("attribute");
+        let ty_end = at
+            + key.len()
+            + bytes[at + key.len()..]
+                .iter()
+                .position(|&b| b == 0)
+                .unwrap()
+            + 1;
+        ty_end + 4
+    }
+
+    fn assert_error_names(p: &Path) {
+        match load(p) {
+            Ok(i) => panic!("{} loaded as {}×{}", p.display(), i.width, i.height),
+            Err(e) => {
+                let msg = e.to_string();
+                assert!(msg.contains(&p.display().to_string()), "{msg}");
+            }
+        }
+    }
+
+    #[test]
+    fn srgb_decoding_is_the_pinned_piecewise_formula() {
+        assert_eq!(srgb_to_linear(0.0), 0.0);
+        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-15);
+        assert!((srgb_to_linear(0.04045) - 0.04045 / 12.92).abs() < 1e-18);
+        assert!((srgb_to_linear(0.5) - ((0.5 + 0.055) / 1.055f64).powf(2.4)).abs() < 1e-15);
+        assert_eq!(lut8()[255], 1.0);
+        assert_eq!(lut16()[65535], 1.0);
+    }
+
+    #[test]
+    fn png_8_and_16_bit_decode_to_linear_rows_from_the_top() {
+        let (_d, p) = tmp("a.png");
+        let mut img = image::RgbImage::new(3, 2);
+        img.put_pixel(2, 0, image::Rgb([255, 128, 0]));
+        img.save(&p).unwrap();
+        let t = load(&p).unwrap();
+        assert_eq!((t.width, t.height, t.envmap), (3, 2, None));
+        let half = srgb_to_linear(128.0 / 255.0) as f32;
+        assert_eq!(t.texel(2, 0), [1.0, half, 0.0]);
+        assert_eq!(t.texel(0, 1), [0.0; 3]);
+        let (_d2, p16) = tmp("b.png");
+        let mut g = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::new(2, 1);
+        g.put_pixel(1, 0, image::Luma([65535]));
+        g.save(&p16).unwrap();
+        let t = load(&p16).unwrap();
+        assert_eq!(t.rgb, vec![[0.0; 3], [1.0; 3]]);
+    }
+
+    #[test]
+    fn exr_half_zip_float_tiled_and_lone_y_channel() {
+        use exr::prelude::*;
+        let (_d, p) = tmp("zip.exr");
+        std::fs::write(&p, small_exr(8, 4)).unwrap();
+        let img = load(&p).unwrap();
+        assert_eq!((img.width, img.height), (8, 4));
+        assert_eq!(img.texel(4, 3), [1.0, 3.0, 0.5]);
+        // A tiled float RGB file with a data window offset from the origin: row 0 = data
+        // window min.y.
+        let (_d, p) = tmp("tiled.exr");
+        let ch = SpecificChannels::rgb(|pos: Vec2<usize>| (pos.0 as f32, pos.1 as f32, 0.5f32));
+        let mut layer = Layer::new(
+            (5, 3),
+            LayerAttributes::named("t"),
+            Encoding {
+                compression: Compression::PIZ,
+                blocks: Blocks::Tiles(Vec2(2, 2)),
+                line_order: LineOrder::Increasing,
+            },
+            ch,
+        );
+        layer.attributes.layer_position = Vec2(10, -4);
+        exr::prelude::Image::from_layer(layer)
+            .write()
+            .to_file(&p)
+            .unwrap();
+        let img = load(&p).unwrap();
+        assert_eq!((img.width, img.height), (5, 3));
+        assert_eq!(img.texel(4, 2), [4.0, 2.0, 0.5]);
+        // A lone Y channel is grey.
+        let (_d, p) = tmp("grey.exr");
+        let ch = AnyChannels::sort(SmallVec::from_vec(vec![AnyChannel::new(
+            "Y",
+            FlatSamples::F16(vec![f16::from_f32(0.25); 6]),
+        )]));
+        exr::prelude::Image::from_layer(Layer::new(
+            (3, 2),
+            LayerAttributes::named("g"),
+            Encoding::UNCOMPRESSED,
+            ch,
+        ))
+        .write()
+        .to_file(&p)
+        .unwrap();
+        let img = load(&p).unwrap();
+        assert_eq!(img.rgb, vec![[0.25; 3]; 6]);
+    }
+
+    #[test]
+    fn an_undecodable_compression_is_a_typed_error_naming_file_and_compression() {
+        let mut bytes = small_exr(8, 4);
+        // Compression codes: 10 = HTJ2K256 (OpenEXR 3.4), which exr 1.74 does not decode.
+        let v = attr_value(&bytes, "compression");
+        bytes[v] = 10;
+        let (_d, p) = tmp("htj2k.exr");
+        std::fs::write(&p, &bytes).unwrap();
+        match load(&p) {
+            Err(e @ TextureError::UnsupportedCompression { .. }) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains("htj2k.exr") && msg.to_lowercase().contains("htj2k"),
+                    "{msg}"
+                );
+            }
+            other => panic!("expected UnsupportedCompression, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn an_absurd_declared_size_is_refused_before_decoding() {
+        let mut bytes = small_exr(8, 4);
+        // dataWindow is box2i (xMin, yMin, xMax, yMax): claim 100000 × 100000 pixels.
+        let v = attr_value(&bytes, "dataWindow");
+        bytes[v + 8..v + 12].copy_from_slice(&99_999i32.to_le_bytes());
+        bytes[v + 12..v + 16].copy_from_slice(&99_999i32.to_le_bytes());
+        let (_d, p) = tmp("huge.exr");
+        std::fs::write(&p, &bytes).unwrap();
+        match load(&p) {
+            Err(TextureError::TooLarge {
+                width,
+                height,
+                path,
+            }) => {
+                assert_eq!((width, height), (100_000, 100_000));
+                assert_eq!(path, p);
+                assert!(width * height > MAX_PIXELS);
+            }
+            other => panic!("expected TooLarge, got {other:?}"),
+        }
+        // The same for a PNG header (IHDR width/height, CRC fixed up).
+        let (_d, png) = tmp("small.png");
+        image::RgbImage::new(4, 4).save(&png).unwrap();
+        let mut b = std::fs::read(&png).unwrap();
+        b[16..20].copy_from_slice(&40_000u32.to_be_bytes());
+        b[20..24].copy_from_slice(&40_000u32.to_be_bytes());
+        let crc = crc32(&b[12..29]);
+        b[29..33].copy_from_slice(&crc.to_be_bytes());
+        std::fs::write(&png, &b).unwrap();
+        assert!(matches!(load(&png), Err(TextureError::TooLarge { .. })));
+    }
+
+    #[test]
+    fn truncated_and_corrupt_files_are_errors_not_panics() {
+        let exr = small_exr(64, 32);
+        let d = tempfile::tempdir().unwrap();
+        for (k, cut) in [exr.len() / 2, 400, 40, 3].into_iter().enumerate() {
+            let p = d.path().join(format!("cut{k}.exr"));
+            std::fs::write(&p, &exr[..cut.min(exr.len() - 1)]).unwrap();
+            assert_error_names(&p);
+        }
+        // PNG: truncated, and garbage with a PNG signature.
+        let png = d.path().join("ok.png");
+        image::RgbImage::from_fn(16, 16, |x, y| image::Rgb([x as u8 * 9, y as u8 * 7, 3]))
+            .save(&png)
+            .unwrap();
+        let png = std::fs::read(&png).unwrap();
+        let p = d.path().join("cut.png");
+        std::fs::write(&p, &png[..png.len() / 2]).unwrap();
+        assert_error_names(&p);
+        let p = d.path().join("garbage.png");
+        std::fs::write(&p, [&png[..8], &[0xAB; 200][..]].concat()).unwrap();
+        assert_error_names(&p);
+        // Not an image at all, and a missing file.
+        let p = d.path().join("text.hdr");
+        std::fs::write(&p, b"hello").unwrap();
+        assert_error_names(&p);
+        assert_error_names(&d.path().join("does-not-exist.exr"));
+    }
+
+    #[test]
+    fn sanitize_clamps_negatives_and_nan() {
+        let mut img = Image::from_rgb(
+            2,
+            1,
+            vec![[-3.4e-4, f32::NAN, 1.0], [f32::INFINITY, 0.5, 0.0]],
+            "x",
+        )
+        .unwrap();
+        assert_eq!(img.sanitize(), 3);
+        assert_eq!(img.rgb, vec![[0.0, 0.0, 1.0], [f32::MAX, 0.5, 0.0]]);
+        assert!(Image::from_rgb(2, 2, vec![[0.0; 3]; 3], "y").is_err());
+    }
+}
