@@ -63,7 +63,10 @@ struct ReadmeDoctests;
 pub use error::{GpuFailure, LuxError, Result};
 pub use gpu::{AdapterSummary, DeviceLimits, adapters};
 pub use limits::Limits;
-pub use model::{Asset, Ies, Input, Light, LightInputs, LightType, Shaping, UpAxis, Value, schema};
+pub use model::{
+    Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFormat,
+    UpAxis, Value, schema,
+};
 pub use prepare::TemperatureMode;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
 #[cfg(feature = "usd")]

@@ -83,6 +83,87 @@ impl Ies {
     }
 }
 
+/// `inputs:texture:format` of DomeLight / DomeLight_1 as authored (DESIGN.md §6 D2–D6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextureFormat {
+    /// Decided from the file (§6 D6): the EXR `envmap` attribute, else the image's aspect.
+    #[default]
+    Automatic,
+    LatLong,
+    MirroredBall,
+    Angular,
+    CubeMapVerticalCross,
+}
+
+impl TextureFormat {
+    /// The format a `texture:format` token names, `None` for a token the schema does not allow.
+    pub fn from_token(token: &str) -> Option<Self> {
+        Some(match token {
+            "automatic" => TextureFormat::Automatic,
+            "latlong" => TextureFormat::LatLong,
+            "mirroredBall" => TextureFormat::MirroredBall,
+            "angular" => TextureFormat::Angular,
+            "cubeMapVerticalCross" => TextureFormat::CubeMapVerticalCross,
+            _ => return None,
+        })
+    }
+}
+
+/// DomeLight_1's `poleAxis` (spec/004; DESIGN.md §6 D1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PoleAxis {
+    /// Follow the stage's `upAxis`.
+    #[default]
+    Scene,
+    Y,
+    Z,
+}
+
+impl PoleAxis {
+    /// The axis a `poleAxis` token names, `None` for a token the schema does not allow.
+    pub fn from_token(token: &str) -> Option<Self> {
+        Some(match token {
+            "scene" => PoleAxis::Scene,
+            "Y" => PoleAxis::Y,
+            "Z" => PoleAxis::Z,
+            _ => return None,
+        })
+    }
+}
+
+/// A light's `inputs:texture:*` (DomeLight, DomeLight_1, RectLight), where `texture:file` is
+/// authored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// `inputs:texture:file`.
+    pub file: Asset,
+    /// `inputs:texture:format` (domes; `Automatic` and unused for a RectLight).
+    pub format: TextureFormat,
+    /// DomeLight_1's `poleAxis`; `None` for a plain DomeLight (always Y-up, §6 D1) and for a
+    /// RectLight.
+    pub pole_axis: Option<PoleAxis>,
+}
+
+impl Texture {
+    /// A texture file with the schema fallbacks: format `automatic`, no pole offset.
+    pub fn new(file: Asset) -> Self {
+        Texture {
+            file,
+            format: TextureFormat::Automatic,
+            pole_axis: None,
+        }
+    }
+    pub fn with_format(mut self, format: TextureFormat) -> Self {
+        self.format = format;
+        self
+    }
+    /// Makes the light a DomeLight_1 with `poleAxis` = `axis`.
+    pub fn with_pole_axis(mut self, axis: PoleAxis) -> Self {
+        self.pole_axis = Some(axis);
+        self
+    }
+}
+
 /// The stage's up axis (`upAxis` metadata): what "down" means for an IES profile's TILT
 /// (DESIGN.md §6 I5) and what DomeLight_1's `poleAxis = scene` follows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -124,7 +205,7 @@ pub enum LightType {
         radius: f64,
         treat_as_line: bool,
     },
-    /// DomeLight / DomeLight_1 without a texture: a uniform environment.
+    /// DomeLight / DomeLight_1: a uniform environment, or the map in [`Light::texture`].
     Dome,
 }
 
@@ -187,6 +268,8 @@ pub struct Light {
     pub shaping: Option<Shaping>,
     /// The up axis of the stage the light belongs to (Y for lights built in code).
     pub stage_up: UpAxis,
+    /// `inputs:texture:*` where `texture:file` is authored (DomeLight, DomeLight_1, RectLight).
+    pub texture: Option<Texture>,
 }
 
 impl Light {
@@ -204,6 +287,7 @@ impl Light {
             inputs,
             shaping: None,
             stage_up: UpAxis::Y,
+            texture: None,
         }
     }
 
@@ -265,6 +349,11 @@ impl Light {
     }
     pub fn with_shaping(mut self, shaping: Shaping) -> Self {
         self.shaping = Some(shaping);
+        self
+    }
+    /// Sets `inputs:texture:*` (a dome's environment map, a rect's image).
+    pub fn with_texture(mut self, texture: Texture) -> Self {
+        self.texture = Some(texture);
         self
     }
     /// Sets the stage's up axis (TILT of IES profiles, DomeLight_1 `poleAxis = scene`).

@@ -8,5 +8,7 @@ pub mod schema;
 pub mod value;
 
 pub use asset::Asset;
-pub use light::{Ies, Light, LightInputs, LightType, Shaping, UpAxis};
+pub use light::{
+    Ies, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFormat, UpAxis,
+};
 pub use value::{Input, Value};
