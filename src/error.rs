@@ -104,6 +104,13 @@ pub enum AssetError {
     /// An IES (LM-63) or EULUMDAT profile that cannot be read (the message names the line).
     #[error(transparent)]
     Ies(#[from] crate::assets::ies::IesError),
+    /// A texture that cannot be decoded (the message names the file and, for OpenEXR, an
+    /// unsupported compression).
+    #[error(transparent)]
+    Texture(#[from] crate::assets::texture::TextureError),
+    /// A dome texture whose `texture:format` does not fit the image (DESIGN.md §6 D5, D6).
+    #[error(transparent)]
+    TextureFormat(#[from] crate::prepare::dome::FormatError),
 }
 
 /// What went wrong on the GPU, keeping wgpu's own error.

@@ -5,6 +5,4 @@
 
 pub mod ies;
 pub mod package;
-// Dome textures (issue 9): `prepare` loads them from the next step on.
-#[allow(dead_code)]
 pub mod texture;

@@ -15,6 +15,9 @@
 //! decoders are additionally run under `catch_unwind`, so that a decoder bug reached by a corrupt
 //! file becomes [`TextureError::DecoderPanic`] instead of aborting the caller.
 
+// `load` and `Image::from_rgb` serve tests and the tools still to come (issue 9).
+#![allow(dead_code)]
+
 use std::io::Cursor;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};

@@ -7,6 +7,7 @@
 
 use glam::DVec3;
 
+use super::dome::dome_factor;
 use super::shaping::{off_axis_angle, shaping};
 use crate::model::LightType;
 use crate::prepare::Prepared;
@@ -15,7 +16,8 @@ use crate::prepare::Prepared;
 pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
     let base = p.base;
     match p.light.kind {
-        LightType::Dome => base,
+        // DESIGN.md §6 D1: every multiplier times the texture along e (1 without one).
+        LightType::Dome => base * dome_factor(p, e),
         LightType::Distant { .. } => {
             // A delta light (θmax = 0) has emission 0 (DESIGN.md §2 "Edge cases"); a finite
             // cone's boundary is inclusive. Distant lights are never shaped.

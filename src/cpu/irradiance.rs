@@ -49,6 +49,10 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3) -> DVec3 {
 /// [`irradiance`] with the quadrature's [`Rule`] chosen (closed forms are used either way).
 pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> DVec3 {
     let e = match p.light.kind {
+        // A textured dome's irradiance is the exact integral of its filtered texture (DESIGN.md
+        // §6), not yet ported (issue 9): NaN rather than the uniform dome's value. The queries
+        // refuse such a dome before calling this.
+        LightType::Dome if p.texture.is_some() => DVec3::NAN,
         LightType::Dome => p.base * PI,
         LightType::Distant { .. } => {
             let c = -p.axis;

@@ -15,7 +15,11 @@ use crate::prepare::Prepared;
 
 /// radiance at `x` from the unit direction `w`.
 pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
-    if hits_emitting_surface(p, x, w) {
+    if matches!(p.light.kind, LightType::Dome) {
+        // A dome's emission is indexed by the direction toward the environment (DESIGN.md §3),
+        // which is ω itself.
+        emission(p, w)
+    } else if hits_emitting_surface(p, x, w) {
         emission(p, -w)
     } else {
         DVec3::ZERO

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use super::ies::Profile;
 use crate::assets::ies::parse_any;
 use crate::assets::package;
+use crate::assets::texture::{self, Image};
 use crate::error::AssetError;
 use crate::model::Asset;
 
@@ -14,9 +15,43 @@ use crate::model::Asset;
 #[derive(Default)]
 pub struct AssetCache {
     profiles: HashMap<String, Arc<Profile>>,
+    textures: HashMap<String, Arc<Image>>,
+}
+
+/// The cache key of `asset`: its resolved path, or the address of contents given in memory.
+fn key(asset: &Asset) -> Result<String, AssetError> {
+    match (&asset.bytes, &asset.resolved) {
+        (Some(b), _) => Ok(format!("<bytes {:p}>", b.as_ptr())),
+        (None, Some(r)) => Ok(r.clone()),
+        (None, None) => Err(AssetError::Unresolved),
+    }
 }
 
 impl AssetCache {
+    /// The texture in `asset` (OpenEXR, PNG, JPEG or Radiance HDR, detected by content; also
+    /// inside a `.usdz` package), decoded to linear RGB once per file.
+    pub fn texture(&mut self, asset: &Asset) -> Result<Arc<Image>, AssetError> {
+        let key = key(asset)?;
+        if let Some(t) = self.textures.get(&key) {
+            return Ok(t.clone());
+        }
+        let name = std::path::PathBuf::from(asset.display());
+        let image = match (&asset.bytes, &asset.resolved) {
+            (Some(b), _) => texture::decode(b, &name)?,
+            (None, Some(r)) => {
+                let bytes = package::read(r).map_err(|source| AssetError::Io {
+                    path: r.clone(),
+                    source,
+                })?;
+                texture::decode(&bytes, &name)?
+            }
+            (None, None) => return Err(AssetError::Unresolved),
+        };
+        let image = Arc::new(image);
+        self.textures.insert(key, image.clone());
+        Ok(image)
+    }
+
     /// The IES profile in `asset` (LM-63 or EULUMDAT, detected by content; a `TILT=<file>` is
     /// read beside it, also inside a package).
     pub fn ies(&mut self, asset: &Asset) -> Result<Arc<Profile>, AssetError> {

@@ -7,6 +7,7 @@
 
 pub mod assets;
 pub mod blackbody;
+pub mod dome;
 pub mod ies;
 pub mod ies_kinks;
 pub mod normalize;
@@ -16,8 +17,8 @@ use std::sync::Arc;
 
 use glam::{DMat3, DVec3};
 
-use crate::error::{LuxError, Result};
-use crate::model::{Light, LightType, Shaping, UpAxis};
+use crate::error::{AssetError, LuxError, Result};
+use crate::model::{Light, LightType, Shaping, Texture, UpAxis};
 use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
@@ -96,6 +97,8 @@ pub struct Prepared {
     pub distant_half_angle: f64,
     /// The IES profile of ShapingAPI, where authored (and the light shapeable).
     pub ies: Option<PreparedIes>,
+    /// A dome's environment map, where `texture:file` is authored (DESIGN.md §6 D1–D6).
+    pub texture: Option<dome::PreparedTexture>,
 }
 
 impl Prepared {
@@ -171,7 +174,12 @@ impl Prepared {
             }
             _ => None,
         };
+        let texture = match &light.texture {
+            None => None,
+            Some(t) => Some(prepare_texture(light, t, linear, cache)?),
+        };
         Ok(Prepared {
+            texture,
             base,
             size_factor,
             origin: light.origin(),
@@ -188,6 +196,50 @@ impl Prepared {
             light: evaluated,
         })
     }
+}
+
+/// Loads a light's texture (once per file, through `cache`) and resolves its format and frame
+/// (DESIGN.md §6 D1–D6). Only dome textures are evaluated so far (issue 9): a RectLight texture
+/// is refused rather than evaluated as if untextured.
+fn prepare_texture(
+    light: &Light,
+    t: &Texture,
+    linear: DMat3,
+    cache: &mut AssetCache,
+) -> Result<dome::PreparedTexture> {
+    if light.kind != LightType::Dome {
+        return Err(LuxError::attr(
+            &light.path,
+            "inputs:texture:file",
+            &t.file.authored,
+            format!(
+                "{} textures are not evaluated yet (only DomeLight textures are)",
+                light.kind.usd_type()
+            ),
+        ));
+    }
+    let asset_err = |attr: &str, source: AssetError| LuxError::Asset {
+        light: light.path.clone(),
+        attr: attr.into(),
+        path: t.file.authored.clone(),
+        source,
+    };
+    let image = cache
+        .texture(&t.file)
+        .map_err(|e| asset_err("inputs:texture:file", e))?;
+    let format = dome::resolve_format(t.format, &image)
+        .map_err(|e| asset_err("inputs:texture:format", e.into()))?;
+    let frame = dome::DomeFrame::new(linear, dome::pole_offset(t.pole_axis, light.stage_up))
+        .ok_or_else(|| LuxError::InvalidTransform {
+            light: light.path.clone(),
+            reason: "is singular, so the dome has no direction".into(),
+        })?;
+    Ok(dome::PreparedTexture {
+        image,
+        format,
+        frame,
+        filter: dome::Filter::default(),
+    })
 }
 
 /// The largest magnitude of a length (a position, a size, an entry of the world transform or

@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::error::{LuxError, Result};
 use crate::gpu::{GpuLights, Kernel, Scratch, ies_atlas, record};
-use crate::model::Light;
+use crate::model::{Light, Texture};
 use crate::prepare::{self, Prepared, TemperatureMode};
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
@@ -42,6 +42,17 @@ impl PreparedScene {
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
+                // Textured domes are evaluated on the CPU reference only until dome.wgsl and
+                // its texture atlas land (issue 9): refused here, never evaluated as uniform.
+                if let Some((p, t)) = textured(&lights) {
+                    return Err(LuxError::attr(
+                        &p.light.path,
+                        "inputs:texture:file",
+                        &t.file.authored,
+                        "textured dome lights are evaluated on the CPU only so far \
+                         (use --device cpu)",
+                    ));
+                }
                 let (atlas, bases) = ies_atlas::scene_atlas(&lights)
                     .map_err(|e| LuxError::input("IES profiles", e.to_string()))?;
                 let records: Vec<record::Record> = lights
@@ -125,6 +136,15 @@ impl PreparedScene {
         acc: Accumulate,
     ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", normals, "normals")?;
+        if let Some((p, t)) = textured(&self.lights) {
+            return Err(LuxError::attr(
+                &p.light.path,
+                "inputs:texture:file",
+                &t.file.authored,
+                "the irradiance of a textured dome (the exact integral of its filtered \
+                 texture, DESIGN.md §6) is not evaluated yet",
+            ));
+        }
         let per_light = acc == Accumulate::PerLight;
         let mut out = self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
             cpu::irradiance_batch(&self.lights, points, normals, per_light)
@@ -204,6 +224,13 @@ impl PreparedScene {
             }
         }
     }
+}
+
+/// The first light with a texture, and its texture.
+fn textured(lights: &[Prepared]) -> Option<(&Prepared, &Texture)> {
+    lights
+        .iter()
+        .find_map(|p| p.light.texture.as_ref().map(|t| (p, t)))
 }
 
 /// Rows scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The

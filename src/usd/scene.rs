@@ -490,7 +490,10 @@ fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, String>
     Ok(Some(t))
 }
 
-/// Whether the queries evaluate this light's texture yet (issue 9 lands in steps).
+/// Whether the queries evaluate this light's texture yet (issue 9 lands in steps). Dome
+/// textures are evaluated by the CPU reference's emission and radiance (lights built in code,
+/// `Light::with_texture`), but not yet by irradiance (and so falloff) or the GPU, which refuse
+/// them: a stage's textured lights stay listed as skipped, with this warning, until they do.
 fn texture_is_evaluated(_kind: &LightType, _texture: &Texture) -> bool {
     false
 }
