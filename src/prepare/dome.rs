@@ -3,7 +3,7 @@
 //! 3×3 `A`), the codes and the cube-cross table the lookups share, the inverse maps (image
 //! coordinates → direction, for tests and irradiance) and the reconstruction's pieces. Ported
 //! from the staged crate `luxeval-dome` (`src/mapping.rs`, `src/filter.rs`); the per-lookup
-//! forward maps are the CPU twin of `dome.wgsl`, `crate::cpu::dome`, which reads this module.
+//! forward maps are the CPU twin of `dome.wgsl`, `src/cpu/dome.rs`, which reads this module.
 
 // The inverse maps, pieces and rect helpers serve the irradiance and rect steps of issue 9 still
 // to land; tests exercise them meanwhile.
@@ -232,7 +232,7 @@ impl DomeFrame {
         }
     }
 
-    /// World direction → dome direction (§6 D1; `crate::cpu::dome::dome_direction`).
+    /// World direction → dome direction (§6 D1; `dome_direction` of `src/cpu/dome.rs`).
     pub fn to_dome(&self, w: DVec3) -> DVec3 {
         (self.inv * w).normalize()
     }
@@ -280,7 +280,7 @@ pub fn cross_face_basis(f: u32) -> (DVec3, DVec3, DVec3, DVec2) {
     )
 }
 
-/// `(s, t)` → dome direction, the inverse of the forward maps (`crate::cpu::dome`). `None`
+/// `(s, t)` → dome direction, the inverse of the forward maps (`src/cpu/dome.rs`). `None`
 /// outside the format's domain (outside the disk for mirroredBall/angular, outside the six faces
 /// for the cross).
 pub fn st_to_direction(format: DomeFormat, st: DVec2) -> Option<DVec3> {
