@@ -6,6 +6,7 @@
 
 // #import shared/record.wgsl
 // #import shared/shaping.wgsl
+// #import shared/dome.wgsl
 
 // Emission along unit direction e (pointing away from the light; for a dome, toward the
 // environment).
@@ -13,7 +14,7 @@ fn emission(light: Record, e: vec3<f32>) -> vec3<f32> {
     let base = light.base.xyz;
     switch light.kind {
         case KIND_DOME: {
-            return base;
+            return base * dome_factor(light, e);
         }
         case KIND_DISTANT: {
             // A delta light (θmax = 0) has no emission; a finite cone's boundary is inclusive.

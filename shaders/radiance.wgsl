@@ -11,8 +11,13 @@
 
 fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
     switch light.kind {
-        case KIND_DOME, KIND_DISTANT: {
-            // The environment, or the distant light's cone, in direction w.
+        case KIND_DOME: {
+            // A dome's emission is indexed by the direction toward the environment (DESIGN.md
+            // §3), which is w itself.
+            return emission(light, w);
+        }
+        case KIND_DISTANT: {
+            // The distant light's cone in direction w.
             return emission(light, -w);
         }
         default: {}

@@ -7,13 +7,16 @@ use crate::error::{GpuFailure, LuxError, Result};
 use super::record::{Params, Record, WORKGROUP_SIZE};
 use super::{GpuContext, Kernel};
 
-/// A prepared scene's light records and IES atlas on the device.
+/// A prepared scene's light records, IES atlas and dome texture atlas on the device.
 pub(crate) struct GpuLights {
     buffer: wgpu::Buffer,
     ies_atlas: wgpu::Buffer,
+    tex_atlas: wgpu::Buffer,
     count: usize,
     /// Whether any light has an IES profile (the pipelines with the lookup are needed).
     has_ies: bool,
+    /// Whether any light has a dome texture (the pipelines with the dome lookup are needed).
+    has_dome: bool,
 }
 
 /// The buffers of one size class: a chunk capacity (a power of two, or the device's largest
@@ -40,9 +43,14 @@ pub(crate) struct Scratch {
 }
 
 impl GpuContext {
-    /// Uploads the records and the IES atlas of a prepared scene (None when there are no
-    /// lights).
-    pub fn upload(&self, records: &[Record], ies_atlas: &[f32]) -> Result<Option<GpuLights>> {
+    /// Uploads the records, the IES atlas and the dome texture atlas of a prepared scene (None
+    /// when there are no lights).
+    pub fn upload(
+        &self,
+        records: &[Record],
+        ies_atlas: &[f32],
+        tex_atlas: &super::dome_atlas::Atlas,
+    ) -> Result<Option<GpuLights>> {
         if records.is_empty() {
             return Ok(None);
         }
@@ -85,13 +93,58 @@ impl GpuContext {
             self.queue
                 .write_buffer(&ies_atlas_buffer, 0, bytemuck::cast_slice(ies_atlas));
         }
+        // One atlas per scene, refused whole when over the binding limit.
+        // TODO(issue 9): tile or reduce oversized textures with a warning instead.
+        let tex_bytes = (tex_atlas.len() * 4) as u64;
+        if tex_bytes > self.limits.max_storage_buffer_binding_size {
+            let files: Vec<String> = tex_atlas
+                .entries
+                .iter()
+                .map(|e| {
+                    format!(
+                        "{} ({} × {})",
+                        e.image.source.display(),
+                        e.image.width,
+                        e.image.height
+                    )
+                })
+                .collect();
+            return Err(LuxError::input(
+                "dome textures",
+                format!(
+                    "the scene's dome textures ({}) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes; use smaller textures or --device cpu",
+                    files.join(", "),
+                    self.limits.max_storage_buffer_binding_size
+                ),
+            ));
+        }
+        let tex_atlas_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("dome texture atlas"),
+            size: tex_bytes.max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        // Each image straight to its offset: no concatenated host copy.
+        for (offset, data) in tex_atlas.chunks() {
+            if !data.is_empty() {
+                self.queue.write_buffer(
+                    &tex_atlas_buffer,
+                    (offset * 4) as u64,
+                    bytemuck::cast_slice(data),
+                );
+            }
+        }
         Ok(Some(GpuLights {
             buffer,
             ies_atlas: ies_atlas_buffer,
+            tex_atlas: tex_atlas_buffer,
             count: records.len(),
             has_ies: records
                 .iter()
                 .any(|r| r.flags & super::record::FLAG_IES != 0),
+            has_dome: records
+                .iter()
+                .any(|r| r.flags & super::record::FLAG_DOME_TEXTURE != 0),
         }))
     }
 
@@ -116,7 +169,11 @@ impl GpuContext {
         }
         // The irradiance kernel integrates no IES-shaped light (the host does, see
         // PreparedScene::irradiance), so it never needs the lookup.
-        let pipeline = self.pipeline(kernel, lights.has_ies && kernel != Kernel::Irradiance)?;
+        let pipeline = self.pipeline(
+            kernel,
+            lights.has_ies && kernel != Kernel::Irradiance,
+            lights.has_dome,
+        )?;
         let capacity = self.chunk_capacity(count, per_light);
         let per_group = self.lights_per_dispatch(kernel).max(1);
         let key = ScratchKey {
@@ -215,6 +272,7 @@ impl GpuContext {
                 entry(3, buf_b.as_ref().unwrap_or(&buf_a)),
                 entry(4, &buf_out),
                 entry(5, &lights.ies_atlas),
+                entry(6, &lights.tex_atlas),
             ],
         });
         Scratch {

@@ -4,6 +4,7 @@
 //! and `prepare` only, never on `cpu`.
 
 pub(crate) mod dispatch;
+pub(crate) mod dome_atlas;
 pub(crate) mod ies_atlas;
 pub(crate) mod record;
 pub(crate) mod shaders;
@@ -74,7 +75,7 @@ pub(crate) struct GpuContext {
     pub(crate) limits: wgpu::Limits,
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<(Kernel, bool), wgpu::ComputePipeline>>,
+    pipelines: Mutex<HashMap<(Kernel, bool, bool), wgpu::ComputePipeline>>,
     /// Why the device was lost, once it is (set by wgpu's device-lost callback): reported
     /// instead of the validation errors a lost device's buffers then raise.
     lost: Arc<Mutex<Option<String>>>,
@@ -193,6 +194,7 @@ impl GpuContext {
                 layout_entry(3, wgpu::BufferBindingType::Storage { read_only: true }),
                 layout_entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
                 layout_entry(5, wgpu::BufferBindingType::Storage { read_only: true }),
+                layout_entry(6, wgpu::BufferBindingType::Storage { read_only: true }),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -214,13 +216,17 @@ impl GpuContext {
 
     /// The pipeline of `kernel`, compiled on first use; `ies` selects the variant with the IES
     /// lookup (the WGSL override `IES_ENABLED`, see the header of shared/ies.wgsl), needed only
-    /// when the scene has a profile.
-    pub fn pipeline(&self, kernel: Kernel, ies: bool) -> Result<wgpu::ComputePipeline> {
+    /// when the scene has a profile; `dome` the variant with the dome texture lookup
+    /// (`DOME_ENABLED`, see the header of shared/dome.wgsl), needed only when the scene has a
+    /// textured dome (kernels that do not import shared/dome.wgsl ignore it).
+    pub fn pipeline(&self, kernel: Kernel, ies: bool, dome: bool) -> Result<wgpu::ComputePipeline> {
         let mut cache = self
             .pipelines
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(p) = cache.get(&(kernel, ies)) {
+        let source = shaders::compose(kernel);
+        let dome = dome && source.contains("override DOME_ENABLED");
+        if let Some(p) = cache.get(&(kernel, ies, dome)) {
             return Ok(p.clone());
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -228,9 +234,12 @@ impl GpuContext {
             .device
             .create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(kernel.file()),
-                source: wgpu::ShaderSource::Wgsl(shaders::compose(kernel).into()),
+                source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
             });
-        let constants = [("IES_ENABLED", if ies { 1.0 } else { 0.0 })];
+        let mut constants = vec![("IES_ENABLED", if ies { 1.0 } else { 0.0 })];
+        if source.contains("override DOME_ENABLED") {
+            constants.push(("DOME_ENABLED", if dome { 1.0 } else { 0.0 }));
+        }
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -250,7 +259,7 @@ impl GpuContext {
                 e,
             ));
         }
-        cache.insert((kernel, ies), pipeline.clone());
+        cache.insert((kernel, ies, dome), pipeline.clone());
         Ok(pipeline)
     }
 

@@ -36,6 +36,9 @@ pub const FLAG_DARK: u32 = 128;
 pub const FLAG_AXIS_SINGULAR: u32 = 256;
 /// ShapingAPI carries an IES profile (`ies`: atlas base, angleScale, scale).
 pub const FLAG_IES: u32 = 512;
+/// A dome with a texture (`tex_inv`, `tex`: the dome frame and the atlas offset, see
+/// `gpu::dome_atlas` and `shaders/shared/dome.wgsl`).
+pub const FLAG_DOME_TEXTURE: u32 = 1024;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -58,6 +61,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_DARK", FLAG_DARK),
     ("FLAG_AXIS_SINGULAR", FLAG_AXIS_SINGULAR),
     ("FLAG_IES", FLAG_IES),
+    ("FLAG_DOME_TEXTURE", FLAG_DOME_TEXTURE),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
 ];
 
@@ -79,6 +83,10 @@ pub struct Record {
     /// IES (FLAG_IES): (atlas base of the profile, exact in f32; angleScale; normalisation or
     /// tilt scale; 0).
     pub ies: [f32; 4],
+    /// Textured dome (FLAG_DOME_TEXTURE): columns of `A_eff⁻¹` (world → dome, §6 D1); w: 0.
+    pub tex_inv: [[f32; 4]; 3],
+    /// Textured dome: (atlas offset of the texture's header, filter code, 0, 0).
+    pub tex: [u32; 4],
     pub kind: u32,
     pub flags: u32,
     pub pad: [u32; 2],
@@ -102,8 +110,9 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 }
 
 /// Rounds a prepared light's f64 constants to its GPU record; `ies_base` is where its IES
-/// profile starts in the scene's atlas (`gpu::ies_atlas`).
-pub fn pack(p: &Prepared, ies_base: Option<u32>) -> Record {
+/// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture
+/// starts in the scene's texture atlas (`gpu::dome_atlas`).
+pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Record {
     let m = p.to_local;
     // Local = M⁻¹·(x − o): row i is (row_i(M⁻¹), −row_i(M⁻¹)·o).
     let row = |i: usize| v4(m.row(i), -m.row(i).dot(p.origin));
@@ -156,6 +165,16 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>) -> Record {
     if let (Some(ies), Some(base)) = (&p.ies, ies_base) {
         r.flags |= FLAG_IES;
         r.ies = [base as f32, ies.angle_scale as f32, ies.scale as f32, 0.0];
+    }
+    if let (Some(t), Some(offset)) = (&p.texture, tex_offset) {
+        r.flags |= FLAG_DOME_TEXTURE;
+        let inv = t.frame.inv;
+        r.tex_inv = [
+            v4(inv.x_axis, 0.0),
+            v4(inv.y_axis, 0.0),
+            v4(inv.z_axis, 0.0),
+        ];
+        r.tex = [offset, t.filter.code(), 0, 0];
     }
     let (kind, size) = match p.light.kind {
         LightType::Distant { .. } => {

@@ -1,13 +1,14 @@
 //! WGSL composition: each kernel file names the modules it needs with `// #import path` lines;
 //! the composer inlines them once each, in dependency order, after a prelude of the constants
 //! shared with Rust: the record's kinds and flags ([`super::record::WGSL_CONSTANTS`]), the IES
-//! atlas codes ([`super::ies_atlas::wgsl_constants`]) and the
+//! atlas codes ([`super::ies_atlas::wgsl_constants`]), the dome texture codes
+//! ([`super::dome_atlas::wgsl_constants`]) and the
 //! quadrature rules and tuning constants of [`crate::rules`]. No constant is retyped in WGSL.
 
 use std::collections::HashSet;
 
-use super::ies_atlas;
 use super::record::WGSL_CONSTANTS;
+use super::{dome_atlas, ies_atlas};
 use crate::rules;
 
 /// Every WGSL source file, by its path under `shaders/`.
@@ -35,6 +36,10 @@ pub const SOURCES: &[(&str, &str)] = &[
     (
         "shared/ies.wgsl",
         include_str!("../../shaders/shared/ies.wgsl"),
+    ),
+    (
+        "shared/dome.wgsl",
+        include_str!("../../shaders/shared/dome.wgsl"),
     ),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
@@ -121,20 +126,25 @@ fn source(path: &str) -> &'static str {
 /// The prelude of shared constants.
 pub fn prelude() -> String {
     let mut s = String::from(
-        "// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs and src/rules.rs.\n",
+        "// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs, src/gpu/dome_atlas.rs and \
+         src/rules.rs.\n",
     );
     for (name, value) in WGSL_CONSTANTS
         .iter()
         .copied()
         .chain(rules::wgsl_u32_constants())
         .chain(ies_atlas::wgsl_constants())
+        .chain(dome_atlas::wgsl_constants())
     {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
     for (name, value) in rules::wgsl_f32_constants() {
         s.push_str(&format!("const {name}: f32 = {};\n", f32_literal(value)));
     }
-    for (name, values) in rules::wgsl_f32_arrays() {
+    for (name, values) in rules::wgsl_f32_arrays()
+        .into_iter()
+        .chain(dome_atlas::wgsl_f32_arrays())
+    {
         let items: Vec<String> = values.iter().map(|v| f32_literal(*v)).collect();
         s.push_str(&format!(
             "var<private> {name}: array<f32, {}> = array<f32, {}>({});\n",

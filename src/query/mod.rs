@@ -110,6 +110,16 @@ impl Evaluator {
         PreparedScene::new(self.backend.clone(), lights, self.temperature_mode)
     }
 
+    /// A scene of lights already prepared (tests that set what the model cannot author yet,
+    /// e.g. the texture filter).
+    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
+    pub(crate) fn prepare_prepared(
+        &self,
+        lights: Vec<crate::prepare::Prepared>,
+    ) -> Result<PreparedScene> {
+        PreparedScene::from_prepared(self.backend.clone(), lights)
+    }
+
     /// emission(light, ω) for every direction (DESIGN.md §3); prepares `lights` for this one
     /// call (use [`Evaluator::prepare`] to query the same lights many times).
     pub fn emission(

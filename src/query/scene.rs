@@ -7,7 +7,7 @@ use glam::DVec3;
 use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::error::{LuxError, Result};
-use crate::gpu::{GpuLights, Kernel, Scratch, ies_atlas, record};
+use crate::gpu::{GpuLights, Kernel, Scratch, dome_atlas, ies_atlas, record};
 use crate::model::{Light, Texture};
 use crate::prepare::{self, Prepared, TemperatureMode};
 
@@ -42,25 +42,17 @@ impl PreparedScene {
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
-                // Textured domes are evaluated on the CPU reference only until dome.wgsl and
-                // its texture atlas land (issue 9): refused here, never evaluated as uniform.
-                if let Some((p, t)) = textured(&lights) {
-                    return Err(LuxError::attr(
-                        &p.light.path,
-                        "inputs:texture:file",
-                        &t.file.authored,
-                        "textured dome lights are evaluated on the CPU only so far \
-                         (use --device cpu)",
-                    ));
-                }
                 let (atlas, bases) = ies_atlas::scene_atlas(&lights)
                     .map_err(|e| LuxError::input("IES profiles", e.to_string()))?;
+                let (tex_atlas, offsets) = dome_atlas::scene_atlas(&lights)
+                    .map_err(|e| LuxError::input("dome textures", e.to_string()))?;
                 let records: Vec<record::Record> = lights
                     .iter()
                     .zip(bases)
-                    .map(|(p, base)| record::pack(p, base))
+                    .zip(offsets)
+                    .map(|((p, base), offset)| record::pack(p, base, offset))
                     .collect();
-                g.upload(&records, &atlas.data)?
+                g.upload(&records, &atlas.data, &tex_atlas)?
             }
         };
         Ok(PreparedScene {

@@ -3,6 +3,7 @@
 //! every type and transform, sample generators, and the WGSL irradiance kernel's rule replayed
 //! in f64 (so that tests can separate its quadrature error from f32 rounding).
 
+pub mod dome;
 pub mod ies;
 pub mod ies_replay;
 pub mod kernel_rule;
