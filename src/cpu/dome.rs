@@ -1,5 +1,5 @@
-//! Dome and rect texture lookup on the CPU (f64). Twin of `shaders/shared/dome.wgsl` (to be
-//! ported from the staged crate `luxeval-dome` with the GPU path, issue 9): the same functions
+//! Dome and rect texture lookup on the CPU (f64). Twin of `shaders/shared/dome.wgsl` (which
+//! reads the texture atlas packed by `src/gpu/dome_atlas.rs`): the same functions
 //! with the same names in the same order, one per step (world direction → dome direction →
 //! format coordinates → filtered texel). The codes and the cube-cross table come from
 //! [`crate::prepare::dome`], which both backends read.
