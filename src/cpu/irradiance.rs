@@ -26,6 +26,7 @@
 pub mod chart;
 pub mod closed;
 pub mod critical;
+pub mod dome;
 pub mod line;
 pub mod outer;
 pub mod pieces;
@@ -50,9 +51,11 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3) -> DVec3 {
 pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> DVec3 {
     let e = match p.light.kind {
         // A textured dome's irradiance is the exact integral of its filtered texture (DESIGN.md
-        // §6), not yet ported (issue 9): NaN rather than the uniform dome's value. The queries
-        // refuse such a dome before calling this.
-        LightType::Dome if p.texture.is_some() => DVec3::NAN,
+        // §6 "Dome and texture irradiance: what 'exact' means"), see dome.rs.
+        LightType::Dome if p.texture.is_some() => match dome::tables(p) {
+            Some(t) => p.base * t.irradiance(n),
+            None => DVec3::NAN,
+        },
         LightType::Dome => p.base * PI,
         LightType::Distant { .. } => {
             let c = -p.axis;

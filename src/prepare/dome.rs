@@ -267,7 +267,15 @@ pub struct PreparedTexture {
     pub frame: DomeFrame,
     /// Bilinear (default) or nearest (§6 D1).
     pub filter: Filter,
+    /// The irradiance tables of this texture (built lazily by the CPU reference on the first
+    /// irradiance query, `src/cpu/irradiance/dome.rs`, and shared by clones of the light). Typed
+    /// `Any` because prepare does not name cpu types (tests/layers.rs).
+    pub irradiance: IrradianceSlot,
 }
+
+/// A lazily filled, shared slot for a texture's irradiance tables (see
+/// [`PreparedTexture::irradiance`]).
+pub type IrradianceSlot = Arc<std::sync::OnceLock<Arc<dyn std::any::Any + Send + Sync>>>;
 
 /// §6 D5's table entry of face `f` as vectors: (F, R, U, block).
 pub fn cross_face_basis(f: u32) -> (DVec3, DVec3, DVec3, DVec2) {

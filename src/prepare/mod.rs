@@ -239,6 +239,7 @@ fn prepare_texture(
         format,
         frame,
         filter: dome::Filter::default(),
+        irradiance: Default::default(),
     })
 }
 

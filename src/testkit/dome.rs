@@ -68,3 +68,25 @@ pub fn near_discontinuity(
         })
         .collect())
 }
+
+/// The CPU reference's irradiance of `light` (a textured dome) read through `filter` (nearest
+/// when `nearest`, else bilinear) at the origin, for each unit receiver normal: the exact
+/// integral of the filtered texture (src/cpu/irradiance/dome.rs), `diffuse` applied.
+pub fn irradiance_with_filter(
+    light: &Light,
+    nearest: bool,
+    normals: &[DVec3],
+) -> Result<Vec<DVec3>> {
+    let mut p = prepare::Prepared::new(light, TemperatureMode::Spec)?;
+    if let Some(t) = &mut p.texture {
+        t.filter = if nearest {
+            Filter::Nearest
+        } else {
+            Filter::Bilinear
+        };
+    }
+    Ok(normals
+        .iter()
+        .map(|&n| crate::cpu::irradiance::irradiance(&p, DVec3::ZERO, n))
+        .collect())
+}

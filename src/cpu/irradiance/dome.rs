@@ -1,0 +1,646 @@
+//! Exact dome irradiance (DESIGN.md §6 D1 last paragraph and "Dome and texture irradiance: what
+//! 'exact' means"): `E(n) = ∫ L(ω) max(0, n·ω) dω` over **world** solid angle, of the texture as
+//! actually filtered (bilinear or nearest), for every format and any invertible dome transform.
+//!
+//! In dome space (`ω ∝ A_eff d`, §6 D1) the integrand is
+//! `L(d) · max(0, m·d) · w(d)` with `m = A_effᵀ n` and `w(d) = |det A| / |A_eff d|⁴`
+//! (`n·ω = m·d / |A_eff d|` times the Jacobian `|det A| / |A_eff d|³`). It is linear in `m`, so a
+//! piece of the texture wholly above the horizon contributes `m · V` with the precomputable
+//! moment `V = ∫ L d w dd` (RGB × xyz). Only pieces the horizon great circle `m·d = 0` crosses
+//! need per-receiver work ([`pieces::exact`]).
+//!
+//! Tables (built lazily on the first query, in parallel): pieces grouped in tiles of T × T
+//! (T = 1 up to 2²⁰ pieces), each with its summed moment and a bounding cap. A receiver adds
+//! `m · V` for tiles whose cap is wholly lit, skips wholly dark ones, and descends into the rest.
+//!
+//! Moments: latlong under a conformal frame (rotation × uniform scale, `w` constant) is separable
+//! — `∫∫ wx wy (sin θ sin φ, cos θ, sin θ cos φ) sin θ dφ dθ` is a product of one column integral
+//! and one row integral — computed per axis piece with a 16-point rule (exact to rounding on
+//! pieces ≤ π/8). Otherwise an n × n Gauss–Legendre rule per piece with n the smallest order whose
+//! term `(2δ(1 + κ))^{2n} / (2n)!` is below 1e-17 (δ the piece's cap radius, κ ≥ the frame's
+//! condition number; a rule of order n is exact for degree 2n − 1 and the integrand's derivatives
+//! grow like `(1 + κ)^k`), and the adaptive routine for disk-rim pieces and pieces with
+//! `δ(1 + κ) > 0.5`. Crossed pieces: adaptive outer integral to 1e-12 of the piece's scale.
+
+pub mod pieces;
+pub mod quadrature;
+pub mod sh;
+
+use std::sync::{Arc, OnceLock};
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::prepare::dome::Filter;
+use crate::prepare::dome::Image;
+use crate::prepare::dome::{DomeFormat, DomeFrame, FormatError};
+use pieces::{Domain, Geometry, HorizonCurve, Piece, PieceGrid, exact, tensor};
+use quadrature::gl;
+
+/// The irradiance tables of a prepared textured dome, built on first use and kept in the
+/// texture's [`crate::prepare::dome::PreparedTexture::irradiance`] slot (shared by clones of the
+/// light). `None` for a light without a texture, or a cross whose size is not 3N × 4N (which
+/// preparation already refuses).
+pub fn tables(p: &crate::prepare::Prepared) -> Option<Arc<DomeIrradiance>> {
+    let t = p.texture.as_ref()?;
+    let slot = t.irradiance.get_or_init(|| {
+        match DomeIrradiance::new(t.image.clone(), t.format, t.filter, t.frame) {
+            Ok(d) => Arc::new(d) as Arc<dyn std::any::Any + Send + Sync>,
+            Err(_) => Arc::new(()) as Arc<dyn std::any::Any + Send + Sync>,
+        }
+    });
+    slot.clone().downcast::<DomeIrradiance>().ok()
+}
+
+/// Pieces per table entry at most (the tile size grows beyond it).
+const MAX_TILES: usize = 1 << 20;
+/// Relative tolerance of the adaptive integrals (per piece).
+const REL_TOL: f64 = 1e-12;
+
+/// A dome texture prepared for irradiance queries.
+pub struct DomeIrradiance {
+    pub img: Arc<Image>,
+    pub format: DomeFormat,
+    pub filter: Filter,
+    pub frame: DomeFrame,
+    geom: Geometry,
+    grids: Vec<PieceGrid>,
+    /// `|det A| / |A_eff d|⁴` is constant (conformal frame).
+    conformal: Option<f64>,
+    /// Upper bound of the frame's condition number.
+    kappa: f64,
+    tables: OnceLock<Tables>,
+}
+
+struct Tile {
+    grid: usize,
+    ix: (usize, usize),
+    iy: (usize, usize),
+    v: [f64; 9],
+    /// Cap centre and angular radius; radius = ∞ forces a descent.
+    centre: DVec3,
+    radius: f64,
+}
+
+struct Tables {
+    tiles: Vec<Tile>,
+    single: bool,
+    /// Separable latlong factors per axis piece: columns (a ∈ {0,1}) × (sin φ, 1, cos φ),
+    /// rows (b ∈ {0,1}) × (sin²θ, sinθ cosθ).
+    cols: Vec<[[f64; 3]; 2]>,
+    rows: Vec<[[f64; 2]; 2]>,
+}
+
+/// Where a cap lies with respect to the lit hemisphere `m̂·d > 0`.
+#[derive(PartialEq)]
+enum Side {
+    Lit,
+    Dark,
+    Crossed,
+}
+
+fn side(mhat: DVec3, centre: DVec3, radius: f64) -> Side {
+    if radius >= 0.5 * std::f64::consts::PI {
+        return Side::Crossed;
+    }
+    let (s, r) = (mhat.dot(centre), radius.sin() + 1e-12);
+    if s > r {
+        Side::Lit
+    } else if s < -r {
+        Side::Dark
+    } else {
+        Side::Crossed
+    }
+}
+
+fn add<const K: usize>(acc: &mut [f64; K], v: &[f64; K]) {
+    acc.iter_mut().zip(v).for_each(|(a, b)| *a += b);
+}
+
+impl DomeIrradiance {
+    /// Fails (naming the file) for a cross whose size is not 3N × 4N; the other formats take any
+    /// non-empty image.
+    pub fn new(
+        img: Arc<Image>,
+        format: DomeFormat,
+        filter: Filter,
+        frame: DomeFrame,
+    ) -> Result<DomeIrradiance, FormatError> {
+        let (w, h) = (img.width, img.height);
+        if format == DomeFormat::Cross && (w == 0 || w % 3 != 0 || h % 4 != 0 || w / 3 != h / 4) {
+            return Err(FormatError::BadCross {
+                path: img.source.clone(),
+                width: w,
+                height: h,
+            });
+        }
+        let geom = Geometry::new(format, img.width, img.height);
+        let grids = geom.grids(filter);
+        let a = frame.a_eff;
+        let gram = a.transpose() * a;
+        let s2 = frame.det_abs.powf(2.0 / 3.0);
+        let conformal = ((gram - glam::DMat3::IDENTITY * s2)
+            .to_cols_array()
+            .iter()
+            .all(|v| v.abs() <= 1e-13 * s2))
+        .then(|| frame.det_abs / (s2 * s2));
+        let kappa = (a.to_cols_array().iter().map(|v| v * v).sum::<f64>()
+            * frame.inv.to_cols_array().iter().map(|v| v * v).sum::<f64>())
+        .sqrt()
+            / 3.0;
+        Ok(DomeIrradiance {
+            img,
+            format,
+            filter,
+            frame,
+            geom,
+            grids,
+            conformal,
+            kappa: kappa.max(1.0),
+            tables: OnceLock::new(),
+        })
+    }
+
+    /// `w(d) = |det A| / |A_eff d|⁴`.
+    #[inline]
+    pub fn weight(&self, d: DVec3) -> f64 {
+        self.conformal.unwrap_or_else(|| {
+            let l2 = (self.frame.a_eff * d).length_squared();
+            self.frame.det_abs / (l2 * l2)
+        })
+    }
+
+    /// The Gauss–Legendre order for a piece of cap radius δ (module docs).
+    pub fn order(&self, delta: f64) -> usize {
+        let x = 2.0 * delta * (1.0 + self.kappa);
+        let mut term = 1.0f64;
+        for n in 1..=24usize {
+            let k = 2 * n;
+            term *= x * x / ((k - 1) as f64 * k as f64);
+            if term < 1e-17 {
+                return n.max(2);
+            }
+        }
+        24
+    }
+
+    fn piece(&self, grid: usize, ix: usize, iy: usize) -> Piece {
+        let g = &self.grids[grid];
+        Piece {
+            ax: g.xs[ix],
+            ay: g.ys[iy],
+            face: g.face,
+        }
+    }
+
+    /// The piece's texture scale for tolerances: its largest corner texel (summed channels) times
+    /// its solid angle estimate.
+    fn scale(&self, p: &Piece) -> f64 {
+        let t = |i, j| crate::cpu::dome::tex_fetch(&self.img, i, j);
+        let m = [
+            t(p.ax.i0, p.ay.i0),
+            t(p.ax.i1, p.ay.i0),
+            t(p.ax.i0, p.ay.i1),
+            t(p.ax.i1, p.ay.i1),
+        ]
+        .iter()
+        .map(|v| v.abs().element_sum())
+        .fold(0.0, f64::max);
+        let (cx, cy) = (0.5 * (p.ax.x0 + p.ax.x1), 0.5 * (p.ay.x0 + p.ay.x1));
+        let (d, j) = self.geom.dir_jac(p.face, cx, cy);
+        let area = (p.ax.x1 - p.ax.x0) * (p.ay.x1 - p.ay.x0);
+        m * (j.max(1e-3 * 16.0 / (self.geom.w * self.geom.h))) * area * self.weight(d) + 1e-300
+    }
+
+    /// `V = ∫_piece L d w dd` (RGB × xyz, channel-major).
+    fn moment(&self, t: &Tables, grid: usize, ix: usize, iy: usize) -> [f64; 9] {
+        let p = self.piece(grid, ix, iy);
+        let dom = self.geom.domain(&p);
+        if dom == Domain::Outside {
+            return [0.0; 9];
+        }
+        let mut f = |d: DVec3, tex: DVec3, j: f64| {
+            let v = d * (self.weight(d) * j);
+            [
+                tex.x * v.x,
+                tex.x * v.y,
+                tex.x * v.z,
+                tex.y * v.x,
+                tex.y * v.y,
+                tex.y * v.z,
+                tex.z * v.x,
+                tex.z * v.y,
+                tex.z * v.z,
+            ]
+        };
+        let cap = self.geom.cap(&p);
+        match (cap, self.conformal) {
+            (Some(_), Some(w)) if self.format == DomeFormat::LatLong => {
+                let (cx, ry) = (&t.cols[ix], &t.rows[iy]);
+                let k = w
+                    * (2.0 * std::f64::consts::PI / self.geom.w)
+                    * (std::f64::consts::PI / self.geom.h);
+                let corners = [
+                    (p.ax.i0, p.ay.i0, 0, 0),
+                    (p.ax.i1, p.ay.i0, 1, 0),
+                    (p.ax.i0, p.ay.i1, 0, 1),
+                    (p.ax.i1, p.ay.i1, 1, 1),
+                ];
+                let mut v = [0.0; 9];
+                for (i, j, a, b) in corners {
+                    let m = DVec3::new(
+                        cx[a][0] * ry[b][0],
+                        cx[a][1] * ry[b][1],
+                        cx[a][2] * ry[b][0],
+                    ) * k;
+                    let tex = crate::cpu::dome::tex_fetch(&self.img, i, j);
+                    add(
+                        &mut v,
+                        &[
+                            tex.x * m.x,
+                            tex.x * m.y,
+                            tex.x * m.z,
+                            tex.y * m.x,
+                            tex.y * m.y,
+                            tex.y * m.z,
+                            tex.z * m.x,
+                            tex.z * m.y,
+                            tex.z * m.z,
+                        ],
+                    );
+                }
+                v
+            }
+            (Some((_, delta)), _) if dom == Domain::Inside && delta * (1.0 + self.kappa) <= 0.5 => {
+                tensor(&self.geom, &self.img, &p, self.order(delta), &mut f)
+            }
+            _ => exact(
+                &self.geom,
+                &self.img,
+                &p,
+                None,
+                None,
+                self.order(0.5),
+                REL_TOL * self.scale(&p),
+                &mut f,
+            ),
+        }
+    }
+
+    fn tables(&self) -> &Tables {
+        self.tables.get_or_init(|| self.build())
+    }
+
+    /// Builds the tables now (they are otherwise built on the first query).
+    pub fn prepare(&self) {
+        let _ = self.tables();
+    }
+
+    fn build(&self) -> Tables {
+        let count: usize = self.grids.iter().map(|g| g.xs.len() * g.ys.len()).sum();
+        let tsize = ((count as f64 / MAX_TILES as f64).sqrt().ceil() as usize).max(1);
+        let axis_rule = |a: f64, b: f64, f: &dyn Fn(f64) -> [f64; 3]| gl::<3>(16, a, b, f);
+        let (mut cols, mut rows) = (vec![], vec![]);
+        if self.format == DomeFormat::LatLong {
+            let (w, h) = (self.geom.w, self.geom.h);
+            let phi = |x: f64| std::f64::consts::PI - 2.0 * std::f64::consts::PI * x / w;
+            cols = self.grids[0]
+                .xs
+                .iter()
+                .map(|p| {
+                    [0, 1].map(|a| {
+                        axis_rule(p.x0, p.x1, &|x| {
+                            let wt = if a == 0 {
+                                p.weights(x).0
+                            } else {
+                                p.weights(x).1
+                            };
+                            [wt * phi(x).sin(), wt, wt * phi(x).cos()]
+                        })
+                    })
+                })
+                .collect();
+            rows = self.grids[0]
+                .ys
+                .iter()
+                .map(|p| {
+                    [0, 1].map(|b| {
+                        let v = axis_rule(p.x0, p.x1, &|y| {
+                            let wt = if b == 0 {
+                                p.weights(y).0
+                            } else {
+                                p.weights(y).1
+                            };
+                            let (s, c) = (std::f64::consts::PI * y / h).sin_cos();
+                            [wt * s * s, wt * s * c, 0.0]
+                        });
+                        [v[0], v[1]]
+                    })
+                })
+                .collect();
+        }
+        let mut t = Tables {
+            tiles: vec![],
+            single: tsize == 1,
+            cols,
+            rows,
+        };
+        let mut specs = vec![];
+        for (gi, g) in self.grids.iter().enumerate() {
+            for y in (0..g.ys.len()).step_by(tsize) {
+                for x in (0..g.xs.len()).step_by(tsize) {
+                    specs.push((
+                        gi,
+                        (x, (x + tsize).min(g.xs.len())),
+                        (y, (y + tsize).min(g.ys.len())),
+                    ));
+                }
+            }
+        }
+        let tiles: Vec<Tile> = specs
+            .into_par_iter()
+            .filter_map(|(grid, ix, iy)| self.tile(&t, grid, ix, iy))
+            .collect();
+        t.tiles = tiles;
+        t
+    }
+
+    fn tile(
+        &self,
+        t: &Tables,
+        grid: usize,
+        ix: (usize, usize),
+        iy: (usize, usize),
+    ) -> Option<Tile> {
+        let mut v = [0.0; 9];
+        let mut caps = vec![];
+        let mut bounded = true;
+        for j in iy.0..iy.1 {
+            for i in ix.0..ix.1 {
+                let p = self.piece(grid, i, j);
+                if self.geom.domain(&p) == Domain::Outside {
+                    continue;
+                }
+                add(&mut v, &self.moment(t, grid, i, j));
+                match self.geom.cap(&p) {
+                    Some(c) => caps.push(c),
+                    None => bounded = false,
+                }
+            }
+        }
+        if caps.is_empty() && bounded {
+            return None;
+        }
+        let centre = caps.get(caps.len() / 2).map_or(DVec3::Z, |c| c.0);
+        let radius = if bounded {
+            caps.iter()
+                .map(|(c, r)| centre.cross(*c).length().atan2(centre.dot(*c)) + r)
+                .fold(0.0, f64::max)
+        } else {
+            f64::INFINITY
+        };
+        Some(Tile {
+            grid,
+            ix,
+            iy,
+            v,
+            centre,
+            radius,
+        })
+    }
+
+    /// `E(n)` (RGB) for a unit world normal `n`: the exact integral of the filtered texture
+    /// (module docs). Multiply by the dome's `intensity · 2^exposure · color ⊙ temperature` and
+    /// `diffuse` outside.
+    pub fn irradiance(&self, n: DVec3) -> DVec3 {
+        let t = self.tables();
+        let m = self.frame.horizon(n);
+        let mhat = m.normalize();
+        let curve = matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
+            .then(|| HorizonCurve::new(self.format, m));
+        let dot = |v: &[f64; 9]| {
+            DVec3::new(
+                m.dot(DVec3::new(v[0], v[1], v[2])),
+                m.dot(DVec3::new(v[3], v[4], v[5])),
+                m.dot(DVec3::new(v[6], v[7], v[8])),
+            )
+        };
+        let mut e = DVec3::ZERO;
+        for tile in &t.tiles {
+            match side(mhat, tile.centre, tile.radius) {
+                Side::Lit => e += dot(&tile.v),
+                Side::Dark => {}
+                Side::Crossed if t.single && tile.radius.is_finite() => {
+                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, curve.as_ref());
+                }
+                Side::Crossed => {
+                    for j in tile.iy.0..tile.iy.1 {
+                        for i in tile.ix.0..tile.ix.1 {
+                            let p = self.piece(tile.grid, i, j);
+                            match self.geom.cap(&p).map(|(c, r)| side(mhat, c, r)) {
+                                _ if self.geom.domain(&p) == Domain::Outside => {}
+                                Some(Side::Lit) => e += dot(&self.moment(t, tile.grid, i, j)),
+                                Some(Side::Dark) => {}
+                                _ => e += self.crossed(tile.grid, i, j, m, curve.as_ref()),
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        e
+    }
+
+    /// One piece's share of `E`, clipped exactly at the horizon.
+    fn crossed(
+        &self,
+        grid: usize,
+        i: usize,
+        j: usize,
+        m: DVec3,
+        curve: Option<&HorizonCurve>,
+    ) -> DVec3 {
+        let p = self.piece(grid, i, j);
+        let delta = self.geom.cap(&p).map_or(0.5, |c| c.1.min(0.5));
+        let v = exact(
+            &self.geom,
+            &self.img,
+            &p,
+            Some(m),
+            curve,
+            self.order(delta) + 2,
+            REL_TOL * self.scale(&p) * m.length(),
+            &mut |d, tex, jac| {
+                let k = m.dot(d) * self.weight(d) * jac;
+                [tex.x * k, tex.y * k, tex.z * k]
+            },
+        );
+        DVec3::from_array(v)
+    }
+
+    /// [`Self::irradiance`] for many normals, in parallel.
+    pub fn irradiance_many(&self, normals: &[DVec3]) -> Vec<DVec3> {
+        self.prepare();
+        normals.par_iter().map(|&n| self.irradiance(n)).collect()
+    }
+
+    /// For latlong under a conformal frame: the dome-space moments `∫ L dd`, `∫ L d dd` and
+    /// `∫ L d dᵀ dd` (world solid angle = dome solid angle there), per channel, exactly and in
+    /// O(W·H): every monomial of degree ≤ 2 in `d = (sin θ sin φ, cos θ, sin θ cos φ)` times
+    /// `sin θ` is a product of a function of φ and one of θ, so each texel's weight is a column
+    /// factor times a row factor (16-point rules per axis piece, as for the moments above).
+    /// `None` for other formats and frames.
+    pub fn separable_moments(&self) -> Option<[(f64, DVec3, glam::DMat3); 3]> {
+        let w = self.conformal?;
+        if self.format != DomeFormat::LatLong {
+            return None;
+        }
+        let (wd, hd) = (self.img.width, self.img.height);
+        let pi = std::f64::consts::PI;
+        let g = &self.grids[0];
+        let mut cols = vec![[0.0f64; 6]; wd];
+        for p in &g.xs {
+            let v = gl::<12>(16, p.x0, p.x1, |x| {
+                let (w0, w1) = p.weights(x);
+                let (sp, cp) = (pi - 2.0 * pi * x / self.geom.w).sin_cos();
+                let f = [1.0, sp, cp, sp * sp, cp * cp, sp * cp];
+                std::array::from_fn(|k| if k < 6 { w0 * f[k] } else { w1 * f[k - 6] })
+            });
+            for k in 0..6 {
+                cols[p.i0 as usize][k] += v[k];
+                cols[p.i1 as usize][k] += v[k + 6];
+            }
+        }
+        let mut rows = vec![[0.0f64; 6]; hd];
+        for p in &g.ys {
+            let v = gl::<12>(16, p.x0, p.x1, |y| {
+                let (w0, w1) = p.weights(y);
+                let (st, ct) = (pi * y / self.geom.h).sin_cos();
+                let f = [
+                    st,
+                    st * st,
+                    ct * st,
+                    st * st * st,
+                    ct * ct * st,
+                    st * st * ct,
+                ];
+                std::array::from_fn(|k| if k < 6 { w0 * f[k] } else { w1 * f[k - 6] })
+            });
+            for k in 0..6 {
+                rows[p.i0 as usize][k] += v[k];
+                rows[p.i1 as usize][k] += v[k + 6];
+            }
+        }
+        // Per channel: the ten monomials 1, x, y, z, xx, yy, zz, xy, yz, xz as (col, row) factors.
+        const PAIRS: [(usize, usize); 10] = [
+            (0, 0),
+            (1, 1),
+            (0, 2),
+            (2, 1),
+            (3, 3),
+            (0, 4),
+            (4, 3),
+            (1, 5),
+            (2, 5),
+            (5, 3),
+        ];
+        let m: [f64; 30] = (0..hd)
+            .into_par_iter()
+            .map(|j| {
+                let mut r = [[0.0f64; 6]; 3];
+                for (t, a) in self.img.rgb[j * wd..(j + 1) * wd].iter().zip(&cols) {
+                    for c in 0..3 {
+                        for k in 0..6 {
+                            r[c][k] += t[c] as f64 * a[k];
+                        }
+                    }
+                }
+                let b = &rows[j];
+                let mut out = [0.0; 30];
+                for c in 0..3 {
+                    for (q, (ka, kb)) in PAIRS.iter().enumerate() {
+                        out[10 * c + q] = r[c][*ka] * b[*kb];
+                    }
+                }
+                out
+            })
+            .reduce(
+                || [0.0; 30],
+                |mut a, b| {
+                    add(&mut a, &b);
+                    a
+                },
+            );
+        // Only the solid-angle factor |det A|/|A d|³ = |det A|/s³ applies here (no cosine): it
+        // is w·s with the stored w = |det A|/s⁴ and s = |det A|^⅓, i.e. 1 for a conformal frame.
+        let k = (2.0 * pi / self.geom.w) * (pi / self.geom.h) * w * self.frame.det_abs.cbrt();
+        Some(std::array::from_fn(|c| {
+            let v = &m[10 * c..10 * c + 10];
+            let s = glam::DMat3::from_cols(
+                DVec3::new(v[4], v[7], v[9]),
+                DVec3::new(v[7], v[5], v[8]),
+                DVec3::new(v[9], v[8], v[6]),
+            );
+            (v[0] * k, DVec3::new(v[1], v[2], v[3]) * k, s * k)
+        }))
+    }
+
+    /// `∫ f(ω, L) dω` over the whole sphere in world solid angle, piece by piece with the same
+    /// rules as the moments (used by the SH projection). `f` gets the world direction and the
+    /// filtered texel and returns K values.
+    pub fn integrate_sphere<const K: usize>(
+        &self,
+        f: &(impl Fn(DVec3, DVec3) -> [f64; K] + Sync),
+    ) -> [f64; K] {
+        let mut specs = vec![];
+        for (gi, g) in self.grids.iter().enumerate() {
+            for j in 0..g.ys.len() {
+                specs.push((gi, j));
+            }
+        }
+        let a = self.frame.a_eff;
+        specs
+            .into_par_iter()
+            .map(|(gi, j)| {
+                let mut acc = [0.0; K];
+                for i in 0..self.grids[gi].xs.len() {
+                    let p = self.piece(gi, i, j);
+                    let dom = self.geom.domain(&p);
+                    if dom == Domain::Outside {
+                        continue;
+                    }
+                    let mut g = |d: DVec3, tex: DVec3, jac: f64| {
+                        let wd = a * d;
+                        let l = wd.length();
+                        f(wd / l, tex).map(|v| v * jac * self.frame.det_abs / (l * l * l))
+                    };
+                    let v = match self.geom.cap(&p) {
+                        Some((_, delta))
+                            if dom == Domain::Inside && delta * (1.0 + self.kappa) <= 0.5 =>
+                        {
+                            tensor(&self.geom, &self.img, &p, self.order(delta) + 1, &mut g)
+                        }
+                        _ => exact(
+                            &self.geom,
+                            &self.img,
+                            &p,
+                            None,
+                            None,
+                            self.order(0.5),
+                            REL_TOL * self.scale(&p),
+                            &mut g,
+                        ),
+                    };
+                    add(&mut acc, &v);
+                }
+                acc
+            })
+            .reduce(
+                || [0.0; K],
+                |mut a, b| {
+                    add(&mut a, &b);
+                    a
+                },
+            )
+    }
+}

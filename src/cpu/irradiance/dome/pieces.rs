@@ -1,0 +1,610 @@
+//! The filtered dome texture as pieces on which it is a polynomial, and the exact integral of a
+//! function of the dome direction over a piece, optionally clipped to a receiver's lit half
+//! (DESIGN.md §6 "Dome and texture irradiance: what 'exact' means").
+//!
+//! A piece is a rectangle of the image sheet (pixel units) between texel-centre lines (bilinear)
+//! or texel edges (nearest), inside one cross face for `cubeMapVerticalCross`; on it the texture
+//! is `Σ wx(x)·wy(y)·T` with linear weights ([`crate::prepare::dome::AxisPiece`]). The map sheet → dome
+//! direction is smooth inside a piece (§6 D2–D5), with the dome solid angle per pixel area `J`:
+//! latlong `sin θ · (2π/W)(π/H)`; mirroredBall `4 · (2/W)(2/H)` (the mirror ball is equal-area);
+//! angular `π sin(πr)/r · (2/W)(2/H)`; cross `(2/N)² / |F + aR + bU|³` (gnomonic).
+//!
+//! Integration over a piece: outer variable x, inner y. For each outer node the lit part of the
+//! inner line is found exactly — latlong: the line is a meridian, which meets the horizon great
+//! circle once, at `θ = α ± π/2` with `α = atan2(m_x sin φ + m_z cos φ, m_y)`; cross: the horizon
+//! is a straight line in the face's gnomonic (a, b); disks: sign changes on 8 sub-intervals refined
+//! by regula falsi — and integrated with an n-point Gauss–Legendre rule. The outer integral is split
+//! at the x where the horizon (or the disk rim) crosses the piece's top or bottom edge, so each
+//! outer part is smooth, and integrated adaptively. The mirror ball's `√(1 − r²)` is removed by
+//! integrating its inner lines in τ with `b = √(1 − a²)·sin τ`; for the disks the outer parts use
+//! `x = x₀ + L(3u² − 2u³)`, which turns the `√` behaviour at the rim's ends and at the horizon's
+//! turning points into a polynomial in u.
+
+use glam::{DVec2, DVec3};
+
+use super::quadrature::{adaptive, gl, sign_change_roots};
+use crate::cpu::dome;
+use crate::prepare::dome::Image;
+use crate::prepare::dome::{AxisPiece, Filter, axis_pieces};
+use crate::prepare::dome::{DomeFormat, ball_dir};
+
+const PI: f64 = std::f64::consts::PI;
+/// Most outer sub-intervals per smooth part of a piece (bounds the work of near-singular cases).
+const MAX_INTERVALS: usize = 64;
+
+/// The sheet → dome-direction map of one format.
+#[derive(Clone, Copy, Debug)]
+pub struct Geometry {
+    pub format: DomeFormat,
+    pub w: f64,
+    pub h: f64,
+    /// Cross face size (W/3); unused otherwise.
+    pub n: f64,
+}
+
+/// One grid of pieces: the whole sheet, or one cross face.
+#[derive(Clone, Debug)]
+pub struct PieceGrid {
+    pub xs: Vec<AxisPiece>,
+    pub ys: Vec<AxisPiece>,
+    /// Cross face (dome::cross_face numbering); 0 otherwise.
+    pub face: u32,
+}
+
+/// A piece: one cell of a grid.
+#[derive(Clone, Copy, Debug)]
+pub struct Piece {
+    pub ax: AxisPiece,
+    pub ay: AxisPiece,
+    pub face: u32,
+}
+
+/// Where a piece lies with respect to a disk format's rim.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Domain {
+    Inside,
+    Boundary,
+    Outside,
+}
+
+impl Geometry {
+    pub fn new(format: DomeFormat, width: usize, height: usize) -> Geometry {
+        Geometry {
+            format,
+            w: width as f64,
+            h: height as f64,
+            n: width as f64 / 3.0,
+        }
+    }
+
+    fn is_disk(&self) -> bool {
+        matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
+    }
+
+    /// The piece grids of this format and filter (§6 D1's wrap/clamp per format).
+    pub fn grids(&self, filter: Filter) -> Vec<PieceGrid> {
+        let (w, h) = (self.w as u32, self.h as u32);
+        match self.format {
+            DomeFormat::LatLong => vec![PieceGrid {
+                xs: axis_pieces(w, true, filter),
+                ys: axis_pieces(h, false, filter),
+                face: 0,
+            }],
+            DomeFormat::MirroredBall | DomeFormat::Angular => {
+                vec![PieceGrid {
+                    xs: axis_pieces(w, false, filter),
+                    ys: axis_pieces(h, false, filter),
+                    face: 0,
+                }]
+            }
+            DomeFormat::Cross => {
+                let n = self.n as u32;
+                (0..6)
+                    .map(|f| {
+                        let b = dome::cross_basis(f).3;
+                        let shift = |p: AxisPiece, k: u32| {
+                            let o = (k * n) as f64;
+                            AxisPiece {
+                                x0: p.x0 + o,
+                                x1: p.x1 + o,
+                                i0: p.i0 + k * n,
+                                i1: p.i1 + k * n,
+                                origin: p.origin + o,
+                            }
+                        };
+                        let xs = axis_pieces(n, false, filter)
+                            .into_iter()
+                            .map(|p| shift(p, b.x as u32))
+                            .collect();
+                        let ys = axis_pieces(n, false, filter)
+                            .into_iter()
+                            .map(|p| shift(p, b.y as u32))
+                            .collect();
+                        PieceGrid { xs, ys, face: f }
+                    })
+                    .collect()
+            }
+        }
+    }
+
+    /// Disk image point (a, b) of sheet (x, y) (§6 D3: `a = 2s − 1`, `b = 1 − 2t`).
+    #[inline]
+    fn ab(&self, x: f64, y: f64) -> DVec2 {
+        DVec2::new(2.0 * x / self.w - 1.0, 1.0 - 2.0 * y / self.h)
+    }
+
+    /// Dome direction and dome solid angle per unit sheet area at (x, y) (module docs).
+    #[inline]
+    pub fn dir_jac(&self, face: u32, x: f64, y: f64) -> (DVec3, f64) {
+        match self.format {
+            DomeFormat::LatLong => {
+                let phi = PI - 2.0 * PI * x / self.w;
+                let theta = PI * y / self.h;
+                let (st, ct) = theta.sin_cos();
+                let (sp, cp) = phi.sin_cos();
+                (
+                    DVec3::new(st * sp, ct, st * cp),
+                    st * (2.0 * PI / self.w) * (PI / self.h),
+                )
+            }
+            DomeFormat::MirroredBall => {
+                let p = self.ab(x, y);
+                (ball_dir(p.x, p.y), 16.0 / (self.w * self.h))
+            }
+            DomeFormat::Angular => {
+                let p = self.ab(x, y);
+                let r = p.length().min(1.0);
+                let k = if r < 1e-8 {
+                    PI * (1.0 - (PI * r).powi(2) / 6.0)
+                } else {
+                    (PI * r).sin() / r
+                };
+                (
+                    DVec3::new(p.x * k, p.y * k, (PI * r).cos()),
+                    PI * k * 4.0 / (self.w * self.h),
+                )
+            }
+            DomeFormat::Cross => {
+                let (f, r, u, blk) = dome::cross_basis(face);
+                let a = 2.0 * (x - blk.x * self.n) / self.n - 1.0;
+                let b = 1.0 - 2.0 * (y - blk.y * self.n) / self.n;
+                let v = f + a * r + b * u;
+                let l = v.length();
+                (v / l, 4.0 / (self.n * self.n * l * l * l))
+            }
+        }
+    }
+
+    /// Inside, on, or outside a disk format's rim (always inside for latlong and cross).
+    pub fn domain(&self, p: &Piece) -> Domain {
+        if !self.is_disk() {
+            return Domain::Inside;
+        }
+        let (a0, b0) = (self.ab(p.ax.x0, p.ay.y1()), self.ab(p.ax.x1, p.ay.y0()));
+        let (lo, hi) = (a0.min(b0), a0.max(b0));
+        let near = DVec2::ZERO.clamp(lo, hi).length();
+        let far = DVec2::new(lo.x.abs().max(hi.x.abs()), lo.y.abs().max(hi.y.abs())).length();
+        if near >= 1.0 {
+            Domain::Outside
+        } else if far > 1.0 - 1e-12 {
+            Domain::Boundary
+        } else {
+            Domain::Inside
+        }
+    }
+
+    /// A cap containing the piece's image on the sphere: (centre, angular radius), or `None`
+    /// where no finite bound is kept (a disk rim piece). The radius is a Lipschitz bound of the
+    /// sheet → sphere map times the half-diagonal: latlong `ds² ≤ (π/H)²dy² + (2π/W)²dx²`;
+    /// cross `|∂d/∂(a,b)| ≤ 1/|v| ≤ 1`; angular `≤ π` per unit (a, b); mirroredBall
+    /// `≤ 2/√(1 − r²_max)`.
+    pub fn cap(&self, p: &Piece) -> Option<(DVec3, f64)> {
+        let (hx, hy) = (0.5 * (p.ax.x1 - p.ax.x0), 0.5 * (p.ay.x1 - p.ay.x0));
+        let (cx, cy) = (p.ax.x0 + hx, p.ay.x0 + hy);
+        let disk_diag = ((2.0 * hx / self.w).powi(2) + (2.0 * hy / self.h).powi(2)).sqrt();
+        let radius = match self.format {
+            DomeFormat::LatLong => {
+                ((2.0 * PI / self.w * hx).powi(2) + (PI / self.h * hy).powi(2)).sqrt()
+            }
+            DomeFormat::Cross => 2.0 / self.n * (hx * hx + hy * hy).sqrt(),
+            DomeFormat::Angular | DomeFormat::MirroredBall => {
+                if self.domain(p) != Domain::Inside {
+                    return None;
+                }
+                let far = self.ab(cx, cy).abs() + DVec2::new(2.0 * hx / self.w, 2.0 * hy / self.h);
+                let r2 = far.length_squared();
+                if self.format == DomeFormat::Angular {
+                    PI * disk_diag
+                } else if r2 < 1.0 {
+                    2.0 / (1.0 - r2).sqrt() * disk_diag
+                } else {
+                    return None;
+                }
+            }
+        };
+        Some((self.dir_jac(p.face, cx, cy).0, radius))
+    }
+}
+
+impl AxisPiece {
+    /// The same piece read as a y-axis piece (bounds).
+    #[inline]
+    pub fn y0(&self) -> f64 {
+        self.x0
+    }
+    #[inline]
+    pub fn y1(&self) -> f64 {
+        self.x1
+    }
+}
+
+/// The filtered texture at (x, y) inside the piece: `Σ wx·wy·T` (§6 D1 bilinear or nearest).
+#[inline]
+pub fn texture_at(img: &Image, p: &Piece, x: f64, y: f64) -> DVec3 {
+    let (wx0, wx1) = p.ax.weights(x);
+    let (wy0, wy1) = p.ay.weights(y);
+    let t = |i: u32, j: u32| dome::tex_fetch(img, i, j);
+    let top = t(p.ax.i0, p.ay.i0) * wx0
+        + if wx1 != 0.0 {
+            t(p.ax.i1, p.ay.i0) * wx1
+        } else {
+            DVec3::ZERO
+        };
+    let bot = if wy1 != 0.0 {
+        (t(p.ax.i0, p.ay.i1) * wx0
+            + if wx1 != 0.0 {
+                t(p.ax.i1, p.ay.i1) * wx1
+            } else {
+                DVec3::ZERO
+            })
+            * wy1
+    } else {
+        DVec3::ZERO
+    };
+    top * wy0 + bot
+}
+
+/// `∫∫_piece f(d, tex, J) dx dy` by the tensor n × n Gauss–Legendre rule (smooth integrand,
+/// whole piece inside the domain, no horizon).
+pub fn tensor<const K: usize>(
+    g: &Geometry,
+    img: &Image,
+    p: &Piece,
+    n: usize,
+    f: &mut impl FnMut(DVec3, DVec3, f64) -> [f64; K],
+) -> [f64; K] {
+    gl(n, p.ax.x0, p.ax.x1, |x| {
+        gl(n, p.ay.x0, p.ay.x1, |y| {
+            let (d, j) = g.dir_jac(p.face, x, y);
+            f(d, texture_at(img, p, x, y), j)
+        })
+    })
+}
+
+/// `∫∫ f(d, tex, J) dx dy` over the piece ∩ domain ∩ {m·d > 0} (no clip when `horizon` is
+/// `None`), exactly in the sense of the module docs. `n` is the inner rule's order, `tol` the
+/// absolute tolerance of the adaptive outer integral.
+#[allow(clippy::too_many_arguments)]
+pub fn exact<const K: usize>(
+    g: &Geometry,
+    img: &Image,
+    p: &Piece,
+    horizon: Option<DVec3>,
+    curve: Option<&HorizonCurve>,
+    n: usize,
+    tol: f64,
+    f: &mut impl FnMut(DVec3, DVec3, f64) -> [f64; K],
+) -> [f64; K] {
+    let (x0, x1, y0, y1) = (p.ax.x0, p.ax.x1, p.ay.x0, p.ay.x1);
+    let boundary = g.domain(p) == Domain::Boundary;
+    let disk = g.is_disk();
+    let h = |x: f64, y: f64| horizon.map_or(1.0, |m| m.dot(g.dir_jac(p.face, x, y).0));
+    let mut breaks = vec![x0, x1];
+    let to_x = |a: f64| 0.5 * g.w * (a + 1.0);
+    match (horizon, curve) {
+        (Some(_), Some(c)) => {
+            // Disk formats: where the horizon crosses the top/bottom edges, and where it turns.
+            let mut pts = Vec::new();
+            for ye in [y0, y1] {
+                c.crossings(1, 1.0 - 2.0 * ye / g.h, &mut pts);
+            }
+            breaks.extend(pts.iter().map(|p| to_x(p.x)));
+            breaks.extend(c.a_extrema().map(to_x));
+        }
+        (Some(_), None) => {
+            for ye in [y0, y1] {
+                sign_change_roots(&mut |x| h(x, ye), x0, x1, 16, &mut breaks);
+            }
+        }
+        _ => {}
+    }
+    if boundary {
+        // Where the rim crosses the piece's top and bottom edges, and the disk's left/right ends.
+        for ye in [y0, y1] {
+            let b = 1.0 - 2.0 * ye / g.h;
+            if b.abs() < 1.0 {
+                let a = (1.0 - b * b).sqrt();
+                breaks.extend([-a, a].map(|a| 0.5 * g.w * (a + 1.0)));
+            }
+        }
+        breaks.extend([0.0, g.w]);
+    }
+    breaks.retain(|&x| (x0..=x1).contains(&x));
+    breaks.sort_by(f64::total_cmp);
+    breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * g.w);
+    let ball = g.format == DomeFormat::MirroredBall;
+    let mut roots = Vec::with_capacity(8);
+    let mut inner = |x: f64| -> [f64; K] {
+        // The inner line's part inside the disk.
+        let (mut ylo, mut yhi) = (y0, y1);
+        if boundary {
+            let a = 2.0 * x / g.w - 1.0;
+            if a.abs() >= 1.0 {
+                return [0.0; K];
+            }
+            let bmax = (1.0 - a * a).sqrt();
+            let (ylo_d, yhi_d) = (0.5 * g.h * (1.0 - bmax), 0.5 * g.h * (1.0 + bmax));
+            ylo = ylo.max(ylo_d);
+            yhi = yhi.min(yhi_d);
+            if ylo >= yhi {
+                return [0.0; K];
+            }
+        }
+        roots.clear();
+        roots.push(ylo);
+        match (horizon, curve) {
+            (Some(_), Some(c)) => {
+                let start = roots.len();
+                let mut pts = Vec::new();
+                c.crossings(0, 2.0 * x / g.w - 1.0, &mut pts);
+                roots.extend(
+                    pts.iter()
+                        .map(|p| 0.5 * g.h * (1.0 - p.y))
+                        .filter(|&y| y > ylo && y < yhi),
+                );
+                roots[start..].sort_by(f64::total_cmp);
+            }
+            (Some(m), None) => inner_roots(g, p.face, m, x, ylo, yhi, &mut roots, disk),
+            _ => {}
+        }
+        roots.push(yhi);
+        let mut sum = [0.0; K];
+        for k in 0..roots.len() - 1 {
+            let (a, b) = (roots[k], roots[k + 1]);
+            if b <= a || h(x, 0.5 * (a + b)) <= 0.0 {
+                continue;
+            }
+            let v = if ball {
+                // b = B sin τ with B = √(1 − a²): the ball's √(1 − r²) = B cos τ is smooth in τ.
+                let bmax = (1.0 - (2.0 * x / g.w - 1.0).powi(2)).max(0.0).sqrt();
+                let tau = |y: f64| ((1.0 - 2.0 * y / g.h) / bmax).clamp(-1.0, 1.0).asin();
+                gl(n, tau(b), tau(a), |t| {
+                    let (st, ct) = t.sin_cos();
+                    let y = 0.5 * g.h * (1.0 - bmax * st);
+                    let (d, j) = g.dir_jac(p.face, x, y);
+                    f(d, texture_at(img, p, x, y), j).map(|c| c * 0.5 * g.h * bmax * ct)
+                })
+            } else {
+                gl(n, a, b, |y| {
+                    let (d, j) = g.dir_jac(p.face, x, y);
+                    f(d, texture_at(img, p, x, y), j)
+                })
+            };
+            for c in 0..K {
+                sum[c] += v[c];
+            }
+        }
+        sum
+    };
+    let mut total = [0.0; K];
+    for w in breaks.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b <= a {
+            continue;
+        }
+        let (v, _) = adaptive(n, 0.0, 1.0, tol, MAX_INTERVALS, &mut |u| {
+            let (x, dx) = substitute(a, b, u, disk, disk);
+            inner(x).map(|c| c * dx)
+        });
+        for c in 0..K {
+            total[c] += v[c];
+        }
+    }
+    total
+}
+
+/// `u ∈ [0, 1]` → `y ∈ [a, b]` and `dy/du`: linear, or the smoothstep `a + L(3u² − 2u³)` at the
+/// ends flagged singular (it turns `√(end − y)` behaviour into a polynomial in u).
+#[inline]
+fn substitute(a: f64, b: f64, u: f64, lo: bool, hi: bool) -> (f64, f64) {
+    let l = b - a;
+    match (lo, hi) {
+        (false, false) => (a + l * u, l),
+        (true, true) => (a + l * u * u * (3.0 - 2.0 * u), 6.0 * l * u * (1.0 - u)),
+        (true, false) => (a + l * u * u, 2.0 * l * u),
+        (false, true) => (a + l * (2.0 * u - u * u), 2.0 * l * (1.0 - u)),
+    }
+}
+
+/// Roots of `m·d(x, ·)` strictly inside `(ylo, yhi)`, appended in increasing order.
+#[allow(clippy::too_many_arguments)]
+fn inner_roots(
+    g: &Geometry,
+    face: u32,
+    m: DVec3,
+    x: f64,
+    ylo: f64,
+    yhi: f64,
+    out: &mut Vec<f64>,
+    disk: bool,
+) {
+    let start = out.len();
+    match g.format {
+        DomeFormat::LatLong => {
+            // m·d = m_y cos θ + c sin θ = R cos(θ − α), zero at θ = α ± π/2 (mod π).
+            let phi = PI - 2.0 * PI * x / g.w;
+            let c = m.x * phi.sin() + m.z * phi.cos();
+            if c == 0.0 && m.y == 0.0 {
+                return;
+            }
+            let alpha = c.atan2(m.y);
+            for th in [alpha - 0.5 * PI, alpha + 0.5 * PI, alpha + 1.5 * PI] {
+                let y = th * g.h / PI;
+                if y > ylo && y < yhi {
+                    out.push(y);
+                }
+            }
+        }
+        DomeFormat::Cross => {
+            // m·(F + aR + bU) = 0 is a line in the face's (a, b).
+            let (f, r, u, blk) = dome::cross_basis(face);
+            let a = 2.0 * (x - blk.x * g.n) / g.n - 1.0;
+            let mu = m.dot(u);
+            if mu != 0.0 {
+                let b = -(m.dot(f) + a * m.dot(r)) / mu;
+                let y = blk.y * g.n + 0.5 * g.n * (1.0 - b);
+                if y > ylo && y < yhi {
+                    out.push(y);
+                }
+            }
+        }
+        _ => {
+            debug_assert!(disk);
+            let mut found = Vec::with_capacity(4);
+            sign_change_roots(
+                &mut |y| m.dot(g.dir_jac(face, x, y).0),
+                ylo,
+                yhi,
+                8,
+                &mut found,
+            );
+            out.extend(found.into_iter().filter(|&y| y > ylo && y < yhi));
+        }
+    }
+    out[start..].sort_by(f64::total_cmp);
+}
+
+/// A receiver's horizon great circle `m·d = 0` drawn on a disk image (§6 D3/D4, "bisected" in
+/// DESIGN.md's words): `γ ↦ (a, b)` of `d(γ) = cos γ·e₁ + sin γ·e₂`, sampled adaptively (image
+/// steps ≤ 0.01), cut at the extrema of `a` and of `b` (refined by golden-section search) into
+/// monotone segments, on which `a(γ) = a₀` or `b(γ) = b₀` has exactly one solution (regula falsi).
+/// This finds every root of the horizon on an inner line and every point where it turns (a
+/// vertical tangent) or crosses a piece edge, which sampling alone could miss.
+pub struct HorizonCurve {
+    format: DomeFormat,
+    e1: DVec3,
+    e2: DVec3,
+    /// Per coordinate (a, b): monotone segments (γ₀, γ₁, v₀, v₁), γ₁ > γ₀.
+    segments: [Vec<(f64, f64, f64, f64)>; 2],
+}
+
+impl HorizonCurve {
+    pub fn new(format: DomeFormat, m: DVec3) -> HorizonCurve {
+        let mh = m.normalize();
+        let e1 = mh.any_orthonormal_vector();
+        let e2 = mh.cross(e1);
+        let mut c = HorizonCurve {
+            format,
+            e1,
+            e2,
+            segments: [vec![], vec![]],
+        };
+        let tau = std::f64::consts::TAU;
+        let mut g: Vec<f64> = (0..=512).map(|k| tau * k as f64 / 512.0).collect();
+        let mut k = 0;
+        while k + 1 < g.len() {
+            let (g0, g1) = (g[k], g[k + 1]);
+            if (c.point(g1) - c.point(g0)).length() > 0.01 && g1 - g0 > 1e-12 && g.len() < 1 << 16 {
+                g.insert(k + 1, 0.5 * (g0 + g1));
+            } else {
+                k += 1;
+            }
+        }
+        let pts: Vec<DVec2> = g.iter().map(|&x| c.point(x)).collect();
+        for axis in 0..2 {
+            let v = |i: usize| pts[i % (pts.len() - 1)][axis];
+            let n = pts.len() - 1;
+            let mut ext = vec![];
+            for i in 0..n {
+                let (prev, cur, next) = (v(i + n - 1), v(i), v(i + 1));
+                if (cur - prev) * (next - cur) < 0.0 || (cur == prev && next != cur) {
+                    let lo = if i == 0 { g[n - 1] - tau } else { g[i - 1] };
+                    ext.push(c.extremum(axis, lo, g[i + 1], next < cur));
+                }
+            }
+            ext.sort_by(f64::total_cmp);
+            if ext.len() >= 2 {
+                let first = ext[0];
+                ext.push(first + tau);
+                c.segments[axis] = ext
+                    .windows(2)
+                    .map(|w| (w[0], w[1], c.point(w[0])[axis], c.point(w[1])[axis]))
+                    .collect();
+            }
+        }
+        c
+    }
+
+    /// Image point (a, b) of the horizon at γ.
+    pub fn point(&self, g: f64) -> DVec2 {
+        let d = g.cos() * self.e1 + g.sin() * self.e2;
+        let st = if self.format == DomeFormat::MirroredBall {
+            dome::mirrored_ball_st(d)
+        } else {
+            dome::angular_st(d)
+        };
+        DVec2::new(2.0 * st.x - 1.0, 1.0 - 2.0 * st.y)
+    }
+
+    /// Golden-section search for the maximum (or minimum) of coordinate `axis` on `[lo, hi]`.
+    fn extremum(&self, axis: usize, mut lo: f64, mut hi: f64, max: bool) -> f64 {
+        let f = |g: f64| {
+            if max {
+                self.point(g)[axis]
+            } else {
+                -self.point(g)[axis]
+            }
+        };
+        let r = 0.5 * (5f64.sqrt() - 1.0);
+        let (mut x1, mut x2) = (hi - r * (hi - lo), lo + r * (hi - lo));
+        let (mut f1, mut f2) = (f(x1), f(x2));
+        for _ in 0..80 {
+            if hi - lo < 1e-15 {
+                break;
+            }
+            if f1 < f2 {
+                lo = x1;
+                (x1, f1) = (x2, f2);
+                x2 = lo + r * (hi - lo);
+                f2 = f(x2);
+            } else {
+                hi = x2;
+                (x2, f2) = (x1, f1);
+                x1 = hi - r * (hi - lo);
+                f1 = f(x1);
+            }
+        }
+        0.5 * (lo + hi)
+    }
+
+    /// Every horizon point whose coordinate `axis` equals `v`, appended as (a, b).
+    pub fn crossings(&self, axis: usize, v: f64, out: &mut Vec<DVec2>) {
+        for &(g0, g1, v0, v1) in &self.segments[axis] {
+            if (v0 - v) * (v1 - v) < 0.0 {
+                let g = super::quadrature::illinois(
+                    &mut |g| self.point(g)[axis] - v,
+                    g0,
+                    g1,
+                    v0 - v,
+                    v1 - v,
+                );
+                out.push(self.point(g));
+            }
+        }
+    }
+
+    /// The `a` values where the curve turns (vertical tangents in the image).
+    pub fn a_extrema(&self) -> impl Iterator<Item = f64> + '_ {
+        self.segments[0].iter().map(|s| s.2)
+    }
+}
