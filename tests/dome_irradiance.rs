@@ -177,3 +177,26 @@ fn known_textures_agree_with_a_brute_force_over_the_hemisphere() {
     }
     eprintln!("brute force (400 × 800 midpoint cells): worst relative difference {worst:.2e}");
 }
+
+/// The CPU evaluator gives the reference's irradiance of a textured dome (rounded to f32); the
+/// GPU path still refuses it (tests/dome_conformance.rs).
+#[test]
+fn the_cpu_evaluator_gives_the_exact_irradiance() {
+    let file = png(16, 8, |x, y| [(16 * x) as u8, (30 * y) as u8, 200]);
+    let l = Light::dome()
+        .with_path("/Tex")
+        .with_intensity(1.5)
+        .with_texture(Texture::new(file));
+    let r = Reference::new(&l, TemperatureMode::Spec).unwrap();
+    let ns = normals();
+    let normals32: Vec<[f32; 3]> = ns.iter().map(|n| n.as_vec3().to_array()).collect();
+    let points = vec![[0.0f32; 3]; ns.len()];
+    let out = luxeval::Evaluator::cpu()
+        .irradiance(&[l], &points, &normals32, luxeval::Accumulate::Sum)
+        .unwrap();
+    for (n, v) in normals32.iter().zip(out) {
+        let n = DVec3::from_array(n.map(f64::from));
+        let e = r.irradiance(DVec3::ZERO, n);
+        assert_eq!(v, e.as_vec3().to_array(), "n {n}");
+    }
+}

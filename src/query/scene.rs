@@ -128,13 +128,15 @@ impl PreparedScene {
         acc: Accumulate,
     ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", normals, "normals")?;
-        if let Some((p, t)) = textured(&self.lights) {
+        // The CPU reference integrates a textured dome's filtered texture exactly
+        // (src/cpu/irradiance/dome.rs); the GPU kernel does not yet.
+        if let (Backend::Gpu(_), Some((p, t))) = (&self.backend, textured(&self.lights)) {
             return Err(LuxError::attr(
                 &p.light.path,
                 "inputs:texture:file",
                 &t.file.authored,
                 "the irradiance of a textured dome (the exact integral of its filtered \
-                 texture, DESIGN.md §6) is not evaluated yet",
+                 texture, DESIGN.md §6) is not evaluated on the GPU yet; use --device cpu",
             ));
         }
         let per_light = acc == Accumulate::PerLight;
