@@ -65,6 +65,8 @@ pub use gpu::{AdapterSummary, DeviceLimits, adapters};
 pub use limits::Limits;
 pub use model::{Asset, Ies, Input, Light, LightInputs, LightType, Shaping, UpAxis, Value, schema};
 pub use prepare::TemperatureMode;
+#[cfg(feature = "usd")]
+pub use query::lights_json;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
 #[cfg(feature = "usd")]
 pub use usd::{Scene, SceneLight, Stage, StageInfo, TimeRule};
