@@ -68,6 +68,8 @@ pub use model::{
     UpAxis, Value, schema,
 };
 pub use prepare::TemperatureMode;
+#[cfg(feature = "usd")]
+pub use query::lights_json;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
 #[cfg(feature = "usd")]
 pub use usd::{Scene, SceneLight, Stage, StageInfo, TimeRule};

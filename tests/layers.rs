@@ -19,7 +19,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("gpu", &["error", "model", "prepare", "rules", "gpu"]),
     (
         "query",
-        &["error", "model", "prepare", "cpu", "gpu", "query"],
+        // `usd` only for the light records of a stage (query/lights.rs, feature `usd`).
+        &["error", "model", "usd", "prepare", "cpu", "gpu", "query"],
     ),
     ("io", &["error", "limits", "io"]),
     ("ies", &["assets", "prepare", "cpu", "plot", "ies"]),

@@ -151,7 +151,7 @@ fn parse_lights(lights: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
 /// `Stage(path, time)`'s arguments, as pickling records them.
 type StageArgs = (String, Option<f64>);
 
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 enum Query {
     Emission,
     Radiance,
@@ -232,13 +232,13 @@ impl Stage {
             None => None,
         };
         let a_rows = arrays::as_vec3(&a_arr)?;
-        let b_rows = match &b_arr {
-            Some(b) => Some(arrays::as_vec3(b)?),
-            None => None,
+        // Radiance and irradiance pair every row of `a` with one of `b` (a missing `b` counts
+        // as an empty array and is refused here).
+        let b_rows: &[[f32; 3]] = match &b_arr {
+            Some(b) => arrays::as_vec3(b)?,
+            None => &[],
         };
-        if let Some(b_rows) = b_rows
-            && b_rows.len() != a_rows.len()
-        {
+        if q != Query::Emission && b_rows.len() != a_rows.len() {
             return Err(errors::input(format!(
                 "{a_name}/{b_name}: {} {a_name} but {} {b_name}; they pair up row by row",
                 a_rows.len(),
@@ -273,8 +273,8 @@ impl Stage {
                     let a = &a_rows[start..end];
                     let rows = match q {
                         Query::Emission => scene.emission(a, acc),
-                        Query::Radiance => scene.radiance(a, &b_rows.unwrap()[start..end], acc),
-                        Query::Irradiance => scene.irradiance(a, &b_rows.unwrap()[start..end], acc),
+                        Query::Radiance => scene.radiance(a, &b_rows[start..end], acc),
+                        Query::Irradiance => scene.irradiance(a, &b_rows[start..end], acc),
                     }
                     .map_err(|e| errors::lux(e, Some(file)))?;
                     let m = end - start;
@@ -375,7 +375,8 @@ impl Stage {
         let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
         let scene =
             py.detach(|| no_panic(|| Scene::load(&path, time).map_err(|e| errors::lux(e, None))))?;
-        let lights_json = lights_json(&scene)
+        let lights_json = luxeval::lights_json(&scene)
+            .map(|v| v.to_string())
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
         Ok(Stage {
             path,
@@ -663,27 +664,4 @@ impl Stage {
             evaluated
         )
     }
-}
-
-/// `scene.lights` exactly as `luxeval lights --json` writes them: each record with its total
-/// `power` (`Reference::power`; null for lights at infinity or not evaluated) and, when the light
-/// cannot be prepared, `power_error`.
-fn lights_json(scene: &Scene) -> serde_json::Result<String> {
-    let mut v = serde_json::to_value(&scene.lights)?;
-    if let Some(records) = v.as_array_mut() {
-        for (json, l) in records.iter_mut().zip(&scene.lights) {
-            let Some(light) = &l.light else {
-                json["power"] = serde_json::Value::Null;
-                continue;
-            };
-            match luxeval::Reference::new(light, luxeval::TemperatureMode::default()) {
-                Ok(r) => json["power"] = serde_json::json!(r.power()),
-                Err(e) => {
-                    json["power"] = serde_json::Value::Null;
-                    json["power_error"] = e.to_string().into();
-                }
-            }
-        }
-    }
-    serde_json::to_string(&v)
 }

@@ -8,7 +8,6 @@ use std::path::Path;
 use super::viridis::VIRIDIS;
 use super::{Map, Plane};
 use crate::error::{LuxError, Result};
-use crate::io::write_atomic;
 use crate::plot::font;
 
 /// How values map to colours.
@@ -362,27 +361,13 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
 
 /// Writes a rendered image as an 8-bit sRGB PNG, atomically.
 pub fn write(path: &Path, r: &Rendered) -> Result<()> {
-    write_atomic(path, |w| {
-        let mut enc = ::png::Encoder::new(w, r.width, r.height);
-        enc.set_color(::png::ColorType::Rgb);
-        enc.set_depth(::png::BitDepth::Eight);
-        enc.set_source_srgb(::png::SrgbRenderingIntent::Perceptual);
-        enc.add_text_chunk(
-            "Software".into(),
-            concat!("luxeval ", env!("CARGO_PKG_VERSION")).into(),
-        )
-        .map_err(std::io::Error::other)?;
-        enc.add_text_chunk(
-            "Comment".into(),
-            format!("irradiance colour bar {} to {} lux", r.range.0, r.range.1),
-        )
-        .map_err(std::io::Error::other)?;
-        let mut writer = enc.write_header().map_err(std::io::Error::other)?;
-        writer
-            .write_image_data(&r.rgb)
-            .map_err(std::io::Error::other)?;
-        writer.finish().map_err(std::io::Error::other)
-    })
+    crate::plot::write_rgb_png(
+        path,
+        r.width,
+        r.height,
+        &r.rgb,
+        &format!("irradiance colour bar {} to {} lux", r.range.0, r.range.1),
+    )
 }
 
 #[cfg(test)]

@@ -95,25 +95,37 @@ impl Canvas {
 
     /// Writes the canvas as an 8-bit sRGB PNG with a text comment, atomically.
     pub fn write_png(&self, path: &Path, comment: &str) -> Result<()> {
-        write_atomic(path, |w| {
-            let mut enc = ::png::Encoder::new(w, self.width, self.height);
-            enc.set_color(::png::ColorType::Rgb);
-            enc.set_depth(::png::BitDepth::Eight);
-            enc.set_source_srgb(::png::SrgbRenderingIntent::Perceptual);
-            enc.add_text_chunk(
-                "Software".into(),
-                concat!("luxeval ", env!("CARGO_PKG_VERSION")).into(),
-            )
-            .map_err(std::io::Error::other)?;
-            enc.add_text_chunk("Comment".into(), comment.into())
-                .map_err(std::io::Error::other)?;
-            let mut writer = enc.write_header().map_err(std::io::Error::other)?;
-            writer
-                .write_image_data(&self.rgb)
-                .map_err(std::io::Error::other)?;
-            writer.finish().map_err(std::io::Error::other)
-        })
+        write_rgb_png(path, self.width, self.height, &self.rgb, comment)
     }
+}
+
+/// Writes `rgb` (RGB8, row-major from the top, `width × height`) as an 8-bit sRGB PNG with the
+/// luxeval version and `comment` as text chunks, atomically (never a partial file).
+pub fn write_rgb_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    rgb: &[u8],
+    comment: &str,
+) -> Result<()> {
+    write_atomic(path, |w| {
+        let mut enc = ::png::Encoder::new(w, width, height);
+        enc.set_color(::png::ColorType::Rgb);
+        enc.set_depth(::png::BitDepth::Eight);
+        enc.set_source_srgb(::png::SrgbRenderingIntent::Perceptual);
+        enc.add_text_chunk(
+            "Software".into(),
+            concat!("luxeval ", env!("CARGO_PKG_VERSION")).into(),
+        )
+        .map_err(std::io::Error::other)?;
+        enc.add_text_chunk("Comment".into(), comment.into())
+            .map_err(std::io::Error::other)?;
+        let mut writer = enc.write_header().map_err(std::io::Error::other)?;
+        writer
+            .write_image_data(rgb)
+            .map_err(std::io::Error::other)?;
+        writer.finish().map_err(std::io::Error::other)
+    })
 }
 
 /// A "nice" step (1, 2 or 5 times a power of ten) for about `n` divisions of `[0, max]`.

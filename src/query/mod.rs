@@ -12,6 +12,10 @@ use crate::error::{LuxError, Result};
 use crate::gpu::{AdapterSummary, DeviceLimits, GpuContext};
 use crate::model::Light;
 use crate::prepare::TemperatureMode;
+#[cfg(feature = "usd")]
+mod lights;
+#[cfg(feature = "usd")]
+pub use lights::lights_json;
 pub use reference::{Power, Reference};
 pub use scene::PreparedScene;
 
