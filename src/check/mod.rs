@@ -215,10 +215,10 @@ pub fn check_with(
                 Some(dirs[i]),
             )
         }));
-        // Irradiance: the CPU values (quadratures) are computed in parallel. Not for
-        // IES-shaped lights: the GPU path takes their irradiance from the CPU reference
-        // (PreparedScene::irradiance), so there is nothing to compare.
-        let ni = if p.ies.is_some() {
+        // Irradiance: the CPU values (quadratures) are computed in parallel. Not for the lights
+        // whose irradiance the GPU path takes from the CPU reference (IES-shaped lights,
+        // textured domes: query::irradiance_on_host), so there is nothing to compare.
+        let ni = if crate::query::irradiance_on_host(p) {
             0
         } else {
             counts.irradiance

@@ -22,9 +22,12 @@ pub mod roots;
 pub mod shapes;
 pub mod shaping;
 
+use std::collections::HashMap;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
+use crate::model::LightType;
 use crate::prepare::Prepared;
 
 /// Converts an f32 triple to f64.
@@ -39,28 +42,26 @@ fn unit(v: [f32; 3]) -> Option<DVec3> {
     (len > 0.0 && len.is_finite()).then(|| d / len)
 }
 
-/// Evaluates `f(light, sample)` for every light and sample: the sum over lights per sample, or,
-/// with `per_light`, one row per (light, sample) in light-major order.
-pub(crate) fn batch<F>(lights: &[Prepared], n: usize, per_light: bool, f: F) -> Vec<DVec3>
+/// Evaluates `f(light index, sample)` for every light and sample: the sum over lights per
+/// sample, or, with `per_light`, one row per (light, sample) in light-major order.
+pub(crate) fn batch<F>(lights: usize, n: usize, per_light: bool, f: F) -> Vec<DVec3>
 where
-    F: Fn(&Prepared, usize) -> DVec3 + Sync,
+    F: Fn(usize, usize) -> DVec3 + Sync,
 {
     if per_light {
-        let mut out = vec![DVec3::ZERO; lights.len() * n];
+        let mut out = vec![DVec3::ZERO; lights * n];
         if n > 0 {
-            out.par_chunks_mut(n)
-                .zip(lights.par_iter())
-                .for_each(|(rows, light)| {
-                    rows.par_iter_mut()
-                        .enumerate()
-                        .for_each(|(i, o)| *o = f(light, i))
-                });
+            out.par_chunks_mut(n).enumerate().for_each(|(k, rows)| {
+                rows.par_iter_mut()
+                    .enumerate()
+                    .for_each(|(i, o)| *o = f(k, i))
+            });
         }
         out
     } else {
         (0..n)
             .into_par_iter()
-            .map(|i| lights.iter().map(|l| f(l, i)).sum())
+            .map(|i| (0..lights).map(|k| f(k, i)).sum())
             .collect()
     }
 }
@@ -68,15 +69,15 @@ where
 /// emission(light, ω) for every light and direction (see [`emission::emission`]); directions
 /// are normalised here (the caller rejects zero and non-finite rows).
 pub fn emission_batch(lights: &[Prepared], dirs: &[[f32; 3]], per_light: bool) -> Vec<DVec3> {
-    batch(lights, dirs.len(), per_light, |l, i| {
-        emission::emission(l, dvec(dirs[i]).normalize())
+    batch(lights.len(), dirs.len(), per_light, |k, i| {
+        emission::emission(&lights[k], dvec(dirs[i]).normalize())
     })
 }
 
 /// intensity(light, ω) for every light and direction (see [`intensity::intensity`]).
 pub fn intensity_batch(lights: &[Prepared], dirs: &[[f32; 3]], per_light: bool) -> Vec<DVec3> {
-    batch(lights, dirs.len(), per_light, |l, i| {
-        intensity::intensity(l, dvec(dirs[i]).normalize())
+    batch(lights.len(), dirs.len(), per_light, |k, i| {
+        intensity::intensity(&lights[k], dvec(dirs[i]).normalize())
     })
 }
 
@@ -87,8 +88,8 @@ pub fn radiance_batch(
     dirs: &[[f32; 3]],
     per_light: bool,
 ) -> Vec<DVec3> {
-    batch(lights, dirs.len(), per_light, |l, i| {
-        radiance::radiance(l, dvec(points[i]), dvec(dirs[i]).normalize())
+    batch(lights.len(), dirs.len(), per_light, |k, i| {
+        radiance::radiance(&lights[k], dvec(points[i]), dvec(dirs[i]).normalize())
     })
 }
 
@@ -100,10 +101,39 @@ pub fn irradiance_batch(
     normals: &[[f32; 3]],
     per_light: bool,
 ) -> Vec<DVec3> {
-    batch(lights, points.len(), per_light, |l, i| {
+    let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
+        .iter()
+        .map(|l| {
+            (matches!(l.light.kind, LightType::Dome) && l.texture.is_some())
+                .then(|| dome_by_normal(l, normals))
+        })
+        .collect();
+    batch(lights.len(), points.len(), per_light, |k, i| {
+        if let Some(values) = &by_normal[k] {
+            return values[&normals[i].map(f32::to_bits)];
+        }
         match unit(normals[i]) {
-            Some(n) => irradiance::irradiance(l, dvec(points[i]), n),
+            Some(n) => irradiance::irradiance(&lights[k], dvec(points[i]), n),
             None => DVec3::ZERO,
         }
     })
+}
+
+/// A textured dome's irradiance for each distinct normal among `normals` (keyed by their bits).
+/// A dome lies at infinity, so its irradiance depends on the normal alone (DESIGN.md §2), and
+/// its exact integral (irradiance/dome.rs) costs far more than a lookup: a falloff map, whose
+/// receivers share one normal, needs one evaluation instead of one per pixel.
+fn dome_by_normal(light: &Prepared, normals: &[[f32; 3]]) -> HashMap<[u32; 3], DVec3> {
+    let mut keys: Vec<[u32; 3]> = normals.iter().map(|n| n.map(f32::to_bits)).collect();
+    keys.sort_unstable();
+    keys.dedup();
+    keys.into_par_iter()
+        .map(|key| {
+            let e = match unit(key.map(f32::from_bits)) {
+                Some(n) => irradiance::irradiance(light, DVec3::ZERO, n),
+                None => DVec3::ZERO,
+            };
+            (key, e)
+        })
+        .collect()
 }

@@ -167,12 +167,12 @@ impl GpuContext {
         if n == 0 || count == 0 {
             return Ok(out);
         }
-        // The irradiance kernel integrates no IES-shaped light (the host does, see
-        // PreparedScene::irradiance), so it never needs the lookup.
+        // The irradiance kernel integrates no IES-shaped light or textured dome (the host does,
+        // see query::irradiance_on_host), so it never needs either lookup.
         let pipeline = self.pipeline(
             kernel,
             lights.has_ies && kernel != Kernel::Irradiance,
-            lights.has_dome,
+            lights.has_dome && kernel != Kernel::Irradiance,
         )?;
         let capacity = self.chunk_capacity(count, per_light);
         let per_group = self.lights_per_dispatch(kernel).max(1);

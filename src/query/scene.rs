@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::error::{LuxError, Result};
 use crate::gpu::{GpuLights, Kernel, Scratch, dome_atlas, ies_atlas, record};
-use crate::model::{Light, Texture};
+use crate::model::{Light, LightType};
 use crate::prepare::{self, Prepared, TemperatureMode};
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
@@ -128,33 +128,19 @@ impl PreparedScene {
         acc: Accumulate,
     ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", normals, "normals")?;
-        // The CPU reference integrates a textured dome's filtered texture exactly
-        // (src/cpu/irradiance/dome.rs); the GPU kernel does not yet.
-        if let (Backend::Gpu(_), Some((p, t))) = (&self.backend, textured(&self.lights)) {
-            return Err(LuxError::attr(
-                &p.light.path,
-                "inputs:texture:file",
-                &t.file.authored,
-                "the irradiance of a textured dome (the exact integral of its filtered \
-                 texture, DESIGN.md §6) is not evaluated on the GPU yet; use --device cpu",
-            ));
-        }
         let per_light = acc == Accumulate::PerLight;
         let mut out = self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
             cpu::irradiance_batch(&self.lights, points, normals, per_light)
         })?;
         if matches!(self.backend, Backend::Gpu(_)) {
-            self.add_ies_irradiance_on_host(points, normals, per_light, &mut out);
+            self.add_host_irradiance(points, normals, per_light, &mut out);
         }
         Ok(out)
     }
 
-    /// The GPU irradiance kernel gives 0 for IES-shaped lights (see the header of
-    /// shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here. The f32
-    /// quadrature does not split at a profile's angle nodes as the reference does, and misses
-    /// features narrower than its nodes (measured: up to 100 % on receivers that see a thin
-    /// lit band of a striped profile); until it does, the exact value is the only one given.
-    fn add_ies_irradiance_on_host(
+    /// The GPU irradiance kernel gives 0 for the lights [`irradiance_on_host`] names (see the
+    /// header of shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here.
+    fn add_host_irradiance(
         &self,
         points: &[[f32; 3]],
         normals: &[[f32; 3]],
@@ -163,7 +149,7 @@ impl PreparedScene {
     ) {
         let n = points.len();
         for (k, light) in self.lights.iter().enumerate() {
-            if light.ies.is_none() {
+            if !irradiance_on_host(light) {
                 continue;
             }
             let values = cpu::irradiance_batch(std::slice::from_ref(light), points, normals, true);
@@ -220,11 +206,17 @@ impl PreparedScene {
     }
 }
 
-/// The first light with a texture, and its texture.
-fn textured(lights: &[Prepared]) -> Option<(&Prepared, &Texture)> {
-    lights
-        .iter()
-        .find_map(|p| p.light.texture.as_ref().map(|t| (p, t)))
+/// Whether the GPU path takes this light's irradiance from the CPU reference, until the f32
+/// quadrature can match it:
+/// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as the
+///   reference's line integrals do, and misses lit features narrower than its nodes (measured: up
+///   to 100 % on receivers that see a thin lit band of a striped profile).
+/// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
+///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a dome's
+///   irradiance depends on the normal only, so the reference evaluates it once per distinct
+///   normal (one for a whole falloff map).
+pub(crate) fn irradiance_on_host(p: &Prepared) -> bool {
+    p.ies.is_some() || (matches!(p.light.kind, LightType::Dome) && p.texture.is_some())
 }
 
 /// Rows scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The

@@ -490,12 +490,11 @@ fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, String>
     Ok(Some(t))
 }
 
-/// Whether the queries evaluate this light's texture yet (issue 9 lands in steps). Dome
-/// textures are evaluated by the CPU reference's emission and radiance (lights built in code,
-/// `Light::with_texture`), but not yet by irradiance (and so falloff) or the GPU, which refuse
-/// them: a stage's textured lights stay listed as skipped, with this warning, until they do.
-fn texture_is_evaluated(_kind: &LightType, _texture: &Texture) -> bool {
-    false
+/// Whether the queries evaluate this light's texture yet: dome textures are evaluated by every
+/// query on both paths (the GPU path takes a textured dome's irradiance from the CPU reference);
+/// RectLight textures are not yet, and such a light stays listed as skipped, with the warning.
+fn texture_is_evaluated(kind: &LightType, _texture: &Texture) -> bool {
+    matches!(kind, LightType::Dome)
 }
 
 #[cfg(test)]
