@@ -1,7 +1,8 @@
 //! CPU (f64) vs GPU (f32) conformance of textured domes (DESIGN.md §6 D1–D6, §5): generated
 //! textures of every format (latlong, mirroredBall, angular, cubeMapVerticalCross) at several
 //! sizes, both filters, plain DomeLight and DomeLight_1 with poleAxis Y and Z, with and without
-//! a rotated transform; emission and radiance within a relative 1e-4 per channel.
+//! a rotated transform; emission and radiance within a relative 1e-4 per channel. Irradiance:
+//! the GPU path gives the reference's value (see the last test).
 //!
 //! Excluded directions (documented divergence 1 of shaders/shared/dome.wgsl): with the nearest
 //! filter, those within 1e-3 px of a texel edge (f32 pixel coordinates carry ~W·2⁻²⁴ px of
@@ -172,20 +173,48 @@ fn untextured_domes_are_unchanged_beside_textured_ones() {
     }
 }
 
-/// Irradiance of a textured dome stays refused on the GPU path (issue 9: the CPU reference has it).
+/// The GPU path takes a textured dome's irradiance from the CPU reference (query's
+/// `irradiance_on_host`): exactly the reference's value rounded to f32, summed with the kernel's
+/// value for the other lights (here an untextured dome, π · its radiance, and a sphere light
+/// whose irradiance the kernel computes), and per light in light-major order.
 #[test]
-fn gpu_irradiance_of_a_textured_dome_is_refused() {
+fn gpu_irradiance_of_a_textured_dome_is_the_reference() {
     let Some(gpu) = common::gpu() else { return };
     let mut rng = Rng::new(8);
-    let l = Light::dome()
+    let tex = Light::dome()
         .with_path("/Tex")
-        .with_texture(Texture::new(png(8, 4, &mut rng)));
-    let e = gpu
-        .irradiance(&[l], &[[0.0; 3]], &[[0.0, 0.0, 1.0]], Accumulate::Sum)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("/Tex") && e.contains("not evaluated on the GPU yet"),
-        "{e}"
-    );
+        .with_texture(Texture::new(png(8, 4, &mut rng)).with_format(TextureFormat::LatLong));
+    let plain = Light::dome().with_path("/Plain").with_intensity(0.5);
+    let normals: Vec<[f32; 3]> = (0..40).map(|_| unit(&mut rng)).collect();
+    // Some receivers share a normal (the host evaluates a dome once per distinct normal).
+    let normals: Vec<[f32; 3]> = normals.iter().chain(&normals[..10]).copied().collect();
+    let points: Vec<[f32; 3]> = (0..normals.len())
+        .map(|i| [i as f32, -(i as f32), 3.0])
+        .collect();
+    let lights = vec![tex.clone(), plain];
+    let cpu = Evaluator::cpu();
+    let want = cpu
+        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let got = gpu
+        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let n = normals.len();
+    // The textured dome's rows are the reference's, bit for bit.
+    assert_eq!(&got[..n], &want[..n]);
+    for i in 0..n {
+        assert!(rel(got[n + i], want[n + i]) < TOL, "{i}: {:?} {:?}", got[n + i], want[n + i]);
+        // A dome's irradiance depends on the normal only.
+        if i >= 40 {
+            assert_eq!(got[i], got[i - 40]);
+        }
+    }
+    let sum = gpu
+        .irradiance(&lights, &points, &normals, Accumulate::Sum)
+        .unwrap();
+    for i in 0..n {
+        let expect = [0, 1, 2].map(|c| want[i][c] + want[n + i][c]);
+        assert!(rel(sum[i], expect) < TOL, "{i}: {:?} {:?}", sum[i], expect);
+    }
+    assert!(got[..n].iter().any(|v| v[0] > 0.0));
 }

@@ -47,6 +47,9 @@ LUXTEST_FILES = {
     "test_vstripes_hquadrants_nonuniform.ies": "66582367293165edfc53a68ca8a486adc8ed06cd257533d91cd2e1d350dba981",
     "test_vstripes_hquadrants_nonuniform_aimDown.ies": "b4f238da7f9ddbfea22bc69b2fbb8bdc3a2daf2b2d920a2bbc7209bc6f04e648",
     "test_vstripes_hquadrants_nonuniform_aimUp.ies": "d8079b1a8874229746da49e3a229505e8869355ae91e65d242b2fb17900dd3ba",
+    # The luxtest dome (and visibleRect) texture: 2048 × 1024 half RGB, ZIPS. Not in
+    # research/data (too big for it): pass a luxtest checkout as --luxtest-src.
+    "dome_grid_2k.exr": "ec953653188832c800b560a301eac86811d491b87e49a43c1c19ff952e16efb6",
     "usd/rect.usda": "d0fc8c543b93bd8f021e329181006d86ac9de7e4ac8db201f06964acf91d995a",
     "usd/sphere.usda": "25f00c53306a2f28ba62fd4916ebf7b733320e6bb6bb2b3f83bdb12ee4776269",
     "usd/disk.usda": "f67f08d24de4b6efb9895e4c32e59f60c961e11c3b5295fcab931d4baf8552a2",
@@ -71,9 +74,11 @@ tools/gen_usd_fixtures.py, which checks every file's sha256.
 - `usd/*.usda`, `usd/shapes/sphere50x50.usda`: the light test scenes.
 - `test_*.ies`: the synthetic IES profiles the scenes reference as `../test_*.ies`. They have CRLF
   line endings on purpose (LM-63); `.gitattributes` keeps git from normalising them.
+- `dome_grid_2k.exr`: the texture of the dome and visibleRect scenes (`../dome_grid_2k.exr`),
+  2048 × 1024 half RGB, ZIPS (origin: anderslanglands/light_comparison, same author).
 
-Not copied (the scenes reference them, so they resolve to nothing here): `../bega_omni002_4777lm.ies`,
-`../04f377f94ce81cd7b5101fffdf571454.ies` (BEGA photometry, CC BY-ND 4.0) and `../dome_grid_2k.exr`.
+Not copied (the scenes reference them, so they resolve to nothing here): `../bega_omni002_4777lm.ies`
+and `../04f377f94ce81cd7b5101fffdf571454.ies` (BEGA photometry, CC BY-ND 4.0).
 """
 
 LIGHT_TYPES = {
