@@ -203,7 +203,12 @@ fn gpu_irradiance_of_a_textured_dome_is_the_reference() {
     // The textured dome's rows are the reference's, bit for bit.
     assert_eq!(&got[..n], &want[..n]);
     for i in 0..n {
-        assert!(rel(got[n + i], want[n + i]) < TOL, "{i}: {:?} {:?}", got[n + i], want[n + i]);
+        assert!(
+            rel(got[n + i], want[n + i]) < TOL,
+            "{i}: {:?} {:?}",
+            got[n + i],
+            want[n + i]
+        );
         // A dome's irradiance depends on the normal only.
         if i >= 40 {
             assert_eq!(got[i], got[i - 40]);

@@ -291,6 +291,19 @@ fn usda_usdc_usdz_are_identical() {
                 let ies = lz.light.as_mut().unwrap().shaping.as_mut().unwrap();
                 ies.ies.as_mut().unwrap().file.resolved = Some(ra);
             }
+            // And the light's texture (texture:file).
+            let texture_of = |l: &luxeval::SceneLight| {
+                l.light
+                    .as_ref()
+                    .and_then(|l| l.texture.as_ref())
+                    .and_then(|t| t.file.resolved.clone())
+            };
+            if let (Some(ra), Some(rz)) = (texture_of(la), texture_of(&lz)) {
+                let inner = ra.strip_prefix(&format!("{}/", dir.display())).unwrap();
+                assert_eq!(rz, format!("{}[{inner}]", dir.join("scene.usdz").display()));
+                let t = lz.light.as_mut().unwrap().texture.as_mut().unwrap();
+                t.file.resolved = Some(ra);
+            }
             assert_eq!(*la, lz, "usda vs usdz at {time:?}");
         }
         assert!(assets_checked >= 4, "{assets_checked}");
@@ -414,7 +427,6 @@ fn scene_lights_and_warnings() {
         "/World/Defaults/Portal",
         "/World/Defaults/MeshLight",
         "/World/Shaped/Textured",
-        "/World/Env/Sky",
     ] {
         assert!(!paths.contains(&skipped), "{skipped} evaluated");
         assert!(
@@ -438,8 +450,18 @@ fn scene_lights_and_warnings() {
             .as_deref()
             .is_some_and(|r| r.ends_with("ies/spot.ies"))
     );
+    // The textured dome is evaluated, with its texture resolved beside its layer.
+    let sky = get("/World/Env/Sky").light.clone().unwrap();
+    let sky = sky.texture.expect("texture:file read");
+    assert!(
+        sky.file
+            .resolved
+            .as_deref()
+            .is_some_and(|r| r.ends_with("env/sky.png"))
+    );
     for kept in [
         "/World/Shaped/Ies",
+        "/World/Env/Sky",
         "/World/Env/Uniform",
         "/World/Untyped/UnderUntyped",
         "/World/Shaped/Cone",
