@@ -64,8 +64,8 @@ pub use error::{GpuFailure, LuxError, Result};
 pub use gpu::{AdapterSummary, DeviceLimits, adapters};
 pub use limits::Limits;
 pub use model::{
-    Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFormat,
-    UpAxis, Value, schema,
+    Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter,
+    TextureFormat, UpAxis, Value, schema,
 };
 pub use prepare::TemperatureMode;
 #[cfg(feature = "usd")]

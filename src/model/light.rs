@@ -142,6 +142,18 @@ pub struct Texture {
     /// DomeLight_1's `poleAxis`; `None` for a plain DomeLight (always Y-up, §6 D1) and for a
     /// RectLight.
     pub pole_axis: Option<PoleAxis>,
+    /// How texels are reconstructed between their centres (not a UsdLux input: luxeval's
+    /// `--texture-filter`, DESIGN.md §4). Bilinear by default.
+    pub filter: TextureFilter,
+}
+
+/// Texture reconstruction (DESIGN.md §6 D1 and "RectLight texture"): bilinear between texel
+/// centres (the default), or the nearest texel. Irradiance integrates whichever is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TextureFilter {
+    #[default]
+    Bilinear,
+    Nearest,
 }
 
 impl Texture {
@@ -151,7 +163,12 @@ impl Texture {
             file,
             format: TextureFormat::Automatic,
             pole_axis: None,
+            filter: TextureFilter::Bilinear,
         }
+    }
+    pub fn with_filter(mut self, filter: TextureFilter) -> Self {
+        self.filter = filter;
+        self
     }
     pub fn with_format(mut self, format: TextureFormat) -> Self {
         self.format = format;

@@ -9,6 +9,7 @@ pub mod value;
 
 pub use asset::Asset;
 pub use light::{
-    Ies, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFormat, UpAxis,
+    Ies, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter, TextureFormat,
+    UpAxis,
 };
 pub use value::{Input, Value};

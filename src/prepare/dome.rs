@@ -69,13 +69,8 @@ pub const CROSS_FACES: [([f64; 3], [f64; 3], [f64; 3], [f64; 2]); 6] = [
     ),
 ];
 
-/// Texture filter (`--texture-filter`), §6 D1.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Filter {
-    #[default]
-    Bilinear,
-    Nearest,
-}
+/// Texture filter (`--texture-filter`), §6 D1: the model's choice.
+pub use crate::model::TextureFilter as Filter;
 
 impl Filter {
     /// The code shared with the WGSL (`FILTER_*`).

@@ -238,7 +238,7 @@ fn prepare_texture(
         image,
         format,
         frame,
-        filter: dome::Filter::default(),
+        filter: t.filter,
         irradiance: Default::default(),
     })
 }

@@ -4,9 +4,10 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use luxeval::{Accumulate, TemperatureMode};
+use luxeval::{Accumulate, TemperatureMode, TextureFilter};
 
-/// The stage, light selection, time and colour-temperature mode every scene command takes.
+/// The stage, light selection, time, colour-temperature mode and texture filter every scene
+/// command takes.
 #[derive(Args)]
 pub struct SceneArgs {
     /// The stage: .usda, .usdc or .usdz.
@@ -21,6 +22,10 @@ pub struct SceneArgs {
     /// UsdLux.BlackbodyTemperatureAsRgb), planckian (the OpenUSD reference renderer's path).
     #[arg(long, value_enum, default_value_t = ModeArg::Spec)]
     pub temperature_mode: ModeArg,
+    /// How dome and rect textures are reconstructed between texel centres: bilinear, or the
+    /// nearest texel. Irradiance integrates the reconstruction chosen.
+    #[arg(long, value_enum, default_value_t = FilterArg::Bilinear)]
+    pub texture_filter: FilterArg,
 }
 
 /// Options shared by the array queries.
@@ -60,6 +65,21 @@ pub struct TimeArg {
 pub enum DeviceArg {
     Gpu,
     Cpu,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FilterArg {
+    Bilinear,
+    Nearest,
+}
+
+impl From<FilterArg> for TextureFilter {
+    fn from(f: FilterArg) -> Self {
+        match f {
+            FilterArg::Bilinear => TextureFilter::Bilinear,
+            FilterArg::Nearest => TextureFilter::Nearest,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]

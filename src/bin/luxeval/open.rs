@@ -7,15 +7,19 @@ use crate::args::{DeviceArg, SceneArgs};
 use crate::exit::{CliResult, in_scene};
 
 /// The selected, visible, evaluable lights of the stage, validated (an invalid attribute is
-/// reported with the stage it comes from). Prints the stage's warnings.
+/// reported with the stage it comes from), their textures read with `--texture-filter`. Prints
+/// the stage's warnings.
 pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
     let scene = load(&args.scene, args.time.time)?;
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
-    let lights = scene.evaluable(&args.lights)?;
-    for l in &lights {
+    let mut lights = scene.evaluable(&args.lights)?;
+    for l in &mut lights {
         l.validate().map_err(|e| in_scene(&args.scene, e))?;
+        if let Some(t) = &mut l.texture {
+            t.filter = args.texture_filter.into();
+        }
     }
     Ok(lights)
 }
