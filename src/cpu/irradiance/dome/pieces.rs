@@ -29,6 +29,7 @@ use crate::prepare::dome::{AxisPiece, Filter, axis_pieces};
 use crate::prepare::dome::{DomeFormat, ball_dir};
 
 const PI: f64 = std::f64::consts::PI;
+const TAU: f64 = std::f64::consts::TAU;
 /// Most outer sub-intervals per smooth part of a piece (bounds the work of near-singular cases).
 const MAX_INTERVALS: usize = 64;
 
@@ -59,6 +60,32 @@ pub struct Piece {
     pub face: u32,
 }
 
+/// The largest angle (radians) a latlong or cross piece may span. The quadrature orders are
+/// chosen from a piece's cap radius assuming it is at most ~0.5 rad (`DomeIrradiance::order`);
+/// on tiny maps a texel spans far more (90° on a 4 × 2 latlong or a 3 × 4 cross), and under a
+/// non-uniform dome scale the fixed inner rule then erred by up to 3.8e-4 (measured). Cutting
+/// such pieces (same texels, same weights: the reconstruction is smooth inside a piece) keeps
+/// every piece within the assumption; maps wider than ~25 pixels are not affected.
+const MAX_PIECE_ANGLE: f64 = 0.25;
+
+/// `pieces` with every piece longer than `max_len` pixels cut into equal parts of at most that
+/// length.
+fn refine(pieces: Vec<AxisPiece>, max_len: f64) -> Vec<AxisPiece> {
+    let mut out = Vec::with_capacity(pieces.len());
+    for p in pieces {
+        let parts = ((p.x1 - p.x0) / max_len).ceil().max(1.0) as usize;
+        for k in 0..parts {
+            let at = |k: usize| p.x0 + (p.x1 - p.x0) * k as f64 / parts as f64;
+            out.push(AxisPiece {
+                x0: at(k),
+                x1: if k + 1 == parts { p.x1 } else { at(k + 1) },
+                ..p
+            });
+        }
+    }
+    out
+}
+
 /// Where a piece lies with respect to a disk format's rim.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Domain {
@@ -81,13 +108,16 @@ impl Geometry {
         matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
     }
 
-    /// The piece grids of this format and filter (§6 D1's wrap/clamp per format).
+    /// The piece grids of this format and filter (§6 D1's wrap/clamp per format). On the
+    /// latlong and cross formats, pieces are also cut so that none spans more than
+    /// [`MAX_PIECE_ANGLE`] (see there).
     pub fn grids(&self, filter: Filter) -> Vec<PieceGrid> {
         let (w, h) = (self.w as u32, self.h as u32);
         match self.format {
             DomeFormat::LatLong => vec![PieceGrid {
-                xs: axis_pieces(w, true, filter),
-                ys: axis_pieces(h, false, filter),
+                // Radians per pixel: 2π/W across, π/H down.
+                xs: refine(axis_pieces(w, true, filter), MAX_PIECE_ANGLE * self.w / TAU),
+                ys: refine(axis_pieces(h, false, filter), MAX_PIECE_ANGLE * self.h / PI),
                 face: 0,
             }],
             DomeFormat::MirroredBall | DomeFormat::Angular => {
@@ -112,11 +142,14 @@ impl Geometry {
                                 origin: p.origin + o,
                             }
                         };
-                        let xs = axis_pieces(n, false, filter)
+                        // A face's gnomonic coordinate spans [−1, 1] over N pixels, at most
+                        // 2/N radians per pixel (at the face's centre).
+                        let max_px = MAX_PIECE_ANGLE * self.n / 2.0;
+                        let xs = refine(axis_pieces(n, false, filter), max_px)
                             .into_iter()
                             .map(|p| shift(p, b.x as u32))
                             .collect();
-                        let ys = axis_pieces(n, false, filter)
+                        let ys = refine(axis_pieces(n, false, filter), max_px)
                             .into_iter()
                             .map(|p| shift(p, b.y as u32))
                             .collect();
@@ -509,7 +542,7 @@ impl HorizonCurve {
             e2,
             segments: [vec![], vec![]],
         };
-        let tau = std::f64::consts::TAU;
+        let tau = TAU;
         let mut g: Vec<f64> = (0..=512).map(|k| tau * k as f64 / 512.0).collect();
         let mut k = 0;
         while k + 1 < g.len() {
