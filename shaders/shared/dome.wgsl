@@ -17,6 +17,10 @@
 // 1. Everything is f32. Pixel coordinates s·W carry about W·2⁻²⁴ px of rounding (5e-4 px at
 //    W = 8192), so the bilinear weights differ by that much; nearest lookups within that distance
 //    of a texel edge, and any lookup at a latlong seam or cross face edge, may pick the neighbour.
+//    The bilinear value's error is that fraction of a pixel times the footprint's contrast: on a
+//    high-dynamic-range map, more than 1e-4 of a dark texel beside a bright one (8.7e-4 seen on
+//    Blender's studio map), but below 1e-4 of the footprint's largest texel, which is what
+//    `check` measures it against (check::texture_floor).
 // 2. atan2 is math.wgsl's atan2_accurate, not the builtin (lavapipe's errs by ~3e-6 rad, and
 //    WGSL only bounds it to 4096 ULP). No acos anywhere: §6 D2's atan2 form keeps the poles.
 // 3. No sin/cos: WGSL only bounds them to 2⁻¹¹ absolute. mirroredBall's r = sin(θ/2) is written

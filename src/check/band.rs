@@ -12,7 +12,9 @@ use crate::cpu::ies::{
 use crate::cpu::radiance;
 use crate::cpu::shaping::off_axis_angle;
 use crate::model::LightType;
+use crate::model::TextureFilter;
 use crate::prepare::Prepared;
+use crate::prepare::dome::DomeFormat;
 use crate::prepare::ies::{HFold, PhotometricType, VFold};
 use crate::query::Reference;
 use crate::testkit::samples::local_extent;
@@ -53,7 +55,12 @@ pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
             let el = (p.to_local * e).normalize();
             m = m.min((el.y * el.y + el.z * el.z).sqrt().asin());
         }
-        LightType::Sphere { .. } | LightType::Dome => {}
+        LightType::Dome => {
+            if near_texture_edge(p, e, TEXEL_BAND) {
+                m = 0.0;
+            }
+        }
+        LightType::Sphere { .. } => {}
     }
     if let (Some(s), true) = (&p.light.shaping, p.light.kind.is_shapeable()) {
         // The cone edge, hard or soft: scaled so that the band is BAND where
@@ -168,7 +175,13 @@ fn ies_jumps(p: &Prepared, el: DVec3) -> f64 {
 pub fn radiance_margin(r: &Reference, x: DVec3, w: DVec3) -> f64 {
     let p = &r.p;
     let w = w.normalize();
-    let m_emit = emission_margin(r, -w);
+    // A dome's emission is indexed by the direction toward the environment, as its radiance is
+    // (DESIGN.md §3); every other light's by the direction light travels.
+    let m_emit = if p.light.kind == LightType::Dome {
+        emission_margin(r, w)
+    } else {
+        emission_margin(r, -w)
+    };
     let xl = p.to_local * (x - p.origin);
     let dl = p.to_local * w;
     let u = dl.normalize();
@@ -471,4 +484,63 @@ pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
         }
     }
     m
+}
+
+/// How close (in pixels, or relative for a cross face edge) a textured dome's sample may come to
+/// a discontinuity f32 may straddle before it is excluded: 2000 times the ~W·2⁻²⁴ px of f32
+/// pixel-coordinate rounding at W = 8192 is still under 1 % of the texels.
+pub const TEXEL_BAND: f64 = 1e-3;
+
+/// A textured dome's comparison floor along world direction `w` (toward the environment):
+/// the largest channel of `base ⊙ texel` over the texels the lookup may read there (the 2 × 2
+/// bilinear footprint, or the nearest texel and its neighbours). Divergence 1 of
+/// shaders/shared/dome.wgsl: f32 pixel coordinates carry ~W·2⁻²⁴ px of rounding (plus the f32
+/// direction's ~1e-7 rad), so the GPU's bilinear value differs from the reference by that
+/// fraction of a pixel times the footprint's contrast. On a high-dynamic-range map (a 100:1 step
+/// between neighbouring texels is common) that is far more than 1e-4 of a dark texel's value,
+/// but always far below 1e-4 of the footprint's largest texel: errors are measured against that.
+/// 0 for other lights.
+pub fn texture_floor(p: &Prepared, w: DVec3) -> f64 {
+    let (LightType::Dome, Some(t)) = (&p.light.kind, &p.texture) else {
+        return 0.0;
+    };
+    let (wd, hd) = (t.image.width, t.image.height);
+    let st = crate::cpu::dome::direction_to_st(t.format, t.frame.to_dome(w.normalize()));
+    let around = |x: f64, n: usize| {
+        let c = (x * n as f64 - 0.5).floor() as i64;
+        [c - 1, c, c + 1, c + 2].map(|i| i.clamp(0, n as i64 - 1) as u32)
+    };
+    let mut m = 0.0f64;
+    for j in around(st.y, hd) {
+        for i in around(st.x, wd) {
+            let v = crate::cpu::dome::tex_fetch(&t.image, i, j) * p.base;
+            m = m.max(v.abs().max_element());
+        }
+    }
+    m
+}
+
+/// Whether a textured dome has a discontinuity within `margin` of world direction `w` that f32
+/// may straddle (divergence 1 of shaders/shared/dome.wgsl): with the nearest filter, a texel
+/// edge within `margin` pixels; with either filter, a cube-cross face edge (the two largest
+/// |d| within a relative `margin`: each face clamps to its own edge texels). In f64, on the
+/// reference's dome direction. False for other lights.
+pub fn near_texture_edge(p: &Prepared, w: DVec3, margin: f64) -> bool {
+    let (LightType::Dome, Some(t)) = (&p.light.kind, &p.texture) else {
+        return false;
+    };
+    let d = t.frame.to_dome(w.normalize());
+    if t.format == DomeFormat::Cross {
+        let mut a = d.abs().to_array();
+        a.sort_by(f64::total_cmp);
+        if a[2] - a[1] < margin * a[2] {
+            return true;
+        }
+    }
+    if t.filter != TextureFilter::Nearest {
+        return false;
+    }
+    let near_int = |x: f64| (x - x.round()).abs() < margin;
+    let st = crate::cpu::dome::direction_to_st(t.format, d);
+    near_int(st.x * t.image.width as f64) || near_int(st.y * t.image.height as f64)
 }

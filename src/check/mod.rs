@@ -31,7 +31,7 @@ use crate::query::{Accumulate, Evaluator, PreparedScene, Reference};
 use crate::testkit::{Rng, emission_samples, irradiance_samples, radiance_samples};
 pub use band::{
     F32_ROUNDING, IRRADIANCE_SLIVER_FACTOR, emission_margin, intensity_margin, irradiance_margin,
-    radiance_margin,
+    near_texture_edge, radiance_margin, texture_floor,
 };
 
 /// Relative tolerance of GPU (f32) against CPU (f64).
@@ -111,8 +111,14 @@ impl CheckReport {
 
 /// Relative error of one sample (see the module docs).
 pub fn rel_error(cpu: DVec3, gpu: [f32; 3]) -> f64 {
+    rel_error_above(cpu, gpu, 0.0)
+}
+
+/// [`rel_error`] relative to at least `floor` (a textured dome's footprint, see
+/// [`band::texture_floor`]).
+pub fn rel_error_above(cpu: DVec3, gpu: [f32; 3], floor: f64) -> f64 {
     let g = DVec3::new(gpu[0] as f64, gpu[1] as f64, gpu[2] as f64);
-    let scale = cpu.abs().max_element();
+    let scale = cpu.abs().max_element().max(floor);
     let diff = (g - cpu).abs().max_element();
     if diff == 0.0 {
         0.0
@@ -185,6 +191,7 @@ pub fn check_with(
                 got[i],
                 dirs[i],
                 None,
+                texture_floor(p, e),
             )
         }));
         // Intensity, on the same directions: `L(ω)·A⊥(ω)`, whose discontinuities are the
@@ -199,6 +206,7 @@ pub fn check_with(
                 got[i],
                 dirs[i],
                 None,
+                0.0,
             )
         }));
         // Radiance.
@@ -213,6 +221,7 @@ pub fn check_with(
                 got[i],
                 pts[i],
                 Some(dirs[i]),
+                texture_floor(p, w),
             )
         }));
         // Irradiance: the CPU values (quadratures) are computed in parallel. Not for the lights
@@ -239,6 +248,7 @@ pub fn check_with(
                 got[i],
                 pts[i],
                 Some(nrms[i]),
+                0.0,
             )
         }));
     }
@@ -253,7 +263,8 @@ pub fn check_with(
     })
 }
 
-type SampleEval = (DVec3, f64, [f32; 3], [f32; 3], Option<[f32; 3]>);
+/// (CPU value, margin, GPU value, input a, input b, error floor).
+type SampleEval = (DVec3, f64, [f32; 3], [f32; 3], Option<[f32; 3]>, f64);
 
 fn compare(r: &Reference, query: Query, n: usize, f: impl Fn(usize) -> SampleEval) -> QueryReport {
     let mut report = QueryReport {
@@ -268,7 +279,7 @@ fn compare(r: &Reference, query: Query, n: usize, f: impl Fn(usize) -> SampleEva
         pass: true,
     };
     for i in 0..n {
-        let (cpu, margin, gpu, a, b) = f(i);
+        let (cpu, margin, gpu, a, b, floor) = f(i);
         if margin < BAND {
             report.excluded += 1;
             continue;
@@ -276,7 +287,7 @@ fn compare(r: &Reference, query: Query, n: usize, f: impl Fn(usize) -> SampleEva
         if cpu != DVec3::ZERO {
             report.nonzero += 1;
         }
-        let err = rel_error(cpu, gpu);
+        let err = rel_error_above(cpu, gpu, floor);
         if err > report.max_rel_error || report.worst.is_none() {
             report.max_rel_error = report.max_rel_error.max(err);
             report.worst = Some(Worst {
