@@ -72,6 +72,12 @@ impl PreparedScene {
         self.lights.is_empty()
     }
 
+    /// The size (width, height) of light `k`'s texture as loaded, if it has one.
+    pub fn texture_size(&self, k: usize) -> Option<(u32, u32)> {
+        let t = self.lights.get(k)?.texture.as_ref()?;
+        Some((t.image.width as u32, t.image.height as u32))
+    }
+
     /// The lights as evaluated, in order (a ShapingAPI whose factor is 1 everywhere is dropped).
     pub fn lights(&self) -> impl Iterator<Item = &Light> {
         self.lights.iter().map(|p| &p.light)

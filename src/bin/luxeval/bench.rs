@@ -28,6 +28,39 @@ pub struct BenchArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     json: bool,
+    /// Time preparing this dome texture instead of a generated lat-long EXR.
+    #[arg(long, value_name = "FILE")]
+    dome_texture: Option<std::path::PathBuf>,
+    /// Size of the generated dome EXR (WxH).
+    #[arg(long, value_name = "WxH", default_value = "8192x4096", value_parser = parse_size)]
+    dome_size: (u32, u32),
+    /// Skip the dome measurement.
+    #[arg(long)]
+    no_dome: bool,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WxH, e.g. 8192x4096"))?;
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&v| (1..=65536).contains(&v))
+    };
+    match (p(w), p(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!(
+            "{s:?}: width and height must be integers from 1 to 65536"
+        )),
+    }
+}
+
+#[derive(serde::Serialize)]
+struct Report {
+    queries: Vec<Row>,
+    dome: Vec<crate::bench_dome::DomeRow>,
 }
 
 #[derive(serde::Serialize)]
@@ -133,10 +166,25 @@ pub fn run(args: BenchArgs) -> CliResult {
             });
         }
     }
+    let evals: Vec<Evaluator> = evaluators.iter().map(|(e, _)| e.clone()).collect();
+    let dome = if args.no_dome {
+        Vec::new()
+    } else {
+        crate::bench_dome::run(
+            &evals,
+            args.dome_texture.as_deref(),
+            args.dome_size,
+            args.repeat.min(3),
+        )?
+    };
     if args.json {
+        let report = Report {
+            queries: rows,
+            dome,
+        };
         outln!(
             "{}",
-            serde_json::to_string_pretty(&rows).map_err(|e| Failure::runtime(e.to_string()))?
+            serde_json::to_string_pretty(&report).map_err(|e| Failure::runtime(e.to_string()))?
         );
         return Ok(());
     }
@@ -158,6 +206,17 @@ pub fn run(args: BenchArgs) -> CliResult {
             r.samples,
             r.median_seconds,
             r.evals_per_second
+        );
+    }
+    for d in &dome {
+        outln!(
+            "dome texture {} × {} from file to prepared scene on {}: median {:.3} s wall, {} CPU",
+            d.width,
+            d.height,
+            d.device,
+            d.wall_seconds,
+            d.cpu_seconds
+                .map_or("n/a".to_string(), |c| format!("{c:.2} s"))
         );
     }
     if evaluators.len() == 2 {

@@ -11,6 +11,7 @@ macro_rules! outln {
 
 mod args;
 mod bench;
+mod bench_dome;
 mod check;
 mod exit;
 mod falloff;
