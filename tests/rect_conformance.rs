@@ -155,7 +155,11 @@ fn gpu_matches_cpu_on_textured_rects() {
             ];
             for (query, gv, cv, skip) in &results {
                 let peak = (0..n)
-                    .map(|i| cv[l * n + i].iter().fold(0.0f64, |a, &b| a.max(b.abs() as f64)))
+                    .map(|i| {
+                        cv[l * n + i]
+                            .iter()
+                            .fold(0.0f64, |a, &b| a.max(b.abs() as f64))
+                    })
                     .fold(0.0, f64::max);
                 for i in 0..n {
                     if skip.is_some_and(|s| s[i]) {

@@ -143,12 +143,9 @@ impl GpuContext {
             has_ies: records
                 .iter()
                 .any(|r| r.flags & super::record::FLAG_IES != 0),
-            has_dome: records
-                .iter()
-                .any(|r| {
-                    r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE)
-                        != 0
-                }),
+            has_dome: records.iter().any(|r| {
+                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE) != 0
+            }),
         }))
     }
 

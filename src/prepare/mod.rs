@@ -257,14 +257,12 @@ fn prepare_rect_texture(
     t: &Texture,
     cache: &mut AssetCache,
 ) -> Result<dome::RectTexture> {
-    let image = cache
-        .texture(&t.file)
-        .map_err(|source| LuxError::Asset {
-            light: light.path.clone(),
-            attr: "inputs:texture:file".into(),
-            path: t.file.authored.clone(),
-            source,
-        })?;
+    let image = cache.texture(&t.file).map_err(|source| LuxError::Asset {
+        light: light.path.clone(),
+        attr: "inputs:texture:file".into(),
+        path: t.file.authored.clone(),
+        source,
+    })?;
     Ok(dome::RectTexture::new(image, dome::Filter::default()))
 }
 

@@ -338,7 +338,16 @@ mod tests {
     /// `L(e) · tex(u, v) · max(0, n·ω) · max(0, N_a·e) / r²`, with `N_a = |det M| M⁻ᵀ(−Z)` the
     /// area-weighted emitting normal, `ω` from x to the surface point and `e = −ω`. Written here
     /// from DESIGN.md §2, §3 and §6 only (the shaping factor is `cpu::shaping`).
-    fn brute_force(p: &Prepared, rgb: &[[f32; 3]], tw: usize, th: usize, x: DVec3, n: DVec3, f: Filter, k: usize) -> DVec3 {
+    fn brute_force(
+        p: &Prepared,
+        rgb: &[[f32; 3]],
+        tw: usize,
+        th: usize,
+        x: DVec3,
+        n: DVec3,
+        f: Filter,
+        k: usize,
+    ) -> DVec3 {
         let LightType::Rect { width, height } = p.light.kind else {
             unreachable!()
         };
