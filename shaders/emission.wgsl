@@ -25,10 +25,7 @@ fn emission(light: Record, e: vec3<f32>) -> vec3<f32> {
             return vec3<f32>(0.0);
         }
         case KIND_RECT, KIND_DISK: {
-            if dot(e, light.normal.xyz) > 0.0 {
-                return base * shaping(light, e);
-            }
-            return vec3<f32>(0.0);
+            return surface_emission(light, e) * rect_mean(light);
         }
         case KIND_CYLINDER: {
             // Some point of the side faces e unless e is parallel to the axis.
@@ -43,6 +40,14 @@ fn emission(light: Record, e: vec3<f32>) -> vec3<f32> {
             return base * shaping(light, e);
         }
     }
+}
+
+// L(e) of a rect or disk before any texture: one-sided, strictly e · n > 0.
+fn surface_emission(light: Record, e: vec3<f32>) -> vec3<f32> {
+    if dot(e, light.normal.xyz) > 0.0 {
+        return light.base.xyz * shaping(light, e);
+    }
+    return vec3<f32>(0.0);
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)

@@ -9,7 +9,8 @@
 // offset `o` (in f32 units, a multiple of 4) is a TEX_HEADER_WORDS-word header — width, height,
 // format code, 0 (u32 bit patterns) — followed by width × height RGB triplets, row-major, row 0
 // at the top: texel (i, j) is at o + 4 + 3·(j·width + i). A light record carries its texture's
-// offset and filter in `tex`, and A_eff⁻¹ in `tex_inv0..2` (FLAG_DOME_TEXTURE). The FORMAT_*,
+// offset and filter in `tex`, and A_eff⁻¹ in `tex_inv0..2` (FLAG_DOME_TEXTURE); a textured rect
+// (FLAG_RECT_TEXTURE) its offset and filter in `tex` and its mean colour in `tex_inv0.rgb`. The FORMAT_*,
 // FILTER_* codes and §6 D5's cube-cross table (CROSS_FACE_TABLE) are generated from Rust
 // (gpu::dome_atlas::wgsl_constants, wgsl_f32_arrays).
 //
@@ -31,7 +32,9 @@
 // 5. The texture's size and format come from the atlas header (tex_info reads it); the f64
 //    twin reads them from the image. The lookup has no loop (lavapipe's loop budget).
 // 6. DOME_ENABLED is a pipeline-overridable constant: kernels are built without the lookup
-//    (false) for scenes without a textured dome, so their pipelines are unchanged.
+//    (false) for scenes without a textured dome or rect, so their pipelines are unchanged.
+// 7. A rect's hit point is f32 (the ray–plane intersection), so (s, t) carries its rounding;
+//    its mean colour is computed in f64 by prepare and rounded once.
 // GPU-only TexInfo, FaceBasis: structs standing in for the Rust tuples.
 
 // #import shared/record.wgsl
@@ -207,4 +210,21 @@ fn dome_factor(light: Record, e: vec3<f32>) -> vec3<f32> {
     }
     let inv = mat3x3<f32>(light.tex_inv0.xyz, light.tex_inv1.xyz, light.tex_inv2.xyz);
     return dome_lookup(light.tex.x, inv, e, light.tex.y);
+}
+
+// A rect record's texture factor for emission: the texture's exact area mean, rounded once
+// (tex_inv0.rgb, FLAG_RECT_TEXTURE); 1 without a texture.
+fn rect_mean(light: Record) -> vec3<f32> {
+    if !DOME_ENABLED || !has_flag(light, FLAG_RECT_TEXTURE) {
+        return vec3<f32>(1.0);
+    }
+    return light.tex_inv0.xyz;
+}
+
+// A rect record's texture factor for radiance at the local hit point (x, y); 1 without one.
+fn rect_factor(light: Record, hit: vec2<f32>) -> vec3<f32> {
+    if !DOME_ENABLED || !has_flag(light, FLAG_RECT_TEXTURE) {
+        return vec3<f32>(1.0);
+    }
+    return rect_texel(light.tex.x, hit.x, hit.y, 2.0 * light.size.x, 2.0 * light.size.y, light.tex.y);
 }

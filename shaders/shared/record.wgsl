@@ -38,10 +38,11 @@ struct Record {
     // normalisation or tilt scale; 0).
     ies: vec4<f32>,
     // Textured dome (FLAG_DOME_TEXTURE): columns of A_eff⁻¹ (world → dome, DESIGN.md §6 D1).
+    // Textured rect (FLAG_RECT_TEXTURE): tex_inv0.rgb is the texture's mean colour.
     tex_inv0: vec4<f32>,
     tex_inv1: vec4<f32>,
     tex_inv2: vec4<f32>,
-    // Textured dome: (atlas offset of the texture's header, filter code, 0, 0).
+    // Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0).
     tex: vec4<u32>,
     kind: u32,
     flags: u32,
@@ -75,7 +76,7 @@ struct Params {
 @group(0) @binding(4) var<storage, read_write> out_rgb: array<f32>;
 // Every IES profile of the scene (shared/ies.wgsl reads it; layout in src/gpu/ies_atlas.rs).
 @group(0) @binding(5) var<storage, read> ies_atlas: array<f32>;
-// Every dome texture of the scene (shared/dome.wgsl reads it; layout in src/gpu/dome_atlas.rs).
+// Every dome and rect texture of the scene (shared/dome.wgsl reads it; layout in src/gpu/dome_atlas.rs).
 @group(0) @binding(6) var<storage, read> tex_atlas: array<f32>;
 
 fn sample_index(gid: vec3<u32>) -> u32 {

@@ -16,7 +16,9 @@ use glam::{DMat3, DVec2, DVec3, DVec4};
 
 use crate::prepare::Prepared;
 use crate::prepare::dome::{DomeFormat, Filter, Image, cross_face_basis};
-use crate::prepare::dome::{FILTER_NEAREST, FORMAT_ANGULAR, FORMAT_LATLONG, FORMAT_MIRRORED_BALL};
+use crate::prepare::dome::{
+    FILTER_NEAREST, FORMAT_ANGULAR, FORMAT_LATLONG, FORMAT_MIRRORED_BALL, FORMAT_RECT,
+};
 
 /// What the lookup needs to know about one texture (the WGSL reads it from the atlas header).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -224,6 +226,33 @@ pub fn dome_factor(p: &Prepared, e: DVec3) -> DVec3 {
             t.filter.code(),
         ),
         None => DVec3::ONE,
+    }
+}
+
+/// A rect light's texture factor for `emission` (§6 "RectLight texture"): the exact area mean
+/// of the filtered reconstruction (`prepare::dome::area_mean`), 1 without a texture.
+pub fn rect_mean(p: &Prepared) -> DVec3 {
+    match &p.rect_texture {
+        Some(t) => t.mean(),
+        None => DVec3::ONE,
+    }
+}
+
+/// A rect light's texture factor for `radiance` at the local hit point `hit` = (x, y) on the
+/// light's plane (§6 "RectLight texture": `radiance(x, ω) = L(−ω) ⊙ tex(s, t)` at the hit), 1
+/// without a texture.
+pub fn rect_factor(p: &Prepared, hit: DVec2) -> DVec3 {
+    match (&p.rect_texture, &p.light.kind) {
+        (Some(t), crate::model::LightType::Rect { width, height }) => rect_texel(
+            &t.image,
+            tex_info(&t.image, FORMAT_RECT),
+            hit.x,
+            hit.y,
+            *width,
+            *height,
+            t.filter().code(),
+        ),
+        _ => DVec3::ONE,
     }
 }
 
@@ -536,11 +565,12 @@ mod tests {
             m.contains("inputs:texture:format") && m.contains("testImage.png"),
             "{m}"
         );
-        // RectLight textures are not evaluated yet: refused, not evaluated as untextured.
-        let rect = Light::rect(1.0, 1.0).with_texture(Texture::new(Asset::file(CHART)));
-        let m = prep(&rect).unwrap_err().to_string();
+        // A texture on a type that has none in UsdLux (here a disk) is refused, not evaluated
+        // as untextured.
+        let disk = Light::disk(1.0).with_texture(Texture::new(Asset::file(CHART)));
+        let m = prep(&disk).unwrap_err().to_string();
         assert!(
-            m.contains("inputs:texture:file") && m.contains("not evaluated yet"),
+            m.contains("inputs:texture:file") && m.contains("not evaluated"),
             "{m}"
         );
     }

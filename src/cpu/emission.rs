@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use super::dome::dome_factor;
+use super::dome::{dome_factor, rect_mean};
 use super::shaping::{off_axis_angle, shaping};
 use crate::model::LightType;
 use crate::prepare::Prepared;
@@ -28,14 +28,9 @@ pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
                 DVec3::ZERO
             }
         }
-        LightType::Rect { .. } | LightType::Disk { .. } => {
-            // One-sided toward local −Z: strictly ω · n > 0, edge-on is 0.
-            if e.dot(p.normal) > 0.0 {
-                base * shaping(p, e)
-            } else {
-                DVec3::ZERO
-            }
-        }
+        // DESIGN.md §6 "RectLight texture": a textured rect's emission is L(ω) ⊙ the area mean
+        // of its filtered texture (1 without one).
+        LightType::Rect { .. } | LightType::Disk { .. } => surface_emission(p, e) * rect_mean(p),
         LightType::Cylinder { .. } => {
             // The side's outward normals are ⊥ to the axis, so some point faces e unless e is
             // parallel to the axis.
@@ -48,6 +43,16 @@ pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
         }
         // A sphere (and its point approximation) emits along every direction.
         LightType::Sphere { .. } => base * shaping(p, e),
+    }
+}
+
+/// L(e) of a rect or disk before any texture: one-sided toward local −Z, strictly ω · n > 0
+/// (edge-on is 0).
+pub fn surface_emission(p: &Prepared, e: DVec3) -> DVec3 {
+    if e.dot(p.normal) > 0.0 {
+        p.base * shaping(p, e)
+    } else {
+        DVec3::ZERO
     }
 }
 

@@ -12,7 +12,7 @@
 //! - Everything else (shaped lights, disks, ellipsoids, cylinders, `treatAsLine`) is one
 //!   deterministic scheme: a plane [`chart`] of the directions x sees the light in, in which
 //!   `E = L·∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY` (S the RGB shaping factor of the emission
-//!   direction e = −ŵ: cone, softness, focus, tint now; IES and textures later), integrated over
+//!   direction e = −ŵ: cone, softness, focus, tint, IES; a rect's texture, [`rect_texture`]), integrated over
 //!   lines Y = const ([`line`]) across the pieces between [`critical`] Ys ([`outer`]), each
 //!   piece mapped to remove peaks and square-root ends ([`pieces`]).
 //!
@@ -30,6 +30,7 @@ pub mod dome;
 pub mod line;
 pub mod outer;
 pub mod pieces;
+pub mod rect_texture;
 
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -82,7 +83,7 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
             let xl = p.to_local * (x - p.origin);
             if !(xl.z < 0.0) {
                 DVec3::ZERO
-            } else if p.shaping.is_none() {
+            } else if p.shaping.is_none() && p.rect_texture.is_none() {
                 p.base * rect_lambert(p, x, n, width / 2.0, height / 2.0)
             } else {
                 let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
@@ -228,9 +229,12 @@ impl Rule for Adaptive {
 pub struct Ctx<'a, R> {
     pub p: &'a Prepared,
     pub n: DVec3,
-    /// Use the closed-form inner integral (no shaping).
+    /// Use the closed-form inner integral (no shaping, no texture).
     pub unshaped: bool,
     pub rule: &'a R,
+    /// A textured rect's texture (rect_texture.rs): one more factor of the integrand, and its
+    /// break lines.
+    pub tex: Option<rect_texture::ChartTexture<'a>>,
 }
 
 #[cfg(test)]

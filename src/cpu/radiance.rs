@@ -8,8 +8,9 @@
 
 use glam::DVec3;
 
-use super::emission::emission;
-use super::shapes::{cylinder_hit, disk_hit, rect_hit, sphere_hit};
+use super::dome::rect_factor;
+use super::emission::{emission, surface_emission};
+use super::shapes::{cylinder_hit, disk_hit, plane_hit, rect_hit, sphere_hit};
 use crate::model::LightType;
 use crate::prepare::Prepared;
 
@@ -20,7 +21,18 @@ pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
         // which is ω itself.
         emission(p, w)
     } else if hits_emitting_surface(p, x, w) {
-        emission(p, -w)
+        if p.rect_texture.is_some() {
+            // DESIGN.md §6 "RectLight texture": L(−ω) ⊙ tex(s, t) at the hit point, not the
+            // texture's mean that emission carries.
+            let xl = p.to_local * (x - p.origin);
+            let dl = p.to_local * w;
+            match plane_hit(xl, dl) {
+                Some(h) => surface_emission(p, -w) * rect_factor(p, h.truncate()),
+                None => DVec3::ZERO,
+            }
+        } else {
+            emission(p, -w)
+        }
     } else {
         DVec3::ZERO
     }

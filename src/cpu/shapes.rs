@@ -15,7 +15,7 @@
 use glam::DVec3;
 
 /// Where a ray from the −Z side meets the plane z = 0 travelling toward +Z.
-fn plane_hit(x: DVec3, d: DVec3) -> Option<DVec3> {
+pub fn plane_hit(x: DVec3, d: DVec3) -> Option<DVec3> {
     if !(d.z > 0.0 && x.z < 0.0) {
         return None;
     }

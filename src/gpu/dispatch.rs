@@ -15,7 +15,8 @@ pub(crate) struct GpuLights {
     count: usize,
     /// Whether any light has an IES profile (the pipelines with the lookup are needed).
     has_ies: bool,
-    /// Whether any light has a dome texture (the pipelines with the dome lookup are needed).
+    /// Whether any light has a dome or rect texture (the pipelines with the texture lookup are
+    /// needed).
     has_dome: bool,
 }
 
@@ -142,9 +143,9 @@ impl GpuContext {
             has_ies: records
                 .iter()
                 .any(|r| r.flags & super::record::FLAG_IES != 0),
-            has_dome: records
-                .iter()
-                .any(|r| r.flags & super::record::FLAG_DOME_TEXTURE != 0),
+            has_dome: records.iter().any(|r| {
+                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE) != 0
+            }),
         }))
     }
 

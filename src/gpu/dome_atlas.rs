@@ -1,4 +1,4 @@
-//! Every dome texture of a scene packed into one flat `f32` storage buffer for
+//! Every dome and rect texture of a scene packed into one flat `f32` storage buffer for
 //! `shaders/shared/dome.wgsl` (`tex_atlas`, binding 6). Ported from the staged crate
 //! `luxeval-dome` (`src/atlas.rs`), on the model of [`super::ies_atlas`]: one atlas per scene.
 //!
@@ -152,20 +152,24 @@ pub fn scene_atlas(lights: &[Prepared]) -> Result<(Atlas, Vec<Option<u32>>), Atl
     let mut packed: Vec<(Arc<Image>, u32, u32)> = Vec::new();
     let mut offsets = Vec::with_capacity(lights.len());
     for p in lights {
-        let Some(t) = &p.texture else {
-            offsets.push(None);
-            continue;
+        // A dome's texture with its format's code; a rect's with FORMAT_RECT.
+        let (image, code) = match (&p.texture, &p.rect_texture) {
+            (Some(t), _) => (&t.image, t.format.code()),
+            (None, Some(t)) => (&t.image, FORMAT_RECT),
+            (None, None) => {
+                offsets.push(None);
+                continue;
+            }
         };
-        let code = t.format.code();
         let found = packed
             .iter()
-            .find(|(img, f, _)| Arc::ptr_eq(img, &t.image) && *f == code)
+            .find(|(img, f, _)| Arc::ptr_eq(img, image) && *f == code)
             .map(|e| e.2);
         let offset = match found {
             Some(o) => o,
             None => {
-                let o = atlas.push(Arc::clone(&t.image), code)?;
-                packed.push((Arc::clone(&t.image), code, o));
+                let o = atlas.push(Arc::clone(image), code)?;
+                packed.push((Arc::clone(image), code, o));
                 o
             }
         };

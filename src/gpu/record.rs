@@ -39,6 +39,9 @@ pub const FLAG_IES: u32 = 512;
 /// A dome with a texture (`tex_inv`, `tex`: the dome frame and the atlas offset, see
 /// `gpu::dome_atlas` and `shaders/shared/dome.wgsl`).
 pub const FLAG_DOME_TEXTURE: u32 = 1024;
+/// A rect with a texture (`tex`: the atlas offset and filter; `tex_inv[0]`: the texture's mean
+/// colour, DESIGN.md §6 "RectLight texture"; see `shaders/shared/dome.wgsl`).
+pub const FLAG_RECT_TEXTURE: u32 = 2048;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -62,6 +65,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_AXIS_SINGULAR", FLAG_AXIS_SINGULAR),
     ("FLAG_IES", FLAG_IES),
     ("FLAG_DOME_TEXTURE", FLAG_DOME_TEXTURE),
+    ("FLAG_RECT_TEXTURE", FLAG_RECT_TEXTURE),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
 ];
 
@@ -84,8 +88,9 @@ pub struct Record {
     /// tilt scale; 0).
     pub ies: [f32; 4],
     /// Textured dome (FLAG_DOME_TEXTURE): columns of `A_eff⁻¹` (world → dome, §6 D1); w: 0.
+    /// Textured rect (FLAG_RECT_TEXTURE): `tex_inv[0]` is the texture's mean colour.
     pub tex_inv: [[f32; 4]; 3],
-    /// Textured dome: (atlas offset of the texture's header, filter code, 0, 0).
+    /// Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0).
     pub tex: [u32; 4],
     pub kind: u32,
     pub flags: u32,
@@ -175,6 +180,11 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
             v4(inv.z_axis, 0.0),
         ];
         r.tex = [offset, t.filter.code(), 0, 0];
+    }
+    if let (Some(t), Some(offset)) = (&p.rect_texture, tex_offset) {
+        r.flags |= FLAG_RECT_TEXTURE;
+        r.tex_inv[0] = v4(t.mean(), 0.0);
+        r.tex = [offset, t.filter().code(), 0, 0];
     }
     let (kind, size) = match p.light.kind {
         LightType::Distant { .. } => {

@@ -268,6 +268,39 @@ pub struct PreparedTexture {
     pub irradiance: IrradianceSlot,
 }
 
+/// A RectLight's texture as both backends evaluate it (DESIGN.md §6 "RectLight texture"): the
+/// image (loaded once per file, shared with any dome using it), its filter, and the exact area
+/// mean of the filtered reconstruction, which `emission` multiplies by. Built by
+/// [`RectTexture::new`] so that the mean always belongs to the filter.
+#[derive(Clone, Debug)]
+pub struct RectTexture {
+    pub image: Arc<Image>,
+    filter: Filter,
+    mean: DVec3,
+}
+
+impl RectTexture {
+    pub fn new(image: Arc<Image>, filter: Filter) -> RectTexture {
+        let mean = area_mean(&image, filter);
+        RectTexture {
+            image,
+            filter,
+            mean,
+        }
+    }
+
+    /// Bilinear (default) or nearest, both axes clamped.
+    pub fn filter(&self) -> Filter {
+        self.filter
+    }
+
+    /// The area mean of the clamped-bilinear (or nearest) reconstruction over the image
+    /// ([`area_mean`]): `emission = L ⊙ mean`, so that `intensity = emission × projected area`.
+    pub fn mean(&self) -> DVec3 {
+        self.mean
+    }
+}
+
 /// A lazily filled, shared slot for a texture's irradiance tables (see
 /// [`PreparedTexture::irradiance`]).
 pub type IrradianceSlot = Arc<std::sync::OnceLock<Arc<dyn std::any::Any + Send + Sync>>>;

@@ -99,6 +99,9 @@ pub struct Prepared {
     pub ies: Option<PreparedIes>,
     /// A dome's environment map, where `texture:file` is authored (DESIGN.md §6 D1–D6).
     pub texture: Option<dome::PreparedTexture>,
+    /// A RectLight's image, where `texture:file` is authored (DESIGN.md §6 "RectLight
+    /// texture"); kept apart from [`Prepared::texture`], which is a dome's.
+    pub rect_texture: Option<dome::RectTexture>,
 }
 
 impl Prepared {
@@ -174,12 +177,16 @@ impl Prepared {
             }
             _ => None,
         };
-        let texture = match &light.texture {
-            None => None,
-            Some(t) => Some(prepare_texture(light, t, linear, cache)?),
+        let (texture, rect_texture) = match (&light.texture, &light.kind) {
+            (None, _) => (None, None),
+            (Some(t), LightType::Rect { .. }) => {
+                (None, Some(prepare_rect_texture(light, t, cache)?))
+            }
+            (Some(t), _) => (Some(prepare_texture(light, t, linear, cache)?), None),
         };
         Ok(Prepared {
             texture,
+            rect_texture,
             base,
             size_factor,
             origin: light.origin(),
@@ -199,8 +206,8 @@ impl Prepared {
 }
 
 /// Loads a light's texture (once per file, through `cache`) and resolves its format and frame
-/// (DESIGN.md §6 D1–D6). Only dome textures are evaluated so far (issue 9): a RectLight texture
-/// is refused rather than evaluated as if untextured.
+/// (DESIGN.md §6 D1–D6). Domes only (a RectLight's is [`prepare_rect_texture`]); a texture on
+/// any other type is refused rather than evaluated as if untextured.
 fn prepare_texture(
     light: &Light,
     t: &Texture,
@@ -213,7 +220,7 @@ fn prepare_texture(
             "inputs:texture:file",
             &t.file.authored,
             format!(
-                "{} textures are not evaluated yet (only DomeLight textures are)",
+                "{} textures are not evaluated (only DomeLight and RectLight textures are)",
                 light.kind.usd_type()
             ),
         ));
@@ -241,6 +248,22 @@ fn prepare_texture(
         filter: t.filter,
         irradiance: Default::default(),
     })
+}
+
+/// Loads a RectLight's texture (once per file, through `cache`) with the default filter and its
+/// exact area mean (DESIGN.md §6 "RectLight texture").
+fn prepare_rect_texture(
+    light: &Light,
+    t: &Texture,
+    cache: &mut AssetCache,
+) -> Result<dome::RectTexture> {
+    let image = cache.texture(&t.file).map_err(|source| LuxError::Asset {
+        light: light.path.clone(),
+        attr: "inputs:texture:file".into(),
+        path: t.file.authored.clone(),
+        source,
+    })?;
+    Ok(dome::RectTexture::new(image, dome::Filter::default()))
 }
 
 /// The largest magnitude of a length (a position, a size, an entry of the world transform or

@@ -221,8 +221,13 @@ impl PreparedScene {
 ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a dome's
 ///   irradiance depends on the normal only, so the reference evaluates it once per distinct
 ///   normal (one for a whole falloff map).
+/// - Textured rects: the exact integral of the filtered texture over the surface, split at
+///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
+///   (src/cpu/irradiance/rect_texture.rs).
 pub(crate) fn irradiance_on_host(p: &Prepared) -> bool {
-    p.ies.is_some() || (matches!(p.light.kind, LightType::Dome) && p.texture.is_some())
+    p.ies.is_some()
+        || (matches!(p.light.kind, LightType::Dome) && p.texture.is_some())
+        || p.rect_texture.is_some()
 }
 
 /// Rows scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The

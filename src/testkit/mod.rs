@@ -8,6 +8,7 @@ pub mod ies;
 pub mod ies_replay;
 pub mod kernel_rule;
 pub mod lights;
+pub mod rect;
 mod rng;
 pub mod samples;
 

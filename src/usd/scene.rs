@@ -490,11 +490,11 @@ fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, String>
     Ok(Some(t))
 }
 
-/// Whether the queries evaluate this light's texture yet: dome textures are evaluated by every
-/// query on both paths (the GPU path takes a textured dome's irradiance from the CPU reference);
-/// RectLight textures are not yet, and such a light stays listed as skipped, with the warning.
+/// Whether the queries evaluate this light's texture: dome and RectLight textures are evaluated
+/// by every query on both paths (the GPU path takes their irradiance from the CPU reference);
+/// a texture on any other type would stay listed as skipped, with the warning.
 fn texture_is_evaluated(kind: &LightType, _texture: &Texture) -> bool {
-    matches!(kind, LightType::Dome)
+    matches!(kind, LightType::Dome | LightType::Rect { .. })
 }
 
 #[cfg(test)]
@@ -586,11 +586,9 @@ mod tests {
                 resolved: None,
             },
         );
-        let e = convert(&rect, UpAxis::Y).unwrap_err();
-        assert!(
-            e.contains("/Lights/RectLight") && e.contains("texture:file"),
-            "{e}"
-        );
+        // RectLight textures are evaluated: read into the model, not skipped.
+        let (l, _) = convert(&rect, UpAxis::Y).unwrap();
+        assert_eq!(l.texture.unwrap().file.authored, "tex.png");
 
         let mut ies = prim("SphereLight", &["ShapingAPI"]);
         set(
@@ -680,13 +678,8 @@ mod tests {
         set(&mut d1, "poleAxis", Value::Token("X".into()));
         let e = texture(&Reader { p: &d1 }, "DomeLight_1").unwrap_err();
         assert!(e.contains("poleAxis"), "{e}");
-        // Until the queries evaluate textures, a textured light is skipped with a warning
-        // naming it, never evaluated as untextured.
-        let e = convert(&rect, UpAxis::Y).unwrap_err();
-        assert!(
-            e.contains("not supported yet") && e.contains("env.exr"),
-            "{e}"
-        );
+        // A textured RectLight is evaluated, not skipped.
+        assert!(convert(&rect, UpAxis::Y).unwrap().0.texture.is_some());
     }
 
     #[test]

@@ -104,10 +104,16 @@ pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
     }
     let (w0, e1, e2) = (chart.w0, chart.e1, chart.e2);
     // Straight region edges X = const (the square's sides), and elliptic arcs.
-    let segs: Vec<f64> = match &chart.region {
+    let mut segs: Vec<f64> = match &chart.region {
         Region::Square => vec![-1.0, 1.0],
         _ => vec![],
     };
+    // A textured rect: the texture's vertical break lines are straight edges too, and its
+    // horizontal ones are breaks (DESIGN.md §6 "what 'exact' means", rect_texture.rs).
+    segs.extend(super::rect_texture::texel_xs(p, chart));
+    for y in super::rect_texture::texel_ys(p, chart) {
+        push_y(&mut ys, y, chart);
+    }
     let arcs: Vec<Arc> = match &chart.region {
         Region::Square => vec![],
         Region::Disk => vec![Arc {

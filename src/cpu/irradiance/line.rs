@@ -19,8 +19,16 @@ use crate::cpu::roots::{axis_approach, cone_roots_on_line};
 use crate::cpu::shaping::shaping;
 use crate::prepare::Kink;
 
-/// `∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX` along w = a + X e1 for X in [x0, x1].
-pub fn line_integral<R: Rule>(ctx: &Ctx<R>, a: DVec3, e1: DVec3, x0: f64, x1: f64) -> DVec3 {
+/// `∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX` along w = a + X e1 for X in [x0, x1], the line Y = `y` of the
+/// chart (`y` is read only for a textured rect's texture factor, `rect_texture`).
+pub fn line_integral<R: Rule>(
+    ctx: &Ctx<R>,
+    a: DVec3,
+    e1: DVec3,
+    x0: f64,
+    x1: f64,
+    y: f64,
+) -> DVec3 {
     let (lo, hi) = match clip_horizon(ctx.n, a, e1, x0, x1) {
         Some(v) => v,
         None => return DVec3::ZERO,
@@ -62,6 +70,10 @@ pub fn line_integral<R: Rule>(ctx: &Ctx<R>, a: DVec3, e1: DVec3, x0: f64, x1: f6
             }
         }
     }
+    if let Some(t) = &ctx.tex {
+        // The texture's vertical break lines (texel-centre lines or texel edges).
+        bps.extend(t.xs.iter().map(|&x| (x, false)));
+    }
     bps.retain(|b| b.0 >= lo && b.0 <= hi);
     bps.sort_by(|p, q| p.0.total_cmp(&q.0));
     // The line's closest approach to x: X* and the width √m/|e1|, m = |a × e1|²/|e1|².
@@ -98,7 +110,11 @@ pub fn line_integral<R: Rule>(ctx: &Ctx<R>, a: DVec3, e1: DVec3, x0: f64, x1: f6
                     }
                     let l2 = wv.length_squared();
                     let e = -wv / l2.sqrt();
-                    shaping(ctx.p, e) * (nw / (l2 * l2) * dx)
+                    let v = shaping(ctx.p, e) * (nw / (l2 * l2) * dx);
+                    match &ctx.tex {
+                        Some(t) => v * t.value(xx, y),
+                        None => v,
+                    }
                 });
             }
         }

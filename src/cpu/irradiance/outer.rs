@@ -52,11 +52,13 @@ pub fn chart_integral<R: Rule>(
     if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
         return DVec3::ZERO;
     }
+    let tex = super::rect_texture::chart_texture(p, chart);
     let ctx = Ctx {
         p,
         n,
-        unshaped: p.shaping.is_none(),
+        unshaped: p.shaping.is_none() && tex.is_none(),
         rule,
+        tex,
     };
     let mut total = DVec3::ZERO;
     for w in ys.windows(2) {
@@ -72,7 +74,7 @@ pub fn chart_integral<R: Rule>(
                 }
                 match chart.x_interval(y) {
                     Some((x0, x1)) => {
-                        line_integral(&ctx, chart.w0 + chart.e2 * y, chart.e1, x0, x1)
+                        line_integral(&ctx, chart.w0 + chart.e2 * y, chart.e1, x0, x1, y)
                             * (dy * chart.jac)
                     }
                     None => DVec3::ZERO,
@@ -107,6 +109,7 @@ pub fn line_irradiance<R: Rule>(
         n,
         unshaped: p.shaping.is_none(),
         rule,
+        tex: None,
     };
-    p.base * line_integral(&ctx, p.origin - x, m * DVec3::X, -hl, hl) * weight
+    p.base * line_integral(&ctx, p.origin - x, m * DVec3::X, -hl, hl, 0.0) * weight
 }

@@ -1,0 +1,210 @@
+//! CPU (f64) vs GPU (f32) conformance of textured RectLights (DESIGN.md §6 "RectLight texture",
+//! §5): generated textures of several sizes, both filters, identity, rotated, non-uniformly
+//! scaled and sheared transforms, shaped and unshaped; emission, radiance and intensity within a
+//! relative 1e-4 per channel (irradiance of a textured rect is the CPU reference's on both paths,
+//! `query::irradiance_on_host`).
+//!
+//! Excluded radiance samples (documented divergences 1 and 7 of shaders/shared/dome.wgsl): rays
+//! meeting the light's plane within a relative 1e-3 of the rect's edge (f32 may hit or miss),
+//! and with the nearest filter within 1e-3 px of a texel edge (f32 may pick the neighbour).
+//! Both counted and printed. Texel values are linear in [0.21, 1] (8-bit sRGB 128..255).
+
+mod common;
+
+use glam::{DMat3, DMat4, DQuat, DVec3};
+use luxeval::testkit::Rng;
+use luxeval::testkit::rect::{near_rect_discontinuity, prepare_rects_with_filter};
+use luxeval::{Accumulate, Asset, Evaluator, Light, LightType, Shaping, Texture};
+
+const TOL: f64 = 1e-4;
+
+fn png(w: u32, h: u32, rng: &mut Rng) -> Asset {
+    let img = image::RgbImage::from_fn(w, h, |_, _| {
+        image::Rgb([0, 1, 2].map(|_| 128 + rng.below(128) as u8))
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
+}
+
+fn unit(rng: &mut Rng) -> DVec3 {
+    let z: f64 = 2.0 * rng.f64() - 1.0;
+    let p = std::f64::consts::TAU * rng.f64();
+    let r = (1.0 - z * z).sqrt();
+    DVec3::new(r * p.cos(), r * p.sin(), z)
+}
+
+fn f32s(v: DVec3) -> [f32; 3] {
+    [v.x as f32, v.y as f32, v.z as f32]
+}
+
+const SIZES: [(u32, u32); 4] = [(1, 1), (2, 3), (7, 5), (16, 9)];
+
+fn transforms() -> [DMat4; 4] {
+    let rot = DQuat::from_axis_angle(DVec3::new(0.3, -0.5, 0.8).normalize(), 0.9);
+    let shear = DMat4::from_mat3(DMat3::from_cols(
+        DVec3::new(1.3, 0.0, 0.0),
+        DVec3::new(0.4, 0.8, 0.0),
+        DVec3::new(0.0, 0.2, 1.1),
+    ));
+    [
+        DMat4::IDENTITY,
+        DMat4::from_rotation_translation(rot, DVec3::new(1.0, -2.0, 0.5)),
+        DMat4::from_scale_rotation_translation(DVec3::new(2.0, 0.5, 1.5), rot, DVec3::Y),
+        DMat4::from_rotation_translation(rot, DVec3::new(-0.5, 0.3, 2.0)) * shear,
+    ]
+}
+
+fn rects(rng: &mut Rng) -> Vec<(Light, DMat4)> {
+    let mut out = Vec::new();
+    for (k, (w, h)) in SIZES.into_iter().enumerate() {
+        let file = png(w, h, rng);
+        for (j, m) in transforms().into_iter().enumerate() {
+            let mut l = Light::rect(1.0 + 0.3 * k as f64, 0.6 + 0.2 * j as f64)
+                .with_path(format!("/Rect_{k}_{j}"))
+                .with_intensity(1.5 + j as f64)
+                .with_transform(m)
+                .with_texture(Texture::new(file.clone()));
+            if (k + j) % 2 == 1 {
+                l = l.with_shaping(Shaping {
+                    focus: 1.5,
+                    focus_tint: DVec3::new(0.2, 0.5, 1.0),
+                    cone_angle: 70.0,
+                    cone_softness: 0.5,
+                    ies: None,
+                });
+            }
+            out.push((l, m));
+        }
+    }
+    out
+}
+
+/// Relative difference per channel, against at least 1e-3 of the light's largest value of that
+/// query (an absolute 1e-7 of the peak): a shaped light's smoothstep tail carries f32's relative
+/// error of the smoothstep near its zero, which is the untextured shaping's divergence, not
+/// the texture's (tests/conformance.rs bounds it).
+fn rel(g: [f32; 3], c: [f32; 3], peak: f64) -> f64 {
+    (0..3)
+        .map(|i| {
+            (g[i] as f64 - c[i] as f64).abs() / (c[i] as f64).abs().max(1e-3 * peak).max(1e-30)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn gpu_matches_cpu_on_textured_rects() {
+    let Some(gpu) = common::gpu() else { return };
+    let cpu = Evaluator::cpu();
+    let mut rng = Rng::new(0x4EC7);
+    let lights = rects(&mut rng);
+    let models: Vec<Light> = lights.iter().map(|(l, _)| l.clone()).collect();
+    let n = 800;
+    let mut total = 0usize;
+    let mut excluded = 0usize;
+    let mut hits = 0usize;
+    let mut worst = (0.0f64, String::new());
+    let mut failures = Vec::new();
+    for nearest in [false, true] {
+        let g = prepare_rects_with_filter(&gpu, &models, nearest).expect("GPU scene");
+        let c = prepare_rects_with_filter(&cpu, &models, nearest).expect("CPU scene");
+        for (l, (light, m)) in lights.iter().enumerate() {
+            // Emission and intensity: any direction (about half on the emitting side).
+            let dirs: Vec<[f32; 3]> = (0..n).map(|_| f32s(unit(&mut rng))).collect();
+            // Radiance: from points on the emitting side (local −Z) toward random points of the
+            // rect (and a little beyond its edges).
+            let (mut points, mut rays) = (Vec::new(), Vec::new());
+            let LightType::Rect { width, height } = light.kind else {
+                unreachable!()
+            };
+            for _ in 0..n {
+                let from = DVec3::new(
+                    2.0 * rng.f64() - 1.0,
+                    2.0 * rng.f64() - 1.0,
+                    -0.2 - 2.0 * rng.f64(),
+                );
+                let to = DVec3::new(
+                    (rng.f64() - 0.5) * 1.1 * width,
+                    (rng.f64() - 0.5) * 1.1 * height,
+                    0.0,
+                );
+                let x = m.transform_point3(from);
+                points.push(f32s(x));
+                rays.push(f32s((m.transform_point3(to) - x).normalize()));
+            }
+            let skip = near_rect_discontinuity(light, &points, &rays, nearest, 1e-3).unwrap();
+            let results = [
+                (
+                    "emission",
+                    g.emission(&dirs, Accumulate::PerLight).unwrap(),
+                    c.emission(&dirs, Accumulate::PerLight).unwrap(),
+                    None,
+                ),
+                (
+                    "intensity",
+                    g.intensity(&dirs, Accumulate::PerLight).unwrap(),
+                    c.intensity(&dirs, Accumulate::PerLight).unwrap(),
+                    None,
+                ),
+                (
+                    "radiance",
+                    g.radiance(&points, &rays, Accumulate::PerLight).unwrap(),
+                    c.radiance(&points, &rays, Accumulate::PerLight).unwrap(),
+                    Some(&skip),
+                ),
+            ];
+            for (query, gv, cv, skip) in &results {
+                let peak = (0..n)
+                    .map(|i| {
+                        cv[l * n + i]
+                            .iter()
+                            .fold(0.0f64, |a, &b| a.max(b.abs() as f64))
+                    })
+                    .fold(0.0, f64::max);
+                for i in 0..n {
+                    if skip.is_some_and(|s| s[i]) {
+                        excluded += 1;
+                        continue;
+                    }
+                    let (gg, cc) = (gv[l * n + i], cv[l * n + i]);
+                    if *query == "radiance" && cc != [0.0; 3] {
+                        hits += 1;
+                    }
+                    total += 1;
+                    let e = rel(gg, cc, peak);
+                    let what = format!(
+                        "{query} {} nearest={nearest} sample {i}: gpu {gg:?} cpu {cc:?}",
+                        light.path
+                    );
+                    if e > worst.0 {
+                        worst = (e, what.clone());
+                    }
+                    if e > TOL {
+                        failures.push((e, what));
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "rect texture conformance on {}: {total} compared ({hits} radiance hits), {excluded} excluded, worst {:.3e} ({})",
+        gpu.device_name(),
+        worst.0,
+        worst.1
+    );
+    assert!(hits > total / 6, "too few radiance hits: {hits}");
+    assert!(excluded < total / 20, "too many excluded: {excluded}");
+    let mut by: std::collections::BTreeMap<String, usize> = Default::default();
+    for (_, w) in &failures {
+        let key: Vec<&str> = w.split_whitespace().take(3).collect();
+        *by.entry(key.join(" ")).or_default() += 1;
+    }
+    println!("failures by light: {by:?}");
+    failures.sort_by(|a, b| b.0.total_cmp(&a.0));
+    assert!(
+        failures.is_empty(),
+        "{} of {total} beyond {TOL}: {:#?}",
+        failures.len(),
+        &failures[..failures.len().min(10)]
+    );
+}
