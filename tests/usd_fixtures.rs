@@ -426,7 +426,6 @@ fn scene_lights_and_warnings() {
         "/World/Blink", // invisible at 0, visible from 2
         "/World/Defaults/Portal",
         "/World/Defaults/MeshLight",
-        "/World/Shaped/Textured",
     ] {
         assert!(!paths.contains(&skipped), "{skipped} evaluated");
         assert!(
@@ -459,8 +458,20 @@ fn scene_lights_and_warnings() {
             .as_deref()
             .is_some_and(|r| r.ends_with("env/sky.png"))
     );
+    // A texture that cannot be read is an error naming the prim and the file when the light is
+    // prepared, never a skip or an untextured light.
+    let missing = get("/World/Shaped/MissingTexture").light.clone().unwrap();
+    let e = luxeval::Reference::new(&missing, luxeval::TemperatureMode::Spec)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("/World/Shaped/MissingTexture") && e.contains("does_not_exist.png"),
+        "{e}"
+    );
     for kept in [
         "/World/Shaped/Ies",
+        "/World/Shaped/Textured",
+        "/World/Shaped/MissingTexture",
         "/World/Env/Sky",
         "/World/Env/Uniform",
         "/World/Untyped/UnderUntyped",
