@@ -8,7 +8,7 @@
 //! output image as a dome of its format must give back the chart's colour in every direction;
 //! tests/dome_formats.rs checks it at the six axes.
 //!
-//! Run: `cargo run --release --no-default-features --example dome_formats`
+//! Run: `cargo run --release --ignore-rust-version --example dome_formats`
 
 use std::f64::consts::PI;
 use std::path::Path;

@@ -2,8 +2,8 @@
 //! scene authors, at every frame, GPU against the CPU reference within tolerance, the IES scenes
 //! included. Frames whose light references a file that is not redistributable (two BEGA
 //! photometric files, see tests/data/luxtest/README.md) must fail to prepare with an error naming
-//! the prim and the file; frames with a feature luxeval does not evaluate yet (textures) are
-//! listed by the scene with a warning. The test counts both.
+//! the prim and the file. The dome and visibleRect scenes are evaluated with their texture
+//! (`../dome_grid_2k.exr`). The test counts both.
 #![cfg(feature = "usd")]
 
 mod common;
@@ -105,10 +105,10 @@ fn every_luxtest_light_at_every_frame_is_within_tolerance() {
         skipped.iter().take(3).collect::<Vec<_>>()
     );
     // rect/sphere/disk/cylinder frames 51-60 and iesTest/iesLibPreview frames 1-10 use BEGA IES
-    // profiles that are not redistributable (not in tests/data); the dome is evaluated with its
-    // texture.
+    // profiles that are not redistributable (not in tests/data); dome and visibleRect are
+    // evaluated with their texture.
     assert!(
-        checked >= 4 * 50 + 35 + 1 + 2 * 21 + 2 * 98,
+        checked >= 4 * 50 + 35 + 2 + 2 * 21 + 2 * 98,
         "only {checked} light-frames were evaluable"
     );
     assert!(
