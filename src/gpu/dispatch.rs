@@ -94,8 +94,8 @@ impl GpuContext {
             self.queue
                 .write_buffer(&ies_atlas_buffer, 0, bytemuck::cast_slice(ies_atlas));
         }
-        // One atlas per scene, refused whole when over the binding limit.
-        // TODO(issue 9): tile or reduce oversized textures with a warning instead.
+        // One atlas per scene, reduced to fit the binding limit (dome_atlas::scene_atlas) where
+        // its textures allow; refused whole when it still does not fit.
         let tex_bytes = (tex_atlas.len() * 4) as u64;
         if tex_bytes > self.limits.max_storage_buffer_binding_size {
             let files: Vec<String> = tex_atlas
@@ -113,7 +113,7 @@ impl GpuContext {
             return Err(LuxError::input(
                 "dome textures",
                 format!(
-                    "the scene's dome textures ({}) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes; use smaller textures or --device cpu",
+                    "the scene's textures ({}) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes, and cannot be halved further (odd sizes); use smaller textures or --device cpu",
                     files.join(", "),
                     self.limits.max_storage_buffer_binding_size
                 ),

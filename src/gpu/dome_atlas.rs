@@ -145,37 +145,120 @@ pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     vec![("CROSS_FACE_TABLE", table)]
 }
 
+/// A texture the GPU holds at a lower resolution than the file (see [`scene_atlas`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Reduced {
+    pub path: String,
+    pub from: (usize, usize),
+    pub to: (usize, usize),
+}
+
 /// The atlas of the distinct textures of `lights` (a shared image with the same format is
-/// packed once) and, per light, the offset of its texture.
-pub fn scene_atlas(lights: &[Prepared]) -> Result<(Atlas, Vec<Option<u32>>), AtlasFull> {
-    let mut atlas = Atlas::new();
-    let mut packed: Vec<(Arc<Image>, u32, u32)> = Vec::new();
-    let mut offsets = Vec::with_capacity(lights.len());
+/// packed once), per light the offset of its texture, and the textures reduced to fit.
+///
+/// When the atlas would exceed `limit_bytes` (the device's storage binding limit), the largest
+/// reducible texture is halved in both axes by a 2 × 2 box average, again until the atlas fits
+/// (DESIGN.md §6: a texture over the adapter's limit is tiled or reduced with a warning that
+/// says which). A texture is reducible when both sizes are even and, for a cube cross, the face
+/// size too (boxes never straddle faces); a latlong stays 2:1. Halving is what a mip level is:
+/// each reduced texel is the mean of the four it covers. The CPU reference always reads the
+/// full texture, so the GPU's values for a reduced texture differ from it by design.
+pub fn scene_atlas(
+    lights: &[Prepared],
+    limit_bytes: u64,
+) -> Result<(Atlas, Vec<Option<u32>>, Vec<Reduced>), AtlasFull> {
+    // The distinct (image, format) pairs, and each light's index into them.
+    let mut distinct: Vec<(Arc<Image>, u32)> = Vec::new();
+    let mut which = Vec::with_capacity(lights.len());
     for p in lights {
         // A dome's texture with its format's code; a rect's with FORMAT_RECT.
         let (image, code) = match (&p.texture, &p.rect_texture) {
             (Some(t), _) => (&t.image, t.format.code()),
             (None, Some(t)) => (&t.image, FORMAT_RECT),
             (None, None) => {
-                offsets.push(None);
+                which.push(None);
                 continue;
             }
         };
-        let found = packed
+        let k = match distinct
             .iter()
-            .find(|(img, f, _)| Arc::ptr_eq(img, image) && *f == code)
-            .map(|e| e.2);
-        let offset = match found {
-            Some(o) => o,
+            .position(|(img, f)| Arc::ptr_eq(img, image) && *f == code)
+        {
+            Some(k) => k,
             None => {
-                let o = atlas.push(Arc::clone(image), code)?;
-                packed.push((Arc::clone(image), code, o));
-                o
+                distinct.push((Arc::clone(image), code));
+                distinct.len() - 1
             }
         };
-        offsets.push(Some(offset));
+        which.push(Some(k));
     }
-    Ok((atlas, offsets))
+    let reduced = fit(&mut distinct, limit_bytes);
+    let mut atlas = Atlas::new();
+    let offsets: Vec<u32> = distinct
+        .iter()
+        .map(|(img, code)| atlas.push(Arc::clone(img), *code))
+        .collect::<Result<_, _>>()?;
+    let per_light = which.into_iter().map(|k| k.map(|k| offsets[k])).collect();
+    Ok((atlas, per_light, reduced))
+}
+
+/// Halves the largest reducible texture of `distinct` until the packed atlas needs at most
+/// `limit_bytes` (or none is reducible); returns what was reduced (see [`scene_atlas`]).
+fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64) -> Vec<Reduced> {
+    let words = |d: &[(Arc<Image>, u32)]| {
+        d.iter().fold(0usize, |n, (img, _)| {
+            n.next_multiple_of(4) + HEADER_WORDS + 3 * img.width * img.height
+        })
+    };
+    let mut reduced: Vec<Reduced> = Vec::new();
+    while (words(distinct) as u64).saturating_mul(4) > limit_bytes {
+        let largest = distinct
+            .iter()
+            .enumerate()
+            .filter(|(_, (img, code))| reducible(img, *code))
+            .max_by_key(|(_, (img, _))| img.width * img.height)
+            .map(|(k, _)| k);
+        let Some(k) = largest else { break };
+        let (img, code) = &distinct[k];
+        let half = Arc::new(halve(img));
+        let path = img.source.display().to_string();
+        match reduced.iter_mut().find(|r| r.path == path) {
+            Some(r) => r.to = (half.width, half.height),
+            None => reduced.push(Reduced {
+                path,
+                from: (img.width, img.height),
+                to: (half.width, half.height),
+            }),
+        }
+        distinct[k] = (half, *code);
+    }
+    reduced
+}
+
+/// Whether [`halve`] keeps `img`'s format: even sizes, and an even face size for a cross.
+fn reducible(img: &Image, code: u32) -> bool {
+    let even = img.width % 2 == 0 && img.height % 2 == 0 && img.width >= 2 && img.height >= 2;
+    even && (code != FORMAT_CROSS || (img.width / 3) % 2 == 0)
+}
+
+/// `img` at half the resolution: each texel the mean of the 2 × 2 texels it covers.
+fn halve(img: &Image) -> Image {
+    let (w, h) = (img.width / 2, img.height / 2);
+    let mut rgb = Vec::with_capacity(w * h);
+    for j in 0..h {
+        for i in 0..w {
+            let t = |di: usize, dj: usize| img.rgb[(2 * j + dj) * img.width + 2 * i + di];
+            let (a, b, c, d) = (t(0, 0), t(1, 0), t(0, 1), t(1, 1));
+            rgb.push(std::array::from_fn(|k| 0.25 * (a[k] + b[k] + c[k] + d[k])));
+        }
+    }
+    Image {
+        width: w,
+        height: h,
+        rgb,
+        envmap: img.envmap,
+        source: img.source.clone(),
+    }
 }
 
 #[cfg(test)]
@@ -184,6 +267,52 @@ mod tests {
 
     fn img(w: usize, h: usize, v: f32) -> Arc<Image> {
         Arc::new(Image::from_rgb(w, h, vec![[v, 2.0 * v, 3.0 * v]; w * h], "t.png").unwrap())
+    }
+
+    #[test]
+    fn textures_over_the_limit_are_halved_until_they_fit() {
+        // A 16 × 8 latlong of distinct texels, a 6 × 8 cross (N = 2, even) and an odd 3 × 3.
+        let lat = Arc::new(
+            Image::from_rgb(
+                16,
+                8,
+                (0..128).map(|k| [k as f32, 1.0, 2.0]).collect(),
+                "lat.exr",
+            )
+            .unwrap(),
+        );
+        let mut d = vec![
+            (lat.clone(), FORMAT_LATLONG),
+            (img(6, 8, 1.0), FORMAT_CROSS),
+            (img(3, 3, 1.0), FORMAT_ANGULAR),
+        ];
+        let words = |d: &[(Arc<Image>, u32)]| {
+            d.iter().fold(0usize, |n, (i, _)| {
+                n.next_multiple_of(4) + HEADER_WORDS + 3 * i.width * i.height
+            })
+        };
+        // Room for everything: nothing reduced.
+        let all = 4 * words(&d) as u64;
+        assert!(fit(&mut d, all).is_empty());
+        // One word short: the largest reducible texture (the latlong) is halved once.
+        let r = fit(&mut d, all - 4);
+        assert_eq!(
+            r,
+            vec![Reduced {
+                path: "lat.exr".into(),
+                from: (16, 8),
+                to: (8, 4)
+            }]
+        );
+        // Each reduced texel is the mean of the 2 × 2 it covers: texel (i, j) of the original is
+        // 16j + i, so reduced (1, 1) averages 34, 35, 50, 51.
+        assert_eq!(d[0].0.rgb[8 + 1], [42.5, 1.0, 2.0]);
+        // Far too little room: the 6 × 8 cross (N = 2) halves to 3 × 4 (N = 1, not halvable
+        // again), the latlong down to 2 × 1; the odd 3 × 3 is never touched.
+        let r = fit(&mut d, 4);
+        let sizes: Vec<(usize, usize)> = d.iter().map(|(i, _)| (i.width, i.height)).collect();
+        assert_eq!(sizes, [(2, 1), (3, 4), (3, 3)]);
+        assert_eq!(r.len(), 2, "{r:?}");
     }
 
     #[test]

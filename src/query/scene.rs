@@ -20,6 +20,9 @@ pub struct PreparedScene {
     gpu: Option<GpuLights>,
     /// The buffers of the last GPU call, reused by the next call of the same size class.
     scratch: Mutex<Option<Scratch>>,
+    /// What the caller should know about how the scene is evaluated (textures the GPU holds
+    /// reduced); see [`PreparedScene::warnings`].
+    warnings: Vec<String>,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -39,13 +42,24 @@ impl PreparedScene {
     /// A scene of lights already prepared (the GPU records are packed from exactly these
     /// constants).
     pub(crate) fn from_prepared(backend: Backend, lights: Vec<Prepared>) -> Result<Self> {
+        let mut warnings = Vec::new();
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
                 let (atlas, bases) = ies_atlas::scene_atlas(&lights)
                     .map_err(|e| LuxError::input("IES profiles", e.to_string()))?;
-                let (tex_atlas, offsets) = dome_atlas::scene_atlas(&lights)
-                    .map_err(|e| LuxError::input("dome textures", e.to_string()))?;
+                let limit = g.device_limits().max_storage_buffer_binding_size;
+                let (tex_atlas, offsets, reduced) = dome_atlas::scene_atlas(&lights, limit)
+                    .map_err(|e| LuxError::input("textures", e.to_string()))?;
+                for r in reduced {
+                    warnings.push(format!(
+                        "{}: the GPU reads this {} × {} texture reduced to {} × {} (2 × 2 box \
+                         averages), to fit the device's storage binding limit of {limit} bytes; \
+                         its GPU values differ from the CPU reference (--device cpu), which reads \
+                         it in full",
+                        r.path, r.from.0, r.from.1, r.to.0, r.to.1
+                    ));
+                }
                 let records: Vec<record::Record> = lights
                     .iter()
                     .zip(bases)
@@ -60,7 +74,15 @@ impl PreparedScene {
             lights,
             gpu,
             scratch: Mutex::new(None),
+            warnings,
         })
+    }
+
+    /// Warnings about how this scene is evaluated: each texture the GPU holds at a lower
+    /// resolution than its file because the scene's textures exceed the device's storage
+    /// binding limit (named with both sizes). Empty on the CPU reference.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// The number of lights.

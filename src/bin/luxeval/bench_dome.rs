@@ -103,6 +103,11 @@ pub fn run(
             let (c0, t0) = (cpu_time(), Instant::now());
             let scene = eval.prepare(std::slice::from_ref(&light))?;
             let wall = t0.elapsed().as_secs_f64();
+            if runs.is_empty() {
+                for w in scene.warnings() {
+                    eprintln!("warning: {w}");
+                }
+            }
             let cpu = cpu_time().zip(c0).map(|(a, b)| a - b);
             dims = scene.texture_size(0).unwrap_or((0, 0));
             drop(scene);

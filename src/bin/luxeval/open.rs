@@ -67,5 +67,8 @@ pub fn prepare(
     let scene = eval
         .prepare(&lights)
         .map_err(|e| in_scene(&args.scene, e))?;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
     Ok((eval, scene))
 }
