@@ -46,7 +46,12 @@ fn each_format_picture_shows_the_chart_around_every_axis() {
     evals.extend(common::gpu());
     for eval in &evals {
         let want = eval
-            .radiance(std::slice::from_ref(&chart), &points, &dirs, Accumulate::Sum)
+            .radiance(
+                std::slice::from_ref(&chart),
+                &points,
+                &dirs,
+                Accumulate::Sum,
+            )
             .unwrap();
         // The chart's faces are near-saturated (its cyan is (0, 0.86, 1) in linear): each
         // channel clearly on or off, as A8 names the colour.
@@ -66,9 +71,11 @@ fn each_format_picture_shows_the_chart_around_every_axis() {
             (TextureFormat::CubeMapVerticalCross, "cubeMapVerticalCross"),
         ] {
             let dome = Light::dome().with_path(format!("/{name}")).with_texture(
-                Texture::new(Asset::file(file(&format!("assets/dome_formats/{name}.png"))))
-                    .with_format(format)
-                    .with_filter(TextureFilter::Nearest),
+                Texture::new(Asset::file(file(&format!(
+                    "assets/dome_formats/{name}.png"
+                ))))
+                .with_format(format)
+                .with_filter(TextureFilter::Nearest),
             );
             let got = eval
                 .radiance(std::slice::from_ref(&dome), &points, &dirs, Accumulate::Sum)

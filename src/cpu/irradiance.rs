@@ -48,6 +48,17 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3) -> DVec3 {
     irradiance_with(p, x, n, &Adaptive::REFERENCE)
 }
 
+/// A textured dome's irradiance by the 9-coefficient spherical-harmonics fast path
+/// ([`dome::sh`]), `diffuse` applied: an approximation whose error against [`irradiance`] depends
+/// on the map (README "Dome textures" gives measured figures). `None` for other lights.
+pub fn irradiance_sh9(p: &Prepared, n: DVec3) -> Option<DVec3> {
+    if p.light.kind != LightType::Dome {
+        return None;
+    }
+    let t = dome::tables(p)?;
+    Some(p.base * t.irradiance_sh9(n) * p.light.inputs.diffuse)
+}
+
 /// [`irradiance`] with the quadrature's [`Rule`] chosen (closed forms are used either way).
 pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> DVec3 {
     let e = match p.light.kind {

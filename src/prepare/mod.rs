@@ -250,8 +250,8 @@ fn prepare_texture(
     })
 }
 
-/// Loads a RectLight's texture (once per file, through `cache`) with the default filter and its
-/// exact area mean (DESIGN.md §6 "RectLight texture").
+/// Loads a RectLight's texture (once per file, through `cache`) with its filter and its exact
+/// area mean (DESIGN.md §6 "RectLight texture").
 fn prepare_rect_texture(
     light: &Light,
     t: &Texture,
@@ -263,7 +263,7 @@ fn prepare_rect_texture(
         path: t.file.authored.clone(),
         source,
     })?;
-    Ok(dome::RectTexture::new(image, dome::Filter::default()))
+    Ok(dome::RectTexture::new(image, t.filter))
 }
 
 /// The largest magnitude of a length (a position, a size, an entry of the world transform or

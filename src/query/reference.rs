@@ -86,6 +86,20 @@ impl Reference {
         })
     }
 
+    /// A textured dome's irradiance on a receiver with normal `n` by the fast path: the dome's
+    /// filtered texture projected once onto 9 spherical-harmonic coefficients (Ramamoorthi and
+    /// Hanrahan; what Filament and most real-time renderers use), then 9 multiply-adds per
+    /// normal. An approximation: bands ≥ 3 are dropped, and README "Dome textures" gives its
+    /// measured error against the exact [`Reference::irradiance`]. `None` for other lights (and
+    /// a zero normal).
+    pub fn dome_irradiance_sh9(&self, n: DVec3) -> Option<DVec3> {
+        let len = n.length();
+        if !(len > 0.0 && len.is_finite()) {
+            return None;
+        }
+        cpu::irradiance::irradiance_sh9(&self.p, n / len)
+    }
+
     /// irradiance at `x` on a receiver with normal `n` (any length; 0 for a zero normal),
     /// `diffuse` applied.
     pub fn irradiance(&self, x: DVec3, n: DVec3) -> DVec3 {

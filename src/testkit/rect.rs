@@ -29,13 +29,6 @@ pub(crate) fn set_rect_filter(prepared: &mut [Prepared], nearest: bool) {
     }
 }
 
-/// One light prepared (spec temperature mode) with its rect texture read through the filter.
-pub(crate) fn prepare_rect(light: &Light, nearest: bool) -> Result<Prepared> {
-    let mut p = vec![Prepared::new(light, TemperatureMode::Spec)?];
-    set_rect_filter(&mut p, nearest);
-    Ok(p.remove(0))
-}
-
 /// Prepares `lights` on `eval` with every rect texture read through the filter.
 pub fn prepare_rects_with_filter(
     eval: &Evaluator,

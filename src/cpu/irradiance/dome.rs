@@ -61,7 +61,6 @@ const REL_TOL: f64 = 1e-12;
 pub struct DomeIrradiance {
     pub img: Arc<Image>,
     pub format: DomeFormat,
-    pub filter: Filter,
     pub frame: DomeFrame,
     geom: Geometry,
     grids: Vec<PieceGrid>,
@@ -70,6 +69,8 @@ pub struct DomeIrradiance {
     /// Upper bound of the frame's condition number.
     kappa: f64,
     tables: OnceLock<Tables>,
+    /// The 9-coefficient fast path, projected on first use.
+    sh9: OnceLock<sh::IrradianceSh>,
 }
 
 struct Tile {
@@ -151,13 +152,13 @@ impl DomeIrradiance {
         Ok(DomeIrradiance {
             img,
             format,
-            filter,
             frame,
             geom,
             grids,
             conformal,
             kappa: kappa.max(1.0),
             tables: OnceLock::new(),
+            sh9: OnceLock::new(),
         })
     }
 
@@ -289,11 +290,6 @@ impl DomeIrradiance {
 
     fn tables(&self) -> &Tables {
         self.tables.get_or_init(|| self.build())
-    }
-
-    /// Builds the tables now (they are otherwise built on the first query).
-    pub fn prepare(&self) {
-        let _ = self.tables();
     }
 
     fn build(&self) -> Tables {
@@ -478,10 +474,11 @@ impl DomeIrradiance {
         DVec3::from_array(v)
     }
 
-    /// [`Self::irradiance`] for many normals, in parallel.
-    pub fn irradiance_many(&self, normals: &[DVec3]) -> Vec<DVec3> {
-        self.prepare();
-        normals.par_iter().map(|&n| self.irradiance(n)).collect()
+    /// The fast path's `E(n)` (see [`sh`]): nine multiply-adds per channel once projected.
+    pub fn irradiance_sh9(&self, n: DVec3) -> DVec3 {
+        self.sh9
+            .get_or_init(|| sh::IrradianceSh::project(self))
+            .irradiance(n)
     }
 
     /// For latlong under a conformal frame: the dome-space moments `∫ L dd`, `∫ L d dd` and
