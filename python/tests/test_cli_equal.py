@@ -109,8 +109,8 @@ def test_luxtest_equals_cli(cli, tmp_path, device, scene):
     frame = 15 if scene.stem.startswith("ies") else 5
     stage = luxeval.Stage(scene, time=frame)
     dirs = sphere_dirs(512, seed=5)
-    # Scenes whose lights luxeval cannot evaluate yet (IES, textured domes) give zeros, with a
-    # warning on the first query, as the CLI gives zeros with a warning.
+    # Scenes whose lights luxeval cannot evaluate give zeros, with a warning on the first query,
+    # as the CLI gives zeros with a warning.
     nothing = not stage.light_paths()
     with pytest.warns(UserWarning, match="no light to evaluate") if nothing else nullcontext():
         got = stage.emission(dirs, per_light=True, device=device)
@@ -118,6 +118,11 @@ def test_luxtest_equals_cli(cli, tmp_path, device, scene):
     assert got.shape == (len(stage.light_paths()), 512, 3)
     np.testing.assert_array_equal(got, want)
 
+    if scene.stem == "visibleRect":
+        # Its 2048 × 1024 rect texture's exact irradiance costs ~50 s per receiver on the CPU
+        # reference (README "Not supported yet"); textured-rect irradiance is tested in Rust on
+        # small textures.
+        return
     points = floor_points(256, half=5.0, seed=6)
     normals = np.tile(np.float32([0, 1, 0]), (256, 1))
     got = stage.irradiance(points, normals, device=device)
