@@ -18,6 +18,7 @@ mod lights;
 pub use lights::lights_json;
 pub use reference::{Power, Reference};
 pub use scene::PreparedScene;
+#[cfg(any(test, feature = "testkit"))]
 pub(crate) use scene::irradiance_on_host;
 
 /// Where queries run.
