@@ -75,8 +75,9 @@ pub enum LuxError {
         light: String,
         attr: String,
         path: String,
+        /// Boxed: the readers' errors are large, and every `Result` of the crate carries this.
         #[source]
-        source: AssetError,
+        source: Box<AssetError>,
     },
 
     /// A file's content is malformed or unsupported.
@@ -145,6 +146,17 @@ impl LuxError {
             attr: attr.to_string(),
             value: value.to_string(),
             reason: reason.into(),
+        }
+    }
+
+    /// A file light `light` references through attribute `attr` (authored as `path`) cannot
+    /// be used.
+    pub(crate) fn asset(light: &str, attr: &str, path: &str, source: AssetError) -> Self {
+        LuxError::Asset {
+            light: light.into(),
+            attr: attr.into(),
+            path: path.into(),
+            source: Box::new(source),
         }
     }
 

@@ -613,7 +613,7 @@ fn blender_studio_maps_decode_and_evaluate() {
     }
     let normals: Vec<[f32; 3]> = dirs[..16].to_vec();
     let e = Evaluator::cpu()
-        .irradiance(&lights, &vec![[0.0; 3]; 16], &normals, Accumulate::Sum)
+        .irradiance(&lights, &[[0.0; 3]; 16], &normals, Accumulate::Sum)
         .unwrap();
     assert!(
         e.iter()

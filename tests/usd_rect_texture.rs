@@ -62,8 +62,8 @@ fn a_textured_rect_light_is_read_and_evaluated() {
     // Emission along the normal (−Z): intensity × the texel mean.
     let mut mean = [0.0f64; 3];
     for p in img.pixels() {
-        for c in 0..3 {
-            mean[c] += srgb(p.0[c]) / (w * h) as f64;
+        for (m, v) in mean.iter_mut().zip(p.0) {
+            *m += srgb(v) / (w * h) as f64;
         }
     }
     let e = scene

@@ -145,6 +145,9 @@ pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     vec![("CROSS_FACE_TABLE", table)]
 }
 
+/// The atlas, each light's texture offset, and the textures reduced to fit.
+pub type SceneAtlas = (Atlas, Vec<Option<u32>>, Vec<Reduced>);
+
 /// A texture the GPU holds at a lower resolution than the file (see [`scene_atlas`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Reduced {
@@ -163,10 +166,7 @@ pub struct Reduced {
 /// size too (boxes never straddle faces); a latlong stays 2:1. Halving is what a mip level is:
 /// each reduced texel is the mean of the four it covers. The CPU reference always reads the
 /// full texture, so the GPU's values for a reduced texture differ from it by design.
-pub fn scene_atlas(
-    lights: &[Prepared],
-    limit_bytes: u64,
-) -> Result<(Atlas, Vec<Option<u32>>, Vec<Reduced>), AtlasFull> {
+pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, AtlasFull> {
     // The distinct (image, format) pairs, and each light's index into them.
     let mut distinct: Vec<(Arc<Image>, u32)> = Vec::new();
     let mut which = Vec::with_capacity(lights.len());
@@ -237,8 +237,11 @@ fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64) -> Vec<Reduced> {
 
 /// Whether [`halve`] keeps `img`'s format: even sizes, and an even face size for a cross.
 fn reducible(img: &Image, code: u32) -> bool {
-    let even = img.width % 2 == 0 && img.height % 2 == 0 && img.width >= 2 && img.height >= 2;
-    even && (code != FORMAT_CROSS || (img.width / 3) % 2 == 0)
+    let even = img.width.is_multiple_of(2)
+        && img.height.is_multiple_of(2)
+        && img.width >= 2
+        && img.height >= 2;
+    even && (code != FORMAT_CROSS || (img.width / 3).is_multiple_of(2))
 }
 
 /// `img` at half the resolution: each texel the mean of the 2 × 2 texels it covers.

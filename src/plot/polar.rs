@@ -20,10 +20,13 @@ pub struct Curve {
 pub const RED: [u8; 3] = [200, 30, 30];
 pub const BLUE: [u8; 3] = [30, 70, 200];
 
+/// A plane pair's label, colour and (signed angle, direction) samples.
+pub type PlaneDirections = (&'static str, [u8; 3], Vec<(f64, DVec3)>);
+
 /// The light-space unit directions of the two plane pairs, every `step` degrees: C0–C180
 /// (`e = (sin s, 0, −cos s)`) and C90–C270 (`e = (0, sin s, −cos s)`), s the signed angle from
 /// nadir in [−180°, 180°]; each with its label and colour.
-pub fn plane_directions(step: f64) -> [(&'static str, [u8; 3], Vec<(f64, DVec3)>); 2] {
+pub fn plane_directions(step: f64) -> [PlaneDirections; 2] {
     let n = (360.0 / step).round().max(4.0) as usize;
     let sample = |plane: fn(f64, f64) -> DVec3| -> Vec<(f64, DVec3)> {
         (0..=n)

@@ -28,9 +28,12 @@ pub const FORMAT_RECT: u32 = 4;
 pub const FILTER_BILINEAR: u32 = 0;
 pub const FILTER_NEAREST: u32 = 1;
 
+/// One face of §6 D5's table: F, R, U and the block (column, row).
+pub type CrossFace = ([f64; 3], [f64; 3], [f64; 3], [f64; 2]);
+
 /// §6 D5's table, faces numbered +X, −X, +Y, −Y, +Z, −Z = 0..5: (F, R, U) and the face's block
 /// (column, row) in the vertical cross.
-pub const CROSS_FACES: [([f64; 3], [f64; 3], [f64; 3], [f64; 2]); 6] = [
+pub const CROSS_FACES: [CrossFace; 6] = [
     (
         [1.0, 0.0, 0.0],
         [0.0, 0.0, 1.0],
@@ -228,12 +231,12 @@ impl DomeFrame {
     }
 
     /// World direction → dome direction (§6 D1; `dome_direction` of `src/cpu/dome.rs`).
-    pub fn to_dome(&self, w: DVec3) -> DVec3 {
+    pub fn to_dome(self, w: DVec3) -> DVec3 {
         (self.inv * w).normalize()
     }
 
     /// Dome direction → world direction (unit).
-    pub fn to_world(&self, d: DVec3) -> DVec3 {
+    pub fn to_world(self, d: DVec3) -> DVec3 {
         (self.a_eff * d).normalize()
     }
 

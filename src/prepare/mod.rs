@@ -157,11 +157,13 @@ impl Prepared {
         };
         let ies = match evaluated.shaping.as_ref().and_then(|s| s.ies.as_ref()) {
             Some(i) if evaluated.kind.is_shapeable() => {
-                let profile = cache.ies(&i.file).map_err(|source| LuxError::Asset {
-                    light: light.path.clone(),
-                    attr: "inputs:shaping:ies:file".into(),
-                    path: i.file.authored.clone(),
-                    source,
+                let profile = cache.ies(&i.file).map_err(|source| {
+                    LuxError::asset(
+                        &light.path,
+                        "inputs:shaping:ies:file",
+                        &i.file.authored,
+                        source,
+                    )
                 })?;
                 let scale = if i.normalize {
                     profile.inverse_mean()
@@ -225,11 +227,8 @@ fn prepare_texture(
             ),
         ));
     }
-    let asset_err = |attr: &str, source: AssetError| LuxError::Asset {
-        light: light.path.clone(),
-        attr: attr.into(),
-        path: t.file.authored.clone(),
-        source,
+    let asset_err = |attr: &str, source: AssetError| {
+        LuxError::asset(&light.path, attr, &t.file.authored, source)
     };
     let image = cache
         .texture(&t.file)
@@ -257,11 +256,8 @@ fn prepare_rect_texture(
     t: &Texture,
     cache: &mut AssetCache,
 ) -> Result<dome::RectTexture> {
-    let image = cache.texture(&t.file).map_err(|source| LuxError::Asset {
-        light: light.path.clone(),
-        attr: "inputs:texture:file".into(),
-        path: t.file.authored.clone(),
-        source,
+    let image = cache.texture(&t.file).map_err(|source| {
+        LuxError::asset(&light.path, "inputs:texture:file", &t.file.authored, source)
     })?;
     Ok(dome::RectTexture::new(image, t.filter))
 }

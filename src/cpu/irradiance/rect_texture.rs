@@ -338,6 +338,7 @@ mod tests {
     /// `L(e) · tex(u, v) · max(0, n·ω) · max(0, N_a·e) / r²`, with `N_a = |det M| M⁻ᵀ(−Z)` the
     /// area-weighted emitting normal, `ω` from x to the surface point and `e = −ω`. Written here
     /// from DESIGN.md §2, §3 and §6 only (the shaping factor is `cpu::shaping`).
+    #[allow(clippy::too_many_arguments)]
     fn brute_force(
         p: &Prepared,
         rgb: &[[f32; 3]],
