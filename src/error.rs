@@ -111,7 +111,7 @@ pub enum AssetError {
     Texture(#[from] crate::assets::texture::TextureError),
     /// A dome texture whose `texture:format` does not fit the image (DESIGN.md §6 D5, D6).
     #[error(transparent)]
-    TextureFormat(#[from] crate::prepare::dome::FormatError),
+    TextureFormat(#[from] crate::assets::texture::FormatError),
 }
 
 /// What went wrong on the GPU, keeping wgpu's own error.

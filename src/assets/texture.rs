@@ -445,6 +445,34 @@ fn load_ldr_or_hdr(path: &Path, bytes: &[u8]) -> Result<Image, TextureError> {
     })
 }
 
+/// A format that does not fit the file (exit 2 in the CLI, §6 D5/D6). Names the file.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum FormatError {
+    #[error(
+        "{}: texture:format automatic cannot tell the layout of a {width} × {height} image (latlong needs W = 2H, cubeMapVerticalCross 4W = 3H, angular W = H)",
+        path.display()
+    )]
+    Ambiguous {
+        path: PathBuf,
+        width: usize,
+        height: usize,
+    },
+    #[error(
+        "{}: the EXR envmap attribute says ENVMAP_CUBE (six faces stacked in a strip), which is not a UsdLux format",
+        path.display()
+    )]
+    EnvmapCube { path: PathBuf },
+    #[error(
+        "{}: cubeMapVerticalCross needs W = 3N and H = 4N; the image is {width} × {height}",
+        path.display()
+    )]
+    BadCross {
+        path: PathBuf,
+        width: usize,
+        height: usize,
+    },
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

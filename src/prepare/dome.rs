@@ -9,7 +9,6 @@
 // to land; tests exercise them meanwhile.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use glam::{DMat3, DVec2, DVec3};
@@ -114,33 +113,8 @@ impl DomeFormat {
     }
 }
 
-/// A format that does not fit the file (exit 2 in the CLI, §6 D5/D6). Names the file.
-#[derive(Debug, thiserror::Error, PartialEq, Eq)]
-pub enum FormatError {
-    #[error(
-        "{}: texture:format automatic cannot tell the layout of a {width} × {height} image (latlong needs W = 2H, cubeMapVerticalCross 4W = 3H, angular W = H)",
-        path.display()
-    )]
-    Ambiguous {
-        path: PathBuf,
-        width: usize,
-        height: usize,
-    },
-    #[error(
-        "{}: the EXR envmap attribute says ENVMAP_CUBE (six faces stacked in a strip), which is not a UsdLux format",
-        path.display()
-    )]
-    EnvmapCube { path: PathBuf },
-    #[error(
-        "{}: cubeMapVerticalCross needs W = 3N and H = 4N; the image is {width} × {height}",
-        path.display()
-    )]
-    BadCross {
-        path: PathBuf,
-        width: usize,
-        height: usize,
-    },
-}
+/// A format that does not fit the file (defined with the other texture-file errors).
+pub use crate::assets::texture::FormatError;
 
 /// §6 D6 (`automatic`) and D5's size rule.
 pub fn resolve_format(requested: TextureFormat, img: &Image) -> Result<DomeFormat, FormatError> {
