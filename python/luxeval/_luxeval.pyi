@@ -12,6 +12,7 @@ __version__: str
 
 Device = Literal["auto", "gpu", "cpu"]
 TemperatureMode = Literal["spec", "usd", "planckian"]
+TextureFilter = Literal["bilinear", "nearest"]
 Lights = Optional[Union[str, Sequence[str]]]
 Vec3 = Union[Sequence[float], npt.ArrayLike]
 
@@ -40,7 +41,7 @@ class Stage:
     Raises ``InputError`` when the file is missing, unreadable or malformed (naming the file and
     line or prim). Queries take any real dtype in C or Fortran order (C-contiguous float32 is
     used without a copy) and return ``numpy.float32`` arrays; the lights are prepared once per
-    (lights, device, temperature_mode) and reused. Picklable: unpickling opens the stage again.
+    (lights, device, temperature_mode, texture_filter) and reused. Picklable: unpickling opens the stage again.
     """
 
     def __init__(self, path: Union[str, os.PathLike[str]], time: Optional[float] = None) -> None: ...
@@ -67,8 +68,11 @@ class Stage:
     def warnings(self) -> list[str]:
         """One message per light the queries skip (unsupported, invisible), naming its prim."""
     @property
-    def prepared(self) -> list[tuple[Optional[tuple[str, ...]], Literal["gpu", "cpu"], TemperatureMode]]:
-        """The prepared light sets cached on this stage: (selection or None, device, mode)."""
+    def prepared(
+        self,
+    ) -> list[tuple[Optional[tuple[str, ...]], Literal["gpu", "cpu"], TemperatureMode, TextureFilter]]:
+        """The prepared light sets cached on this stage: (selection or None, device, mode,
+        texture filter)."""
     def light_paths(self, lights: Lights = None) -> list[str]:
         """The prim paths a query with this ``lights=`` evaluates, in ``per_light`` row order."""
     def emission(
@@ -79,6 +83,7 @@ class Stage:
         lights: Lights = None,
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
     ) -> npt.NDArray[np.float32]:
         """Radiance leaving each light along each direction (N, 3) → float32 (N, 3), or
         (L, N, 3) with ``per_light=True``."""
@@ -91,6 +96,7 @@ class Stage:
         lights: Lights = None,
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
     ) -> npt.NDArray[np.float32]:
         """Radiance arriving at each point from each direction (pairs of (N, 3)) → float32
         (N, 3), or (L, N, 3) with ``per_light=True``."""
@@ -103,6 +109,7 @@ class Stage:
         lights: Lights = None,
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
     ) -> npt.NDArray[np.float32]:
         """Diffuse-weighted irradiance at each point on a receiver with the given normal →
         float32 (N, 3), or (L, N, 3) with ``per_light=True``."""
@@ -116,6 +123,7 @@ class Stage:
         lights: Lights = None,
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
     ) -> npt.NDArray[np.float32]:
         """The summed irradiance at the pixel centres of ``origin + s·u + t·v``, res = (W, H)
         → float32 (H, W, 3), row 0 at the top (the ``origin + v`` side)."""

@@ -16,7 +16,7 @@ chunk is evaluated by whichever scheduler computes it: the local threaded schedu
 
 A worker process opens the stage once, on its first chunk, and keeps it (a per-process cache
 keyed by the stage's absolute path and requested time); the stage keeps its prepared lights per
-(``lights``, device, ``temperature_mode``), so the GPU pipelines and buffers are built once per
+(``lights``, device, ``temperature_mode``, ``texture_filter``), so the GPU pipelines and buffers are built once per
 worker, not per chunk. The path must name the same file on every worker (a shared file system).
 
 Devices: each worker picks its own. With ``device="auto"`` (the default) a worker without a GPU
@@ -146,6 +146,7 @@ def _map(
     lights: Union[None, str, Sequence[str]],
     device: str,
     temperature_mode: str,
+    texture_filter: str,
     chunks: int,
 ) -> da.Array:
     path, requested = _locate(stage, time)
@@ -159,6 +160,10 @@ def _map(
         raise InputError(
             f'temperature_mode: {temperature_mode!r} is not one of "spec", "usd", "planckian"'
         )
+    if texture_filter not in ("bilinear", "nearest"):
+        raise InputError(
+            f'texture_filter: {texture_filter!r} is not one of "bilinear", "nearest"'
+        )
     if isinstance(lights, str):
         lights = [lights]
     options = {
@@ -166,6 +171,7 @@ def _map(
         "lights": None if lights is None else list(lights),
         "device": device,
         "temperature_mode": temperature_mode,
+        "texture_filter": texture_filter,
     }
     xs = [_rows(x, name, chunks) for x, name in arrays]
     first, first_name = xs[0], arrays[0][1]
@@ -205,6 +211,7 @@ def emission(
     lights: Union[None, str, Sequence[str]] = None,
     device: str = "auto",
     temperature_mode: str = "spec",
+    texture_filter: str = "bilinear",
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.emission` over a dask array of directions (N, 3), lazily.
@@ -222,6 +229,7 @@ def emission(
         lights=lights,
         device=device,
         temperature_mode=temperature_mode,
+        texture_filter=texture_filter,
         chunks=chunks,
     )
 
@@ -236,6 +244,7 @@ def radiance(
     lights: Union[None, str, Sequence[str]] = None,
     device: str = "auto",
     temperature_mode: str = "spec",
+    texture_filter: str = "bilinear",
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.radiance` over dask arrays of points and directions (N, 3) each,
@@ -249,6 +258,7 @@ def radiance(
         lights=lights,
         device=device,
         temperature_mode=temperature_mode,
+        texture_filter=texture_filter,
         chunks=chunks,
     )
 
@@ -263,6 +273,7 @@ def irradiance(
     lights: Union[None, str, Sequence[str]] = None,
     device: str = "auto",
     temperature_mode: str = "spec",
+    texture_filter: str = "bilinear",
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.irradiance` over dask arrays of points and receiver normals (N, 3)
@@ -276,5 +287,6 @@ def irradiance(
         lights=lights,
         device=device,
         temperature_mode=temperature_mode,
+        texture_filter=texture_filter,
         chunks=chunks,
     )

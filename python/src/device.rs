@@ -5,7 +5,7 @@
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use luxeval::{Evaluator, LuxError, TemperatureMode};
+use luxeval::{Evaluator, LuxError, TemperatureMode, TextureFilter};
 use pyo3::prelude::*;
 
 use crate::errors::{self, DeviceError, DeviceWarning};
@@ -40,6 +40,24 @@ pub fn parse_mode(s: &str) -> PyResult<TemperatureMode> {
         other => Err(errors::input(format!(
             "temperature_mode: {other:?} is not one of \"spec\", \"usd\", \"planckian\""
         ))),
+    }
+}
+
+/// The `texture_filter=` argument (the CLI's `--texture-filter`).
+pub fn parse_filter(s: &str) -> PyResult<TextureFilter> {
+    match s {
+        "bilinear" => Ok(TextureFilter::Bilinear),
+        "nearest" => Ok(TextureFilter::Nearest),
+        other => Err(errors::input(format!(
+            "texture_filter: {other:?} is not one of \"bilinear\", \"nearest\""
+        ))),
+    }
+}
+
+pub fn filter_name(f: TextureFilter) -> &'static str {
+    match f {
+        TextureFilter::Bilinear => "bilinear",
+        TextureFilter::Nearest => "nearest",
     }
 }
 

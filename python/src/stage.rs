@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use luxeval::falloff::{self, Plane};
-use luxeval::{Accumulate, PreparedScene, Scene, TemperatureMode, TimeRule};
+use luxeval::{Accumulate, PreparedScene, Scene, TemperatureMode, TextureFilter, TimeRule};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyMemoryError, PyUserWarning};
@@ -72,7 +72,7 @@ impl Chunks {
 /// The queries (``emission``, ``radiance``, ``irradiance``, ``falloff``) take NumPy arrays (any
 /// real dtype, C or Fortran order; C-contiguous float32 is used without a copy) and return
 /// ``numpy.float32`` arrays. The lights a query evaluates are prepared once per
-/// (``lights``, device, ``temperature_mode``) and kept on the stage: later calls reuse the
+/// (``lights``, device, ``temperature_mode``, ``texture_filter``) and kept on the stage: later calls reuse the
 /// prepared lights, the GPU pipelines and buffers. The GIL is released while the device works,
 /// and Ctrl-C stops a long call with ``KeyboardInterrupt`` between chunks.
 ///
@@ -100,6 +100,7 @@ struct Key {
     select: Vec<String>,
     gpu: bool,
     mode: TemperatureMode,
+    filter: TextureFilter,
 }
 
 /// The options every query takes.
@@ -107,14 +108,21 @@ struct Options {
     select: Vec<String>,
     device: Device,
     mode: TemperatureMode,
+    filter: TextureFilter,
 }
 
 impl Options {
-    fn parse(lights: Option<&Bound<'_, PyAny>>, device: &str, mode: &str) -> PyResult<Options> {
+    fn parse(
+        lights: Option<&Bound<'_, PyAny>>,
+        device: &str,
+        mode: &str,
+        filter: &str,
+    ) -> PyResult<Options> {
         Ok(Options {
             select: parse_lights(lights)?,
             device: Device::parse(device)?,
             mode: device::parse_mode(mode)?,
+            filter: device::parse_filter(filter)?,
         })
     }
 }
@@ -166,13 +174,16 @@ impl Stage {
     /// The prepared scene for these options, from the cache or prepared now.
     fn prepare_for(&self, py: Python<'_>, o: &Options) -> PyResult<Arc<PreparedScene>> {
         // Selection and attribute errors first: they cost nothing to find, a device does.
-        let lights = self
+        let mut lights = self
             .scene
             .evaluable(&o.select)
             .map_err(|e| errors::lux(e, Some(self.file())))?;
-        for l in &lights {
+        for l in &mut lights {
             l.validate()
                 .map_err(|e| errors::lux(e, Some(self.file())))?;
+            if let Some(t) = &mut l.texture {
+                t.filter = o.filter;
+            }
         }
         let eval = device::evaluator(py, o.device, o.mode)?;
         let mut select = o.select.clone();
@@ -182,6 +193,7 @@ impl Stage {
             select,
             gpu: eval.is_gpu(),
             mode: o.mode,
+            filter: o.filter,
         };
         if let Some(p) = self.cache().get(&key) {
             return Ok(p.clone());
@@ -447,17 +459,25 @@ impl Stage {
     }
 
     /// The prepared light sets cached on this stage, as (``lights`` selection as a sorted tuple
-    /// or ``None`` for every light, ``"gpu"`` or ``"cpu"``, ``temperature_mode``) tuples: each is
-    /// prepared by the first query with those options and reused by every later one.
+    /// or ``None`` for every light, ``"gpu"`` or ``"cpu"``, ``temperature_mode``,
+    /// ``texture_filter``) tuples: each is prepared by the first query with those options and
+    /// reused by every later one.
     #[getter]
     fn prepared<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyTuple>>> {
         let mut keys: Vec<Key> = self.cache().keys().cloned().collect();
         keys.sort_by(|a, b| {
-            (&a.select, a.gpu, device::mode_name(a.mode)).cmp(&(
-                &b.select,
-                b.gpu,
-                device::mode_name(b.mode),
-            ))
+            (
+                &a.select,
+                a.gpu,
+                device::mode_name(a.mode),
+                device::filter_name(a.filter),
+            )
+                .cmp(&(
+                    &b.select,
+                    b.gpu,
+                    device::mode_name(b.mode),
+                    device::filter_name(b.filter),
+                ))
         });
         keys.into_iter()
             .map(|k| {
@@ -474,6 +494,9 @@ impl Stage {
                             .into_any()
                             .unbind(),
                         PyString::new(py, device::mode_name(k.mode))
+                            .into_any()
+                            .unbind(),
+                        PyString::new(py, device::filter_name(k.filter))
                             .into_any()
                             .unbind(),
                     ],
@@ -507,9 +530,10 @@ impl Stage {
     /// ``device``: ``"auto"`` (the GPU, else the CPU reference with one ``DeviceWarning``),
     /// ``"gpu"`` (``DeviceError`` without one) or ``"cpu"`` (the f64 reference, rounded to
     /// float32). ``temperature_mode``: ``"spec"``, ``"usd"`` or ``"planckian"``.
+    /// ``texture_filter``: ``"bilinear"`` or ``"nearest"`` (dome and rect textures).
     /// Raises ``InputError`` for a wrong shape or dtype, a non-finite or zero row, an unknown
     /// light, or a light attribute luxeval cannot evaluate (naming the file, prim, attribute).
-    #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
     fn emission<'py>(
         &self,
         py: Python<'py>,
@@ -518,8 +542,9 @@ impl Stage {
         lights: Option<&Bound<'py, PyAny>>,
         device: &str,
         temperature_mode: &str,
+        texture_filter: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode)?;
+        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
         self.query(py, Query::Emission, dirs, None, per_light, o)
     }
 
@@ -528,7 +553,7 @@ impl Stage {
     ///
     /// ``points``, ``dirs``: (N, 3) each, paired row by row. Returns float32 (N, 3), or
     /// (L, N, 3) with ``per_light=True``. Options and errors as ``emission``.
-    #[pyo3(signature = (points, dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[pyo3(signature = (points, dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
     #[allow(clippy::too_many_arguments)]
     fn radiance<'py>(
         &self,
@@ -539,8 +564,9 @@ impl Stage {
         lights: Option<&Bound<'py, PyAny>>,
         device: &str,
         temperature_mode: &str,
+        texture_filter: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode)?;
+        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
         self.query(py, Query::Radiance, points, Some(dirs), per_light, o)
     }
 
@@ -551,7 +577,7 @@ impl Stage {
     /// ``points``, ``normals``: (N, 3) each, paired row by row; normals any non-zero length.
     /// Returns float32 (N, 3), or (L, N, 3) with ``per_light=True``. Options and errors as
     /// ``emission``.
-    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
     #[allow(clippy::too_many_arguments)]
     fn irradiance<'py>(
         &self,
@@ -562,8 +588,9 @@ impl Stage {
         lights: Option<&Bound<'py, PyAny>>,
         device: &str,
         temperature_mode: &str,
+        texture_filter: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode)?;
+        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
         self.query(py, Query::Irradiance, points, Some(normals), per_light, o)
     }
 
@@ -573,7 +600,7 @@ impl Stage {
     /// (width, height). Returns float32 (height, width, 3), row 0 at the top of the image
     /// (``origin + v`` side), column 0 at the ``origin`` side: pixel (row j, column i) is at
     /// ``origin + (i + ½)/W·u + (1 − (j + ½)/H)·v``. Options and errors as ``emission``.
-    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec"))]
+    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
     #[allow(clippy::too_many_arguments)]
     fn falloff<'py>(
         &self,
@@ -585,8 +612,9 @@ impl Stage {
         lights: Option<&Bound<'py, PyAny>>,
         device: &str,
         temperature_mode: &str,
+        texture_filter: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode)?;
+        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
         let origin = vec3(py, origin, "origin")?;
         let u = vec3(py, u, "u")?;
         let v = vec3(py, v, "v")?;

@@ -203,21 +203,23 @@ def test_prepared_lights_are_reused(device):
     stage.emission(dirs, device=device)
     stage.radiance(floor_points(100), dirs, device=device)
     stage.irradiance(floor_points(100), np.tile([0, 1.0, 0], (100, 1)), device=device)
-    assert stage.prepared == [(None, device, "spec")]
+    assert stage.prepared == [(None, device, "spec", "bilinear")]
     stage.emission(dirs, device=device, lights=["/lights/sun", "/lights/key"])
     stage.emission(dirs, device=device, lights=["/lights/key", "/lights/sun"])
     stage.emission(dirs, device=device, temperature_mode="usd")
+    stage.emission(dirs, device=device, texture_filter="nearest")
     assert stage.prepared == [
-        (None, device, "spec"),
-        (None, device, "usd"),
-        (("/lights/key", "/lights/sun"), device, "spec"),
+        (None, device, "spec", "bilinear"),
+        (None, device, "spec", "nearest"),
+        (None, device, "usd", "bilinear"),
+        (("/lights/key", "/lights/sun"), device, "spec", "bilinear"),
     ]
 
 
 def test_auto_is_the_gpu_when_there_is_one(has_gpu):
     stage = luxeval.Stage(STUDIO)
     stage.emission(sphere_dirs(10))
-    assert stage.prepared == [(None, "gpu" if has_gpu else "cpu", "spec")]
+    assert stage.prepared == [(None, "gpu" if has_gpu else "cpu", "spec", "bilinear")]
     assert (luxeval.device_name() != "cpu (f64 reference)") == has_gpu
 
 
@@ -237,7 +239,7 @@ def test_a_stage_pickles_by_path_and_time(tmp_path):
     assert again.lights == stage.lights and again.time == 5.0
     dirs = sphere_dirs(50)
     np.testing.assert_array_equal(again.emission(dirs, device="cpu"), stage.emission(dirs, device="cpu"))
-    assert again.prepared == [(None, "cpu", "spec")]  # prepared lights are not pickled
+    assert again.prepared == [(None, "cpu", "spec", "bilinear")]  # prepared lights are not pickled
 
 
 def test_the_gil_is_released_while_the_device_works(stage):

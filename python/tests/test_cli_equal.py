@@ -165,3 +165,22 @@ def test_temperature_mode_equals_cli(cli, tmp_path, device, mode):
     # The fill light has a colour temperature: the modes differ there.
     spec = stage.emission(dirs, per_light=True, device=device)
     assert not np.array_equal(got[1], spec[1])
+
+
+@pytest.mark.parametrize("texture_filter", ["bilinear", "nearest"])
+def test_texture_filter_equals_cli(cli, tmp_path, device, texture_filter):
+    """``texture_filter=`` is the CLI's ``--texture-filter``: luxtest's textured dome, per light,
+    equal to the CLI with the same filter; the two filters differ."""
+    scene = LUXTEST / "dome.usda"
+    stage = luxeval.Stage(scene, time=1)
+    dirs = sphere_dirs(512, seed=8)
+    got = stage.emission(dirs, per_light=True, device=device, texture_filter=texture_filter)
+    want = cli_query(
+        cli, tmp_path, "emission", scene, {"dirs": dirs}, *_flags(device, True, 1),
+        "--texture-filter", texture_filter,
+    )
+    np.testing.assert_array_equal(got, want)
+    other = "nearest" if texture_filter == "bilinear" else "bilinear"
+    assert not np.array_equal(
+        got, stage.emission(dirs, per_light=True, device=device, texture_filter=other)
+    )

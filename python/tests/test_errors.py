@@ -114,6 +114,8 @@ def test_bad_options(stage):
         stage.emission(dirs, device="tpu")
     with pytest.raises(luxeval.InputError, match=r'temperature_mode: "kelvin" is not one of'):
         stage.emission(dirs, temperature_mode="kelvin")
+    with pytest.raises(luxeval.InputError, match=r'texture_filter: "cubic" is not one of'):
+        stage.emission(dirs, texture_filter="cubic")
     with pytest.raises(luxeval.InputError, match=r"lights: /lights/nope is not a light of .*studio.usda"):
         stage.emission(dirs, lights=["/lights/key", "/lights/nope"])
     with pytest.raises(luxeval.InputError, match="lights: an empty list selects no light"):
@@ -168,7 +170,7 @@ NO_GPU_CHILD = textwrap.dedent(
     assert name == "cpu (f64 reference)", name
     assert np.array_equal(a, stage.emission(dirs, device="cpu"))
     assert np.array_equal(b, stage.emission(dirs, per_light=True, device="cpu"))
-    assert stage.prepared == [(None, "cpu", "spec")], stage.prepared
+    assert stage.prepared == [(None, "cpu", "spec", "bilinear")], stage.prepared
     try:
         stage.emission(dirs, device="gpu")
     except luxeval.DeviceError as e:

@@ -149,7 +149,7 @@ pub struct Texture {
 
 /// Texture reconstruction (DESIGN.md §6 D1 and "RectLight texture"): bilinear between texel
 /// centres (the default), or the nearest texel. Irradiance integrates whichever is chosen.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum TextureFilter {
     #[default]
     Bilinear,
