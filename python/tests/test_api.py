@@ -272,9 +272,13 @@ def test_the_gil_is_released_while_the_device_works(stage):
 
 CHILD = textwrap.dedent(
     """
-    import sys, time
+    import signal, sys, time
     import numpy as np
     import luxeval
+    # A process started in the background by a shell without job control (as a CI runner may
+    # start the tests) inherits SIGINT ignored, and Python then installs no KeyboardInterrupt
+    # handler: install Python's own, as an interactive session has it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     stage = luxeval.Stage(sys.argv[1])
     rng = np.random.default_rng(0)
     pts = np.zeros((300, 3), np.float32)
