@@ -6,11 +6,13 @@
 //   formula when (d / smaller half-extent)·(d / height above its plane) exceeds
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
-// On the host: IES-shaped lights, textured domes and textured rects give 0 here and the host adds the CPU
-//   reference's value (query::irradiance_on_host gives the reasons): this f32 quadrature does
-//   not split at a profile's angle nodes as the reference's line integrals do, and misses lit
+// On the host: lights flagged FLAG_HOST_IRRADIANCE (IES-shaped lights, textured domes and
+//   textured rects) give 0 here and the host adds the CPU reference's value
+//   (prepare::Prepared::irradiance_on_host gives the reasons): this f32 quadrature does not
+//   split at a profile's angle nodes as the reference's line integrals do, and misses lit
 //   features narrower than its nodes; a textured dome's exact integral splits at texel-centre
-//   lines (a textured rect's, texel lines on its surface). The pipeline is built with IES_ENABLED = false and DOME_ENABLED = false.
+//   lines (a textured rect's, texel lines on its surface). The pipeline is built with
+//   IES_ENABLED = false and DOME_ENABLED = false.
 // Structure (this file only): the sphere, rect, disk and cylinder cases choose their chart inside the
 //   switch and chart_integral is called once after it (the CPU calls it in each case). Every
 //   call site is inlined by the shader compiler, and one copy of the quadrature instead of four
@@ -33,7 +35,7 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     // the switch (see the header).
     var chart: Chart;
     var use_chart = false;
-    if has_flag(light, FLAG_IES) || has_flag(light, FLAG_DOME_TEXTURE) || has_flag(light, FLAG_RECT_TEXTURE) {
+    if has_flag(light, FLAG_HOST_IRRADIANCE) {
         // Integrated on the host (see the header).
         return e;
     }

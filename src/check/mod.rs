@@ -234,8 +234,8 @@ pub fn check_with(
         }));
         // Irradiance: the CPU values (quadratures) are computed in parallel. Not for the lights
         // whose irradiance the GPU path takes from the CPU reference (IES-shaped lights,
-        // textured domes: query::irradiance_on_host), so there is nothing to compare.
-        let ni = if crate::query::irradiance_on_host(p) {
+        // textured domes and rects: Prepared::irradiance_on_host), so there is nothing to compare.
+        let ni = if p.irradiance_on_host() {
             0
         } else {
             counts.irradiance

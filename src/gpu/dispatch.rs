@@ -169,7 +169,7 @@ impl GpuContext {
             return Ok(out);
         }
         // The irradiance kernel integrates no IES-shaped light or textured dome (the host does,
-        // see query::irradiance_on_host), so it never needs either lookup.
+        // see prepare::Prepared::irradiance_on_host), so it never needs either lookup.
         let pipeline = self.pipeline(
             kernel,
             lights.has_ies && kernel != Kernel::Irradiance,

@@ -42,6 +42,9 @@ pub const FLAG_DOME_TEXTURE: u32 = 1024;
 /// A rect with a texture (`tex`: the atlas offset and filter; `tex_inv[0]`: the texture's mean
 /// colour, DESIGN.md §6 "RectLight texture"; see `shaders/shared/dome.wgsl`).
 pub const FLAG_RECT_TEXTURE: u32 = 2048;
+/// The irradiance kernel gives 0: the host adds the CPU reference's value
+/// (`prepare::Prepared::irradiance_on_host`).
+pub const FLAG_HOST_IRRADIANCE: u32 = 4096;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -66,6 +69,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_IES", FLAG_IES),
     ("FLAG_DOME_TEXTURE", FLAG_DOME_TEXTURE),
     ("FLAG_RECT_TEXTURE", FLAG_RECT_TEXTURE),
+    ("FLAG_HOST_IRRADIANCE", FLAG_HOST_IRRADIANCE),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
 ];
 
@@ -185,6 +189,9 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
         r.flags |= FLAG_RECT_TEXTURE;
         r.tex_inv[0] = v4(t.mean(), 0.0);
         r.tex = [offset, t.filter().code(), 0, 0];
+    }
+    if p.irradiance_on_host() {
+        r.flags |= FLAG_HOST_IRRADIANCE;
     }
     let (kind, size) = match p.light.kind {
         LightType::Distant { .. } => {

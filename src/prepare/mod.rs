@@ -105,6 +105,25 @@ pub struct Prepared {
 }
 
 impl Prepared {
+    /// Whether the GPU path takes this light's irradiance from the CPU reference, until the f32
+    /// quadrature can match it (the record's `FLAG_HOST_IRRADIANCE`, which the irradiance kernel
+    /// answers with 0, and the host's sum in `query::PreparedScene::irradiance` both read this):
+    /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as the
+    ///   reference's line integrals do, and misses lit features narrower than its nodes (measured: up
+    ///   to 100 % on receivers that see a thin lit band of a striped profile).
+    /// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
+    ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a dome's
+    ///   irradiance depends on the normal only, so the reference evaluates it once per distinct
+    ///   normal (one for a whole falloff map).
+    /// - Textured rects: the exact integral of the filtered texture over the surface, split at
+    ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
+    ///   (src/cpu/irradiance/rect_texture.rs).
+    pub fn irradiance_on_host(&self) -> bool {
+        self.ies.is_some()
+            || (matches!(self.light.kind, LightType::Dome) && self.texture.is_some())
+            || self.rect_texture.is_some()
+    }
+
     /// Validates `light` and computes its constants for `mode`.
     pub fn new(light: &Light, mode: TemperatureMode) -> Result<Self> {
         Self::with_assets(light, mode, &mut AssetCache::default())

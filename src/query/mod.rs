@@ -18,8 +18,6 @@ mod lights;
 pub use lights::lights_json;
 pub use reference::{Power, Reference};
 pub use scene::PreparedScene;
-#[cfg(any(test, feature = "testkit"))]
-pub(crate) use scene::irradiance_on_host;
 
 /// Where queries run.
 #[derive(Clone, Debug)]
@@ -114,16 +112,6 @@ impl Evaluator {
     /// them: the prepared scene answers any number of queries.
     pub fn prepare(&self, lights: &[Light]) -> Result<PreparedScene> {
         PreparedScene::new(self.backend.clone(), lights, self.temperature_mode)
-    }
-
-    /// A scene of lights already prepared (tests that set what the model cannot author yet,
-    /// e.g. the texture filter).
-    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
-    pub(crate) fn prepare_prepared(
-        &self,
-        lights: Vec<crate::prepare::Prepared>,
-    ) -> Result<PreparedScene> {
-        PreparedScene::from_prepared(self.backend.clone(), lights)
     }
 
     /// emission(light, ω) for every direction (DESIGN.md §3); prepares `lights` for this one

@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::error::{LuxError, Result};
 use crate::gpu::{GpuLights, Kernel, Scratch, dome_atlas, ies_atlas, record};
-use crate::model::{Light, LightType};
+use crate::model::Light;
 use crate::prepare::{self, Prepared, TemperatureMode};
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
@@ -166,7 +166,7 @@ impl PreparedScene {
         Ok(out)
     }
 
-    /// The GPU irradiance kernel gives 0 for the lights [`irradiance_on_host`] names (see the
+    /// The GPU irradiance kernel gives 0 for the lights [`Prepared::irradiance_on_host`] names (see the
     /// header of shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here.
     fn add_host_irradiance(
         &self,
@@ -177,7 +177,7 @@ impl PreparedScene {
     ) {
         let n = points.len();
         for (k, light) in self.lights.iter().enumerate() {
-            if !irradiance_on_host(light) {
+            if !light.irradiance_on_host() {
                 continue;
             }
             let values = cpu::irradiance_batch(std::slice::from_ref(light), points, normals, true);
@@ -232,24 +232,6 @@ impl PreparedScene {
             }
         }
     }
-}
-
-/// Whether the GPU path takes this light's irradiance from the CPU reference, until the f32
-/// quadrature can match it:
-/// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as the
-///   reference's line integrals do, and misses lit features narrower than its nodes (measured: up
-///   to 100 % on receivers that see a thin lit band of a striped profile).
-/// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
-///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a dome's
-///   irradiance depends on the normal only, so the reference evaluates it once per distinct
-///   normal (one for a whole falloff map).
-/// - Textured rects: the exact integral of the filtered texture over the surface, split at
-///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
-///   (src/cpu/irradiance/rect_texture.rs).
-pub(crate) fn irradiance_on_host(p: &Prepared) -> bool {
-    p.ies.is_some()
-        || (matches!(p.light.kind, LightType::Dome) && p.texture.is_some())
-        || p.rect_texture.is_some()
 }
 
 /// Rows scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The

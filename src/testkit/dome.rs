@@ -5,29 +5,44 @@
 use glam::DVec3;
 
 use crate::error::Result;
-use crate::model::Light;
-use crate::prepare::dome::Filter;
+use crate::model::{Light, TextureFilter};
 use crate::prepare::{self, TemperatureMode};
 use crate::query::{Evaluator, PreparedScene};
 
-/// Prepares `lights` on `eval` with every dome texture read through `filter` (nearest when
-/// `nearest`, else bilinear).
+/// `lights` with every texture (dome or rect) read through the nearest filter when `nearest`,
+/// else bilinear: the model's [`Texture::filter`](crate::model::Texture), as `--texture-filter`
+/// sets it.
+pub fn with_filter(lights: &[Light], nearest: bool) -> Vec<Light> {
+    let filter = if nearest {
+        TextureFilter::Nearest
+    } else {
+        TextureFilter::Bilinear
+    };
+    lights
+        .iter()
+        .cloned()
+        .map(|mut l| {
+            if let Some(t) = &mut l.texture {
+                t.filter = filter;
+            }
+            l
+        })
+        .collect()
+}
+
+/// `light` with its texture read through the chosen filter, prepared (spec temperature mode).
+fn prepared_with_filter(light: &Light, nearest: bool) -> Result<prepare::Prepared> {
+    let light = with_filter(std::slice::from_ref(light), nearest).remove(0);
+    prepare::Prepared::new(&light, TemperatureMode::Spec)
+}
+
+/// Prepares `lights` on `eval` with every texture read through the chosen filter.
 pub fn prepare_with_filter(
     eval: &Evaluator,
     lights: &[Light],
     nearest: bool,
 ) -> Result<PreparedScene> {
-    let mut prepared = prepare::prepare(lights, TemperatureMode::Spec)?;
-    for p in &mut prepared {
-        if let Some(t) = &mut p.texture {
-            t.filter = if nearest {
-                Filter::Nearest
-            } else {
-                Filter::Bilinear
-            };
-        }
-    }
-    eval.prepare_prepared(prepared)
+    eval.prepare(&with_filter(lights, nearest))
 }
 
 /// Per direction (world, toward the environment), whether the textured dome `light` read
@@ -39,14 +54,7 @@ pub fn near_discontinuity(
     nearest: bool,
     margin: f64,
 ) -> Result<Vec<bool>> {
-    let mut p = prepare::Prepared::new(light, TemperatureMode::Spec)?;
-    if let Some(t) = &mut p.texture {
-        t.filter = if nearest {
-            Filter::Nearest
-        } else {
-            Filter::Bilinear
-        };
-    }
+    let p = prepared_with_filter(light, nearest)?;
     Ok(dirs
         .iter()
         .map(|d| crate::check::near_texture_edge(&p, crate::cpu::dvec(*d), margin))
@@ -61,14 +69,7 @@ pub fn irradiance_with_filter(
     nearest: bool,
     normals: &[DVec3],
 ) -> Result<Vec<DVec3>> {
-    let mut p = prepare::Prepared::new(light, TemperatureMode::Spec)?;
-    if let Some(t) = &mut p.texture {
-        t.filter = if nearest {
-            Filter::Nearest
-        } else {
-            Filter::Bilinear
-        };
-    }
+    let p = prepared_with_filter(light, nearest)?;
     Ok(normals
         .iter()
         .map(|&n| crate::cpu::irradiance::irradiance(&p, DVec3::ZERO, n))

@@ -1,43 +1,22 @@
 //! Textured rects for the tests (tests/rect_texture.rs, tests/rect_conformance.rs): a scene
-//! prepared with a chosen filter (the model has no filter attribute; the CLI's
-//! `--texture-filter` is still to come), and the samples to leave out of a pointwise CPU-vs-GPU
+//! prepared with a chosen filter, and the samples to leave out of a pointwise CPU-vs-GPU
 //! comparison because f32 may fall on the other side of a discontinuity there.
 
 use glam::DVec3;
 
 use crate::error::Result;
 use crate::model::{Light, LightType};
-use crate::prepare::dome::{Filter, RectTexture};
-use crate::prepare::{self, Prepared, TemperatureMode};
+use crate::prepare::{Prepared, TemperatureMode};
 use crate::query::{Evaluator, PreparedScene};
 
-fn filter(nearest: bool) -> Filter {
-    if nearest {
-        Filter::Nearest
-    } else {
-        Filter::Bilinear
-    }
-}
-
-/// Re-reads every rect texture of `prepared` through `filter` (nearest when `nearest`), its
-/// mean recomputed.
-pub(crate) fn set_rect_filter(prepared: &mut [Prepared], nearest: bool) {
-    for p in prepared {
-        if let Some(t) = &mut p.rect_texture {
-            *t = RectTexture::new(t.image.clone(), filter(nearest));
-        }
-    }
-}
-
-/// Prepares `lights` on `eval` with every rect texture read through the filter.
+/// Prepares `lights` on `eval` with every rect texture read through the chosen filter (the
+/// model's `Texture::filter`, see [`super::dome::with_filter`]).
 pub fn prepare_rects_with_filter(
     eval: &Evaluator,
     lights: &[Light],
     nearest: bool,
 ) -> Result<PreparedScene> {
-    let mut prepared = prepare::prepare(lights, TemperatureMode::Spec)?;
-    set_rect_filter(&mut prepared, nearest);
-    eval.prepare_prepared(prepared)
+    eval.prepare(&super::dome::with_filter(lights, nearest))
 }
 
 /// Per radiance sample (point, direction), whether the textured rect `light` has a

@@ -114,6 +114,21 @@ fn side(mhat: DVec3, centre: DVec3, radius: f64) -> Side {
     }
 }
 
+/// `tex ⊗ v`, channel-major: a moment's RGB × xyz entries.
+fn outer(tex: DVec3, v: DVec3) -> [f64; 9] {
+    [
+        tex.x * v.x,
+        tex.x * v.y,
+        tex.x * v.z,
+        tex.y * v.x,
+        tex.y * v.y,
+        tex.y * v.z,
+        tex.z * v.x,
+        tex.z * v.y,
+        tex.z * v.z,
+    ]
+}
+
 fn add<const K: usize>(acc: &mut [f64; K], v: &[f64; K]) {
     acc.iter_mut().zip(v).for_each(|(a, b)| *a += b);
 }
@@ -220,20 +235,7 @@ impl DomeIrradiance {
         if dom == Domain::Outside {
             return [0.0; 9];
         }
-        let mut f = |d: DVec3, tex: DVec3, j: f64| {
-            let v = d * (self.weight(d) * j);
-            [
-                tex.x * v.x,
-                tex.x * v.y,
-                tex.x * v.z,
-                tex.y * v.x,
-                tex.y * v.y,
-                tex.y * v.z,
-                tex.z * v.x,
-                tex.z * v.y,
-                tex.z * v.z,
-            ]
-        };
+        let mut f = |d: DVec3, tex: DVec3, j: f64| outer(tex, d * (self.weight(d) * j));
         let cap = self.geom.cap(&p);
         match (cap, self.conformal) {
             (Some(_), Some(w)) if self.format == DomeFormat::LatLong => {
@@ -255,35 +257,37 @@ impl DomeIrradiance {
                         cx[a][2] * ry[b][0],
                     ) * k;
                     let tex = crate::cpu::dome::tex_fetch(&self.img, i, j);
-                    add(
-                        &mut v,
-                        &[
-                            tex.x * m.x,
-                            tex.x * m.y,
-                            tex.x * m.z,
-                            tex.y * m.x,
-                            tex.y * m.y,
-                            tex.y * m.z,
-                            tex.z * m.x,
-                            tex.z * m.y,
-                            tex.z * m.z,
-                        ],
-                    );
+                    add(&mut v, &outer(tex, m));
                 }
                 v
             }
-            (Some((_, delta)), _) if dom == Domain::Inside && delta * (1.0 + self.kappa) <= 0.5 => {
-                tensor(&self.geom, &self.img, &p, self.order(delta), &mut f)
+            _ => self.whole_piece(&p, dom, 0, &mut f),
+        }
+    }
+
+    /// `∫ f(d, tex, J)` over a whole piece (no horizon): one tensor Gauss–Legendre rule of
+    /// order `order(δ) + extra` where the piece lies inside the image's domain and is small for
+    /// the frame (`δ(1 + κ) ≤ 0.5`, see the module docs), else the adaptive [`exact`].
+    fn whole_piece<const K: usize>(
+        &self,
+        p: &Piece,
+        dom: Domain,
+        extra: usize,
+        f: &mut impl FnMut(DVec3, DVec3, f64) -> [f64; K],
+    ) -> [f64; K] {
+        match self.geom.cap(p) {
+            Some((_, delta)) if dom == Domain::Inside && delta * (1.0 + self.kappa) <= 0.5 => {
+                tensor(&self.geom, &self.img, p, self.order(delta) + extra, f)
             }
             _ => exact(
                 &self.geom,
                 &self.img,
-                &p,
+                p,
                 None,
                 None,
                 self.order(0.5),
-                REL_TOL * self.scale(&p),
-                &mut f,
+                REL_TOL * self.scale(p),
+                f,
             ),
         }
     }
@@ -611,24 +615,7 @@ impl DomeIrradiance {
                         let l = wd.length();
                         f(wd / l, tex).map(|v| v * jac * self.frame.det_abs / (l * l * l))
                     };
-                    let v = match self.geom.cap(&p) {
-                        Some((_, delta))
-                            if dom == Domain::Inside && delta * (1.0 + self.kappa) <= 0.5 =>
-                        {
-                            tensor(&self.geom, &self.img, &p, self.order(delta) + 1, &mut g)
-                        }
-                        _ => exact(
-                            &self.geom,
-                            &self.img,
-                            &p,
-                            None,
-                            None,
-                            self.order(0.5),
-                            REL_TOL * self.scale(&p),
-                            &mut g,
-                        ),
-                    };
-                    add(&mut acc, &v);
+                    add(&mut acc, &self.whole_piece(&p, dom, 1, &mut g));
                 }
                 acc
             })

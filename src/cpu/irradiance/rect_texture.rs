@@ -1,6 +1,6 @@
 //! Exact irradiance of a textured rect (DESIGN.md §6 "RectLight texture" and "Dome and texture
 //! irradiance: what 'exact' means"), f64, CPU only: the GPU path takes it from here
-//! (`query::irradiance_on_host`), so this module has no WGSL twin.
+//! (`prepare::Prepared::irradiance_on_host`), so this module has no WGSL twin.
 //!
 //! The rect's plane chart (`chart::plane_chart`) is `X = x/hx`, `Y = y/hy` ∈ [−1, 1] in the
 //! light's local coordinates, so by §6's `s = 0.5 − x/w`, `t = 0.5 − y/h` the texture at chart
