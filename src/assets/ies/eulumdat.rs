@@ -164,14 +164,11 @@ impl<'a> Fixed<'a> {
             return Err(IesError::at(n, K::NotAnInteger { what, value: v }));
         }
         if v < lo || v > hi {
-            let expected = "outside the values EULUMDAT defines";
-            return Err(IesError::at(
+            return Err(out_of_range(
                 n,
-                K::OutOfRange {
-                    what,
-                    value: v,
-                    expected,
-                },
+                what,
+                v,
+                "outside the values EULUMDAT defines",
             ));
         }
         Ok(v)
@@ -180,18 +177,22 @@ impl<'a> Fixed<'a> {
     fn non_negative(&mut self, what: &'static str) -> Result<f64, IesError> {
         let (v, n) = self.number(what)?;
         if v < 0.0 {
-            let expected = "must not be negative";
-            return Err(IesError::at(
-                n,
-                K::OutOfRange {
-                    what,
-                    value: v,
-                    expected,
-                },
-            ));
+            return Err(out_of_range(n, what, v, "must not be negative"));
         }
         Ok(v)
     }
+}
+
+/// The error for `value` of `what` on line `n` outside its range.
+fn out_of_range(n: usize, what: &'static str, value: f64, expected: &'static str) -> IesError {
+    IesError::at(
+        n,
+        K::OutOfRange {
+            what,
+            value,
+            expected,
+        },
+    )
 }
 
 /// Reads an EULUMDAT file into the type C layout described in the module documentation.
@@ -306,14 +307,7 @@ pub fn parse_eulumdat(text: &[u8]) -> Result<IesFile, IesError> {
     if c_angles[mc - 1] >= 360.0 {
         let expected = "[0, 360)";
         let value = c_angles[mc - 1];
-        return Err(IesError::at(
-            c_line,
-            K::OutOfRange {
-                what: "C-plane angles",
-                value,
-                expected,
-            },
-        ));
+        return Err(out_of_range(c_line, "C-plane angles", value, expected));
     }
     if ng > toks.remaining() as f64 {
         return Err(too_many("gamma angles", ng, ng_line, toks.remaining()));
