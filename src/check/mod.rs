@@ -35,7 +35,7 @@ pub use band::{
 };
 
 /// Relative tolerance of GPU (f32) against CPU (f64).
-pub const TOLERANCE: f64 = 1e-4;
+pub const TOLERANCE: f64 = crate::rules::GPU_TOLERANCE;
 /// Half-width of the excluded band around discontinuities (radians, or a fraction of the
 /// shape's size).
 pub const BAND: f64 = 1e-4;

@@ -161,10 +161,13 @@ pub trait Rule {
 }
 
 /// The reference's rule: globally adaptive Gauss–Kronrod (QUADPACK `qag`) on every piece.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Adaptive {
     pub outer: Tolerance,
     pub inner: Tolerance,
+    /// The rule also stops once its error estimate is below this fraction of the whole
+    /// irradiance, estimated first by [`Adaptive::COARSE`] (see [`ABS_FRACTION`]); 0: never.
+    pub scale_fraction: f64,
 }
 
 impl Adaptive {
@@ -181,7 +184,32 @@ impl Adaptive {
             abs: 0.0,
             max_intervals: 400,
         },
+        scale_fraction: ABS_FRACTION,
     };
+
+    /// The rule for a relative tolerance `rel` of the whole irradiance (`luxeval irradiance
+    /// --tolerance`; [`Adaptive::REFERENCE`] for `rel` at or below its own 1e-9). The error
+    /// budget is split with margin: the outer rule stops at `rel/4` of its value, each line at
+    /// `rel/40` of its own (the outer rule integrates the lines' errors), and either stops once
+    /// its estimate is below `rel/8` of the coarse estimate of the whole (pieces that contribute
+    /// nothing measurable). Gauss–Kronrod's estimates are themselves pessimistic, and the test
+    /// `tolerance_maps_hold_the_reference` measures the result against the reference.
+    pub fn for_tolerance(rel: f64) -> Adaptive {
+        if !(rel > Self::REFERENCE.outer.rel) {
+            return Self::REFERENCE;
+        }
+        Adaptive {
+            outer: Tolerance {
+                rel: rel / 4.0,
+                ..Self::REFERENCE.outer
+            },
+            inner: Tolerance {
+                rel: rel / 40.0,
+                ..Self::REFERENCE.inner
+            },
+            scale_fraction: rel / 8.0,
+        }
+    }
 
     /// A cheap estimate of the same integral, used only to scale [`ABS_FRACTION`].
     pub const COARSE: Adaptive = Adaptive {
@@ -195,6 +223,7 @@ impl Adaptive {
             abs: 0.0,
             max_intervals: 8,
         },
+        scale_fraction: 0.0,
     };
 }
 
@@ -220,7 +249,7 @@ impl Rule for Adaptive {
         }
         let ys = critical::critical_ys(p, chart, n);
         let mut rule = *self;
-        if self.outer.abs == 0.0 && self.outer.max_intervals > Self::COARSE.outer.max_intervals {
+        if self.outer.abs == 0.0 && self.scale_fraction > 0.0 {
             // The scale of the answer from a coarse pass; an inner error δ on every line moves
             // the outer integral by δ·jac·(Y extent).
             let scale = chart_integral(p, chart, n, &ys, &Self::COARSE)
@@ -228,8 +257,8 @@ impl Rule for Adaptive {
                 .max_element();
             let extent = chart.jac * (ys[ys.len() - 1] - ys[0]);
             if scale > 0.0 && scale.is_finite() && extent > 0.0 && extent.is_finite() {
-                rule.outer.abs = ABS_FRACTION * scale;
-                rule.inner.abs = ABS_FRACTION * scale / extent;
+                rule.outer.abs = self.scale_fraction * scale;
+                rule.inner.abs = self.scale_fraction * scale / extent;
             }
         }
         chart_integral(p, chart, n, &ys, &rule)

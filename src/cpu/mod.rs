@@ -93,13 +93,15 @@ pub fn radiance_batch(
     })
 }
 
-/// irradiance(x, n) for every light and (point, normal) pair (see
-/// [`irradiance::irradiance`]); a zero or non-finite normal gives 0.
+/// irradiance(x, n) for every light and (point, normal) pair by `rule` (see
+/// [`irradiance::irradiance_with`]; closed forms and textured domes are exact either way); a
+/// zero or non-finite normal gives 0.
 pub fn irradiance_batch(
     lights: &[Prepared],
     points: &[[f32; 3]],
     normals: &[[f32; 3]],
     per_light: bool,
+    rule: &irradiance::Adaptive,
 ) -> Vec<DVec3> {
     let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
         .iter()
@@ -113,7 +115,7 @@ pub fn irradiance_batch(
             return values[&normals[i].map(f32::to_bits)];
         }
         match unit(normals[i]) {
-            Some(n) => irradiance::irradiance(&lights[k], dvec(points[i]), n),
+            Some(n) => irradiance::irradiance_with(&lights[k], dvec(points[i]), n, rule),
             None => DVec3::ZERO,
         }
     })

@@ -13,7 +13,7 @@ fn norm(v: DVec3) -> f64 {
 }
 
 /// Tolerances and limits of [`integrate`].
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tolerance {
     /// Stop when the summed error estimate is at most `rel · |result|` ...
     pub rel: f64,

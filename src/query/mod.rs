@@ -28,6 +28,9 @@ pub(crate) enum Backend {
     Gpu(Arc<GpuContext>),
 }
 
+/// The relative tolerances [`Evaluator::with_irradiance_tolerance`] accepts.
+pub(crate) const IRRADIANCE_TOLERANCE_RANGE: (f64, f64) = (1e-9, 0.1);
+
 /// Sum the lights per sample, or keep one row per (light, sample).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Accumulate {
@@ -44,6 +47,8 @@ pub enum Accumulate {
 pub struct Evaluator {
     backend: Backend,
     temperature_mode: TemperatureMode,
+    /// Relative tolerance of irradiance (None: the reference's 1e-9).
+    irradiance_tolerance: Option<f64>,
 }
 
 impl Evaluator {
@@ -52,6 +57,7 @@ impl Evaluator {
         Evaluator {
             backend: Backend::Cpu,
             temperature_mode: TemperatureMode::default(),
+            irradiance_tolerance: None,
         }
     }
 
@@ -61,6 +67,7 @@ impl Evaluator {
         Ok(Evaluator {
             backend: Backend::Gpu(Arc::new(GpuContext::new()?)),
             temperature_mode: TemperatureMode::default(),
+            irradiance_tolerance: None,
         })
     }
 
@@ -71,6 +78,41 @@ impl Evaluator {
 
     pub fn temperature_mode(&self) -> TemperatureMode {
         self.temperature_mode
+    }
+
+    /// Computes irradiance to relative tolerance `rel` rather than to the reference's 1e-9
+    /// (`luxeval irradiance --tolerance`, whose default is 1e-4): the CPU's adaptive rules stop
+    /// there ([`crate::cpu`]'s `Adaptive::for_tolerance`; closed forms stay exact), which makes
+    /// shaped lights many times faster. The GPU's f32 rule is fixed and held to 1e-4 by the
+    /// conformance tests (the tolerance of `luxeval check`), so a GPU evaluator accepts no
+    /// tighter `rel`. Errors: `rel` not in [1e-9, 0.1], or below the GPU's bound on
+    /// a GPU evaluator.
+    pub fn with_irradiance_tolerance(mut self, rel: f64) -> Result<Self> {
+        if !(IRRADIANCE_TOLERANCE_RANGE.0..=IRRADIANCE_TOLERANCE_RANGE.1).contains(&rel) {
+            return Err(LuxError::input(
+                "tolerance",
+                format!(
+                    "{rel}: a relative tolerance must be from {:e} (the reference's own) to {}",
+                    IRRADIANCE_TOLERANCE_RANGE.0, IRRADIANCE_TOLERANCE_RANGE.1
+                ),
+            ));
+        }
+        if self.is_gpu() && rel < crate::rules::GPU_TOLERANCE {
+            return Err(LuxError::input(
+                "tolerance",
+                format!(
+                    "{rel} is tighter than the GPU's irradiance rule is held to ({:e}, f32); use the CPU reference for it",
+                    crate::rules::GPU_TOLERANCE
+                ),
+            ));
+        }
+        self.irradiance_tolerance = Some(rel);
+        Ok(self)
+    }
+
+    /// The relative tolerance irradiance is computed to (None: the reference's 1e-9).
+    pub fn irradiance_tolerance(&self) -> Option<f64> {
+        self.irradiance_tolerance
     }
 
     /// Used by `check` (feature `testkit`).
@@ -111,7 +153,12 @@ impl Evaluator {
     /// Validates the lights, computes their per-light constants once and, on a GPU, uploads
     /// them: the prepared scene answers any number of queries.
     pub fn prepare(&self, lights: &[Light]) -> Result<PreparedScene> {
-        PreparedScene::new(self.backend.clone(), lights, self.temperature_mode)
+        PreparedScene::new(
+            self.backend.clone(),
+            lights,
+            self.temperature_mode,
+            self.irradiance_tolerance,
+        )
     }
 
     /// emission(light, ω) for every direction (DESIGN.md §3); prepares `lights` for this one

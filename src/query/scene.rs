@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
+use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
 use crate::gpu::{GpuLights, Kernel, Scratch, dome_atlas, ies_atlas, record};
 use crate::model::Light;
@@ -23,6 +24,8 @@ pub struct PreparedScene {
     /// What the caller should know about how the scene is evaluated (textures the GPU holds
     /// reduced); see [`PreparedScene::warnings`].
     warnings: Vec<String>,
+    /// The CPU's irradiance rule (the reference's, or one for a requested tolerance).
+    rule: Adaptive,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -35,8 +38,17 @@ impl std::fmt::Debug for PreparedScene {
 }
 
 impl PreparedScene {
-    pub(crate) fn new(backend: Backend, lights: &[Light], mode: TemperatureMode) -> Result<Self> {
-        Self::from_prepared(backend, prepare::prepare(lights, mode)?)
+    pub(crate) fn new(
+        backend: Backend,
+        lights: &[Light],
+        mode: TemperatureMode,
+        irradiance_tolerance: Option<f64>,
+    ) -> Result<Self> {
+        let mut scene = Self::from_prepared(backend, prepare::prepare(lights, mode)?)?;
+        if let Some(rel) = irradiance_tolerance {
+            scene.rule = Adaptive::for_tolerance(rel);
+        }
+        Ok(scene)
     }
 
     /// A scene of lights already prepared (the GPU records are packed from exactly these
@@ -75,6 +87,7 @@ impl PreparedScene {
             gpu,
             scratch: Mutex::new(None),
             warnings,
+            rule: Adaptive::REFERENCE,
         })
     }
 
@@ -158,7 +171,7 @@ impl PreparedScene {
         check_pairs(points, "points", normals, "normals")?;
         let per_light = acc == Accumulate::PerLight;
         let mut out = self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
-            cpu::irradiance_batch(&self.lights, points, normals, per_light)
+            cpu::irradiance_batch(&self.lights, points, normals, per_light, &self.rule)
         })?;
         if matches!(self.backend, Backend::Gpu(_)) {
             self.add_host_irradiance(points, normals, per_light, &mut out);
@@ -180,7 +193,13 @@ impl PreparedScene {
             if !light.irradiance_on_host() {
                 continue;
             }
-            let values = cpu::irradiance_batch(std::slice::from_ref(light), points, normals, true);
+            let values = cpu::irradiance_batch(
+                std::slice::from_ref(light),
+                points,
+                normals,
+                true,
+                &self.rule,
+            );
             for (i, v) in values.into_iter().enumerate() {
                 let row = if per_light { k * n + i } else { i };
                 let sum = DVec3::from_array(out[row].map(f64::from)) + v;

@@ -53,6 +53,17 @@ impl QueryArgs {
     }
 }
 
+/// How closely irradiance is computed (irradiance and falloff).
+#[derive(Args, Clone, Copy)]
+pub struct ToleranceArg {
+    /// Relative tolerance of the irradiance, from 1e-9 to 0.1. The CPU's adaptive quadrature
+    /// stops there (closed forms are exact either way); the GPU's f32 rule is fixed and held to
+    /// 1e-4, so the GPU takes no tighter value (use --device cpu). `luxeval check` and the tests
+    /// use the reference's 1e-9.
+    #[arg(long, value_name = "REL", default_value_t = 1e-4)]
+    pub tolerance: f64,
+}
+
 #[derive(Args)]
 pub struct TimeArg {
     /// USD time code to evaluate at. Default: the stage's startTimeCode when authored, else each

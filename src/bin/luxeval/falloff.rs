@@ -6,7 +6,9 @@ use clap::Args;
 
 use luxeval::falloff::{self, Plane};
 
-use crate::args::{DeviceArg, ScaleArg, SceneArgs, parse_range, parse_res, parse_vec3};
+use crate::args::{
+    DeviceArg, ScaleArg, SceneArgs, ToleranceArg, parse_range, parse_res, parse_vec3,
+};
 use crate::exit::{CliResult, Failure};
 use crate::open;
 
@@ -53,6 +55,8 @@ pub struct FalloffArgs {
     /// Where to evaluate (default: the GPU, falling back to the CPU reference with a warning).
     #[arg(long, value_enum)]
     device: Option<DeviceArg>,
+    #[command(flatten)]
+    tolerance: ToleranceArg,
 }
 
 pub fn run(a: &FalloffArgs) -> CliResult {
@@ -77,7 +81,7 @@ pub fn run(a: &FalloffArgs) -> CliResult {
     {
         return Err(Failure::bad_input("--range: a log scale needs LOW > 0"));
     }
-    let (eval, scene) = open::prepare(&a.scene, a.device)?;
+    let (eval, scene) = open::prepare_irradiance(&a.scene, a.device, a.tolerance)?;
     // A bar on a terminal, nothing when stderr is redirected (indicatif hides itself there).
     let bar = indicatif::ProgressBar::new(plane.pixels() as u64);
     bar.set_style(

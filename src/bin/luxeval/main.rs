@@ -103,6 +103,8 @@ enum Command {
         /// Receiver normals, float (N, 3), paired row by row with the points; normalised before use.
         #[arg(long, value_name = "N.npy")]
         normals: PathBuf,
+        #[command(flatten)]
+        tolerance: args::ToleranceArg,
         /// Output: float32 (N, 3), or (L, N, 3) with --per-light.
         #[arg(short, long, value_name = "OUT.npy")]
         output: PathBuf,
@@ -185,12 +187,14 @@ fn run(cli: Cli) -> CliResult {
             common,
             points,
             normals,
+            tolerance,
             output,
         } => query::run(
             &common,
             query::Query::Irradiance {
                 points: &points,
                 normals: &normals,
+                tolerance,
             },
             &output,
         ),

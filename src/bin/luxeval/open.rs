@@ -3,8 +3,8 @@
 
 use luxeval::{Evaluator, Light, LuxError, PreparedScene, Scene};
 
-use crate::args::{DeviceArg, SceneArgs};
-use crate::exit::{CliResult, in_scene};
+use crate::args::{DeviceArg, SceneArgs, ToleranceArg};
+use crate::exit::{CliResult, Failure, in_scene};
 
 /// The selected, visible, evaluable lights of the stage, validated (an invalid attribute is
 /// reported with the stage it comes from), their textures read with `--texture-filter`. Prints
@@ -56,6 +56,30 @@ pub fn prepare(
     args: &SceneArgs,
     device: Option<DeviceArg>,
 ) -> CliResult<(Evaluator, PreparedScene)> {
+    prepare_with(args, device, None)
+}
+
+/// [`prepare`] for irradiance to a relative tolerance (`--tolerance`); checked before the stage
+/// is read, so that a bad value costs nothing.
+pub fn prepare_irradiance(
+    args: &SceneArgs,
+    device: Option<DeviceArg>,
+    tolerance: ToleranceArg,
+) -> CliResult<(Evaluator, PreparedScene)> {
+    prepare_with(args, device, Some(tolerance.tolerance))
+}
+
+fn prepare_with(
+    args: &SceneArgs,
+    device: Option<DeviceArg>,
+    tolerance: Option<f64>,
+) -> CliResult<(Evaluator, PreparedScene)> {
+    if let Some(rel) = tolerance {
+        // The range alone, before the stage is read (the device's own bound is checked below).
+        Evaluator::cpu()
+            .with_irradiance_tolerance(rel)
+            .map_err(|e| Failure::bad_input(format!("--{e}")))?;
+    }
     let lights = lights(args)?;
     if lights.is_empty() {
         eprintln!(
@@ -63,7 +87,12 @@ pub fn prepare(
             args.scene.display()
         );
     }
-    let eval = evaluator(device, args)?;
+    let mut eval = evaluator(device, args)?;
+    if let Some(rel) = tolerance {
+        eval = eval
+            .with_irradiance_tolerance(rel)
+            .map_err(|e| Failure::bad_input(format!("--{e}")))?;
+    }
     let scene = eval
         .prepare(&lights)
         .map_err(|e| in_scene(&args.scene, e))?;

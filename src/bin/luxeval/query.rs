@@ -6,7 +6,7 @@ use luxeval::io::{self, npy};
 use luxeval::plot::polar;
 use luxeval::{Accumulate, Evaluator, Limits, PreparedScene, Reference};
 
-use crate::args::{QueryArgs, SceneArgs};
+use crate::args::{QueryArgs, SceneArgs, ToleranceArg};
 use crate::exit::{CliResult, Failure, in_scene};
 use crate::open;
 
@@ -22,6 +22,7 @@ pub enum Query<'a> {
     Irradiance {
         points: &'a Path,
         normals: &'a Path,
+        tolerance: ToleranceArg,
     },
     Intensity {
         dirs: &'a Path,
@@ -35,7 +36,9 @@ impl Query<'_> {
         match *self {
             Query::Emission { dirs } => vec![("--dirs", dirs)],
             Query::Radiance { points, dirs } => vec![("--points", points), ("--dirs", dirs)],
-            Query::Irradiance { points, normals } => {
+            Query::Irradiance {
+                points, normals, ..
+            } => {
                 vec![("--points", points), ("--normals", normals)]
             }
             Query::Intensity { dirs, .. } => vec![("--dirs", dirs)],
@@ -77,6 +80,7 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
         Query::Irradiance {
             points: pp,
             normals: np,
+            tolerance,
         } => {
             let points = npy::read_points(pp)?;
             let normals = npy::read_directions(np)?;
@@ -84,7 +88,7 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
                 ("--points", pp, points.len()),
                 ("--normals", np, normals.len()),
             )?;
-            let (_, scene) = open::prepare(&args.scene, args.device)?;
+            let (_, scene) = open::prepare_irradiance(&args.scene, args.device, tolerance)?;
             check_output_rows(&scene, points.len(), args.per_light)?;
             let out = scene.irradiance(&points, &normals, acc)?;
             (points.len(), scene, out)
