@@ -61,7 +61,7 @@ pub(crate) mod usd;
 struct ReadmeDoctests;
 
 pub use error::{GpuFailure, LuxError, Result};
-pub use gpu::{AdapterSummary, DeviceLimits, adapters};
+pub use gpu::{AdapterSummary, CacheStatus, DeviceLimits, Startup, adapters};
 pub use limits::Limits;
 pub use model::{
     Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter,

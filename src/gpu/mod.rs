@@ -3,6 +3,7 @@
 //! buffers so that any batch fits the device's buffer and dispatch limits. Depends on the model
 //! and `prepare` only, never on `cpu`.
 
+pub(crate) mod cache;
 pub(crate) mod dispatch;
 pub(crate) mod dome_atlas;
 pub(crate) mod ies_atlas;
@@ -13,6 +14,7 @@ use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use crate::error::{LuxError, Result};
+pub use cache::CacheStatus;
 pub(crate) use dispatch::{GpuLights, Scratch};
 pub(crate) use record::Params;
 pub(crate) use shaders::Kernel;
@@ -48,6 +50,28 @@ pub struct DeviceLimits {
     pub samples_per_dispatch_one_light: usize,
 }
 
+/// How long each step of opening a GPU evaluator took (`luxeval bench`'s cold start).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Startup {
+    /// Creating the wgpu instance (loading the Vulkan loader and drivers).
+    pub instance: std::time::Duration,
+    /// Finding the adapter.
+    pub adapter: std::time::Duration,
+    /// Opening the device.
+    pub device: std::time::Duration,
+    /// Each pipeline compiled so far, in order, by name (kernel, with `+ies` / `+texture`).
+    pub pipelines: Vec<(String, std::time::Duration)>,
+}
+
+fn pipeline_name(kernel: Kernel, ies: bool, dome: bool) -> String {
+    format!(
+        "{}{}{}",
+        kernel.entry_point(),
+        if ies { "+ies" } else { "" },
+        if dome { "+texture" } else { "" }
+    )
+}
+
 /// Environment variable that picks an adapter by (case-insensitive) name substring.
 pub const ADAPTER_ENV: &str = "LUXEVAL_ADAPTER";
 
@@ -76,6 +100,11 @@ pub(crate) struct GpuContext {
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<(Kernel, bool, bool), wgpu::ComputePipeline>>,
+    /// The persistent pipeline cache and its file (gpu/cache.rs), where the adapter has one.
+    cache: Option<(wgpu::PipelineCache, std::path::PathBuf)>,
+    cache_status: CacheStatus,
+    /// How long opening took, and each pipeline's compile (`luxeval bench`).
+    startup: Mutex<Startup>,
     /// Why the device was lost, once it is (set by wgpu's device-lost callback): reported
     /// instead of the validation errors a lost device's buffers then raise.
     lost: Arc<Mutex<Option<String>>>,
@@ -105,7 +134,9 @@ impl GpuContext {
     }
 
     async fn new_async() -> Result<Self> {
+        let t0 = std::time::Instant::now();
         let instance = instance();
+        let t_instance = t0.elapsed();
         let adapter = match std::env::var(ADAPTER_ENV) {
             Ok(want) if !want.is_empty() => {
                 let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
@@ -134,6 +165,7 @@ impl GpuContext {
                     source: Some(e),
                 })?,
         };
+        let t_adapter = t0.elapsed() - t_instance;
         let info = adapter.get_info();
         // Ask for everything the adapter offers: big batches want its largest buffers.
         let limits = adapter.limits();
@@ -141,6 +173,7 @@ impl GpuContext {
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("luxeval"),
                 required_limits: limits.clone(),
+                required_features: adapter.features() & wgpu::Features::PIPELINE_CACHE,
                 ..Default::default()
             })
             .await
@@ -202,6 +235,8 @@ impl GpuContext {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let t_device = t0.elapsed() - t_instance - t_adapter;
+        let (cache, cache_status) = cache::open(&device, &info);
         Ok(GpuContext {
             device,
             queue,
@@ -210,6 +245,14 @@ impl GpuContext {
             layout,
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
+            cache,
+            cache_status,
+            startup: Mutex::new(Startup {
+                instance: t_instance,
+                adapter: t_adapter,
+                device: t_device,
+                pipelines: Vec::new(),
+            }),
             lost,
         })
     }
@@ -240,6 +283,7 @@ impl GpuContext {
         if source.contains("override DOME_ENABLED") {
             constants.push(("DOME_ENABLED", if dome { 1.0 } else { 0.0 }));
         }
+        let t0 = std::time::Instant::now();
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -251,7 +295,7 @@ impl GpuContext {
                     constants: &constants,
                     ..Default::default()
                 },
-                cache: None,
+                cache: self.cache.as_ref().map(|(c, _)| c),
             });
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(LuxError::gpu(
@@ -259,8 +303,31 @@ impl GpuContext {
                 e,
             ));
         }
+        let took = t0.elapsed();
+        if let Some((c, path)) = &self.cache {
+            // Saved after every new pipeline: a CLI process may end without dropping the context.
+            cache::save(c, path);
+        }
+        self.startup
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .pipelines
+            .push((pipeline_name(kernel, ies, dome), took));
         cache.insert((kernel, ies, dome), pipeline.clone());
         Ok(pipeline)
+    }
+
+    /// Whether and where compiled pipelines are cached.
+    pub fn cache_status(&self) -> CacheStatus {
+        self.cache_status.clone()
+    }
+
+    /// How long opening the device and compiling each pipeline so far took.
+    pub fn startup(&self) -> Startup {
+        self.startup
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone()
     }
 
     pub fn adapter(&self) -> AdapterSummary {

@@ -9,7 +9,7 @@ mod scene;
 use std::sync::Arc;
 
 use crate::error::{LuxError, Result};
-use crate::gpu::{AdapterSummary, DeviceLimits, GpuContext};
+use crate::gpu::{AdapterSummary, CacheStatus, DeviceLimits, GpuContext, Startup};
 use crate::model::Light;
 use crate::prepare::TemperatureMode;
 #[cfg(feature = "usd")]
@@ -131,6 +131,24 @@ impl Evaluator {
         match &self.backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => Some(g.adapter()),
+        }
+    }
+
+    /// Whether and where compiled pipelines are cached across processes, when queries run on a
+    /// GPU (`luxeval info`).
+    pub fn pipeline_cache(&self) -> Option<CacheStatus> {
+        match &self.backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(g.cache_status()),
+        }
+    }
+
+    /// How long opening the device and compiling each pipeline so far took, when queries run
+    /// on a GPU (`luxeval bench`).
+    pub fn startup(&self) -> Option<Startup> {
+        match &self.backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(g.startup()),
         }
     }
 

@@ -27,6 +27,7 @@ pub fn run(json: bool) -> CliResult {
                             "max_compute_invocations_per_workgroup": l.max_compute_invocations_per_workgroup,
                         })),
                         "samples_per_dispatch_one_light": limits.as_ref().map(|l| l.samples_per_dispatch_one_light),
+                        "pipeline_cache": g.pipeline_cache(),
                     })
                 }
                 Err(e) => serde_json::json!({ "error": e.to_string() }),
@@ -71,6 +72,25 @@ pub fn run(json: bool) -> CliResult {
                     "  samples per dispatch (one light): {}",
                     l.samples_per_dispatch_one_light
                 );
+                match g.pipeline_cache() {
+                    Some(luxeval::CacheStatus {
+                        path: Some(p),
+                        loaded_bytes,
+                        ..
+                    }) => outln!(
+                        "  pipeline cache: {} ({})",
+                        p.display(),
+                        if loaded_bytes > 0 {
+                            format!("used: {loaded_bytes} bytes loaded")
+                        } else {
+                            "used: empty so far".into()
+                        }
+                    ),
+                    Some(luxeval::CacheStatus {
+                        reason: Some(r), ..
+                    }) => outln!("  pipeline cache: not used: {r}"),
+                    _ => {}
+                }
             }
             Err(e) => {
                 outln!("chosen: none: {e}\n  queries fall back to the CPU reference (--device cpu)")
