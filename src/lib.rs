@@ -61,6 +61,7 @@ pub(crate) mod usd;
 struct ReadmeDoctests;
 
 pub use error::{GpuFailure, LuxError, Result};
+pub use gpu::cache::CACHE_DIR_ENV as PIPELINE_CACHE_DIR_ENV;
 pub use gpu::{AdapterSummary, CacheStatus, DeviceLimits, Startup, adapters};
 pub use limits::Limits;
 pub use model::{

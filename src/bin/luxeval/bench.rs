@@ -37,6 +37,23 @@ pub struct BenchArgs {
     /// Skip the dome measurement.
     #[arg(long)]
     no_dome: bool,
+    /// Skip the cold-start measurement (two child processes that open the GPU and compile every
+    /// pipeline, without and with the pipeline cache).
+    #[arg(long)]
+    no_startup: bool,
+    /// Also measure throughput over every combination of --sweep-samples and --sweep-lights
+    /// (irradiance on 1/64 of the samples), on the GPU and the CPU.
+    #[arg(long)]
+    sweep: bool,
+    /// Sample counts of the sweep.
+    #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000,10000000")]
+    sweep_samples: Vec<usize>,
+    /// Light counts of the sweep.
+    #[arg(long, value_delimiter = ',', default_value = "1,8,64")]
+    sweep_lights: Vec<usize>,
+    /// The child process of the cold-start measurement (internal).
+    #[arg(long = "startup-probe", hide = true)]
+    startup_probe: bool,
 }
 
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
@@ -60,7 +77,15 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
 #[derive(serde::Serialize)]
 struct Report {
     queries: Vec<Row>,
+    /// GPU/CPU throughput per query (same run).
+    ratios: Vec<(String, f64)>,
+    /// Warm latency: one call of 1,000 samples on a prepared scene (median).
+    latency: Vec<Row>,
+    startup: Vec<crate::bench_startup::StartupRow>,
+    sweep: Vec<Row>,
     dome: Vec<crate::bench_dome::DomeRow>,
+    /// This process's peak resident set (Linux VmHWM), bytes.
+    peak_rss_bytes: Option<u64>,
 }
 
 #[derive(serde::Serialize)]
@@ -99,7 +124,51 @@ fn time(repeat: usize, mut f: impl FnMut() -> luxeval::Result<()>) -> luxeval::R
     Ok(median(times))
 }
 
+/// Latency is measured on this many samples.
+const LATENCY_SAMPLES: usize = 1000;
+
+/// One timed measurement of `query` on `m` samples of `dirs`/`points` with `lights` lights.
+fn measure(
+    eval: &Evaluator,
+    lights: &[luxeval::Light],
+    query: &'static str,
+    dirs: &[[f32; 3]],
+    points: &[[f32; 3]],
+    repeat: usize,
+) -> luxeval::Result<Row> {
+    // The scene is prepared once (as a renderer or the CLI would) and its buffers reused.
+    let scene = eval.prepare(lights)?;
+    let m = dirs.len();
+    let t = time(repeat, || {
+        match query {
+            "emission" => scene.emission(dirs, Accumulate::Sum)?,
+            "radiance" => scene.radiance(points, dirs, Accumulate::Sum)?,
+            _ => scene.irradiance(points, dirs, Accumulate::Sum)?,
+        };
+        Ok(())
+    })?;
+    Ok(Row {
+        query,
+        device: eval.device_name(),
+        lights: lights.len(),
+        samples: m,
+        median_seconds: t.as_secs_f64(),
+        evals_per_second: (m * lights.len()) as f64 / t.as_secs_f64(),
+    })
+}
+
+/// The peak resident set of this process (Linux), bytes.
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
 pub fn run(args: BenchArgs) -> CliResult {
+    if args.startup_probe {
+        return crate::bench_startup::probe();
+    }
     if args.samples == 0 || args.cpu_samples == 0 || args.lights == 0 {
         return Err(Failure {
             code: 2,
@@ -124,9 +193,44 @@ pub fn run(args: BenchArgs) -> CliResult {
             args.repeat
         )));
     }
+    if args.sweep {
+        for &m in &args.sweep_samples {
+            limits.check_samples("--sweep-samples", m as u64)?;
+        }
+        if args.sweep_samples.contains(&0) || args.sweep_lights.contains(&0) {
+            return Err(Failure::bad_input(
+                "--sweep-samples and --sweep-lights must be at least 1",
+            ));
+        }
+        if let Some(&l) = args.sweep_lights.iter().find(|&&l| l as u64 > limits.max_prims) {
+            return Err(Failure::bad_input(format!(
+                "--sweep-lights {l} exceeds the limit of {} ({})",
+                limits.max_prims,
+                luxeval::limits::raise_hint(luxeval::limits::ENV_MAX_PRIMS)
+            )));
+        }
+    }
+    // Cold start first, in child processes, before this process has touched the GPU.
+    let startup = if args.no_startup {
+        Vec::new()
+    } else {
+        eprintln!("bench: cold start (two child processes) …");
+        match crate::bench_startup::measure() {
+            Ok(rows) => rows,
+            Err(e) => {
+                eprintln!("warning: {}; no cold-start figures", e.message);
+                Vec::new()
+            }
+        }
+    };
     let lights = synthetic_lights(args.lights);
     let mut rng = Rng::new(7);
-    let n = args.samples.max(args.cpu_samples);
+    let sweep_max = if args.sweep {
+        args.sweep_samples.iter().copied().max().unwrap_or(0)
+    } else {
+        0
+    };
+    let n = args.samples.max(args.cpu_samples).max(sweep_max);
     let dirs: Vec<[f32; 3]> = (0..n).map(|_| rng.unit().as_vec3().to_array()).collect();
     let points: Vec<[f32; 3]> = (0..n)
         .map(|_| (rng.unit() * rng.range(0.5, 6.0)).as_vec3().to_array())
@@ -137,35 +241,76 @@ pub fn run(args: BenchArgs) -> CliResult {
         Ok(g) => evaluators.insert(0, (g, args.samples)),
         Err(e) => eprintln!("warning: no GPU ({e}); measuring the CPU only"),
     }
+    // Irradiance is a quadrature per (light, receiver): 1/IRRADIANCE_SHARE of the samples.
+    let share = |query: &str, m: usize| {
+        if query == "irradiance" {
+            (m / IRRADIANCE_SHARE).max(1)
+        } else {
+            m
+        }
+    };
     let mut rows = Vec::new();
+    let mut latency = Vec::new();
     for (eval, m) in &evaluators {
-        let (d, p) = (&dirs[..*m], &points[..*m]);
         for query in QUERIES {
-            // Irradiance is a quadrature per (light, receiver): 1/IRRADIANCE_SHARE of the samples.
-            let m = if query == "irradiance" {
-                (*m / IRRADIANCE_SHARE).max(1)
-            } else {
-                *m
-            };
-            let (d, p) = (&d[..m], &p[..m]);
-            let t = time(args.repeat, || {
-                match query {
-                    "emission" => eval.emission(&lights, d, Accumulate::Sum)?,
-                    "radiance" => eval.radiance(&lights, p, d, Accumulate::Sum)?,
-                    _ => eval.irradiance(&lights, p, d, Accumulate::Sum)?,
-                };
-                Ok(())
-            })?;
-            rows.push(Row {
+            let m = share(query, *m);
+            eprintln!("bench: {query} on {} …", eval.device_name());
+            rows.push(measure(
+                eval,
+                &lights,
                 query,
-                device: eval.device_name(),
-                lights: lights.len(),
-                samples: m,
-                median_seconds: t.as_secs_f64(),
-                evals_per_second: (m * lights.len()) as f64 / t.as_secs_f64(),
-            });
+                &dirs[..m],
+                &points[..m],
+                args.repeat,
+            )?);
+            let k = LATENCY_SAMPLES.min(n);
+            latency.push(measure(
+                eval,
+                &lights,
+                query,
+                &dirs[..k],
+                &points[..k],
+                args.repeat.max(20),
+            )?);
         }
     }
+    let mut sweep = Vec::new();
+    if args.sweep {
+        for (eval, _) in &evaluators {
+            for &l in &args.sweep_lights {
+                let set = synthetic_lights(l);
+                for &m in &args.sweep_samples {
+                    for query in QUERIES {
+                        let m = share(query, m);
+                        eprintln!(
+                            "bench: sweep {query}, {l} lights × {m} samples on {} …",
+                            eval.device_name()
+                        );
+                        sweep.push(measure(
+                            eval,
+                            &set,
+                            query,
+                            &dirs[..m],
+                            &points[..m],
+                            args.repeat.min(3),
+                        )?);
+                    }
+                }
+            }
+        }
+    }
+    let ratios: Vec<(String, f64)> = QUERIES
+        .iter()
+        .filter_map(|&query| {
+            let g = rows
+                .iter()
+                .find(|r| r.query == query && !r.device.starts_with("cpu"))?;
+            let c = rows
+                .iter()
+                .find(|r| r.query == query && r.device.starts_with("cpu"))?;
+            Some((query.to_string(), g.evals_per_second / c.evals_per_second))
+        })
+        .collect();
     let evals: Vec<Evaluator> = evaluators.iter().map(|(e, _)| e.clone()).collect();
     let dome = if args.no_dome {
         Vec::new()
@@ -180,7 +325,12 @@ pub fn run(args: BenchArgs) -> CliResult {
     if args.json {
         let report = Report {
             queries: rows,
+            ratios,
+            latency,
+            startup,
+            sweep,
             dome,
+            peak_rss_bytes: peak_rss(),
         };
         outln!(
             "{}",
@@ -197,7 +347,7 @@ pub fn run(args: BenchArgs) -> CliResult {
         "median s",
         "evals/s"
     );
-    for r in &rows {
+    for r in rows.iter().chain(&sweep) {
         outln!(
             "{:<10} {:<44} {:>7} {:>9} {:>12.6} {:>16.4e}",
             r.query,
@@ -219,21 +369,39 @@ pub fn run(args: BenchArgs) -> CliResult {
                 .map_or("n/a".to_string(), |c| format!("{c:.2} s"))
         );
     }
-    if evaluators.len() == 2 {
-        for query in QUERIES {
-            let g = rows
-                .iter()
-                .find(|r| r.query == query && !r.device.starts_with("cpu"));
-            let c = rows
-                .iter()
-                .find(|r| r.query == query && r.device.starts_with("cpu"));
-            if let (Some(g), Some(c)) = (g, c) {
-                outln!(
-                    "{query}: GPU/CPU throughput ratio {:.1}× (same run)",
-                    g.evals_per_second / c.evals_per_second
-                );
-            }
-        }
+    for r in &latency {
+        outln!(
+            "warm latency, {} × {} samples, {} on {}: median {:.3} ms",
+            r.lights,
+            r.samples,
+            r.query,
+            r.device,
+            r.median_seconds * 1e3
+        );
+    }
+    for s in &startup {
+        let p = &s.probe;
+        let pipelines: Vec<String> = p
+            .pipelines
+            .iter()
+            .map(|(n, t)| format!("{n} {t:.3} s"))
+            .collect();
+        outln!(
+            "cold start {} ({} bytes loaded): process {:.3} s; instance {:.3} s, adapter {:.3} s, device {:.3} s; pipelines: {}",
+            s.cache,
+            p.cache_loaded_bytes,
+            s.process_seconds,
+            p.instance_seconds,
+            p.adapter_seconds,
+            p.device_seconds,
+            pipelines.join(", ")
+        );
+    }
+    for (query, ratio) in &ratios {
+        outln!("{query}: GPU/CPU throughput ratio {ratio:.2}× (same run)");
+    }
+    if let Some(rss) = peak_rss() {
+        outln!("peak RSS of this process: {:.0} MiB", rss as f64 / (1 << 20) as f64);
     }
     Ok(())
 }

@@ -12,6 +12,7 @@ macro_rules! outln {
 mod args;
 mod bench;
 mod bench_dome;
+mod bench_startup;
 mod check;
 mod exit;
 mod falloff;
