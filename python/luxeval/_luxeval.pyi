@@ -110,6 +110,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        tolerance: float = 1e-4,
     ) -> npt.NDArray[np.float32]:
         """Diffuse-weighted irradiance at each point on a receiver with the given normal →
         float32 (N, 3), or (L, N, 3) with ``per_light=True``."""
@@ -124,6 +125,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        tolerance: float = 1e-4,
     ) -> npt.NDArray[np.float32]:
         """The summed irradiance at the pixel centres of ``origin + s·u + t·v``, res = (W, H)
         → float32 (H, W, 3), row 0 at the top (the ``origin + v`` side)."""

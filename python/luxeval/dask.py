@@ -148,6 +148,7 @@ def _map(
     temperature_mode: str,
     texture_filter: str,
     chunks: int,
+    extra: Optional[dict[str, Any]] = None,
 ) -> da.Array:
     path, requested = _locate(stage, time)
     # Opened here too (no device: reading the lights only): a bad stage, selection or option is
@@ -172,6 +173,7 @@ def _map(
         "device": device,
         "temperature_mode": temperature_mode,
         "texture_filter": texture_filter,
+        **(extra or {}),
     }
     xs = [_rows(x, name, chunks) for x, name in arrays]
     first, first_name = xs[0], arrays[0][1]
@@ -274,10 +276,12 @@ def irradiance(
     device: str = "auto",
     temperature_mode: str = "spec",
     texture_filter: str = "bilinear",
+    tolerance: float = 1e-4,
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.irradiance` over dask arrays of points and receiver normals (N, 3)
-    each, lazily; ``normals`` is rechunked like ``points``. Arguments as :func:`emission`."""
+    each, lazily; ``normals`` is rechunked like ``points``. Arguments as :func:`emission`;
+    ``tolerance`` as :meth:`luxeval.Stage.irradiance`."""
     return _map(
         "irradiance",
         stage,
@@ -289,4 +293,5 @@ def irradiance(
         temperature_mode=temperature_mode,
         texture_filter=texture_filter,
         chunks=chunks,
+        extra={"tolerance": float(tolerance)},
     )

@@ -109,6 +109,9 @@ struct Options {
     device: Device,
     mode: TemperatureMode,
     filter: TextureFilter,
+    /// Irradiance's relative tolerance (`luxeval irradiance --tolerance`); not part of the
+    /// prepared scene, which takes it per call.
+    tolerance: Option<f64>,
 }
 
 impl Options {
@@ -123,7 +126,30 @@ impl Options {
             device: Device::parse(device)?,
             mode: device::parse_mode(mode)?,
             filter: device::parse_filter(filter)?,
+            tolerance: None,
         })
+    }
+
+    /// With irradiance's tolerance, its range checked now (the GPU's bound per call).
+    fn with_tolerance(mut self, rel: f64) -> PyResult<Options> {
+        luxeval::Evaluator::cpu()
+            .with_irradiance_tolerance(rel)
+            .map_err(|e| errors::lux(e, None))?;
+        self.tolerance = Some(rel);
+        Ok(self)
+    }
+
+    fn irradiance(
+        &self,
+        scene: &PreparedScene,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        acc: Accumulate,
+    ) -> luxeval::Result<Vec<[f32; 3]>> {
+        match self.tolerance {
+            Some(rel) => scene.irradiance_with_tolerance(points, normals, acc, rel),
+            None => scene.irradiance(points, normals, acc),
+        }
     }
 }
 
@@ -286,7 +312,7 @@ impl Stage {
                     let rows = match q {
                         Query::Emission => scene.emission(a, acc),
                         Query::Radiance => scene.radiance(a, &b_rows[start..end], acc),
-                        Query::Irradiance => scene.irradiance(a, &b_rows[start..end], acc),
+                        Query::Irradiance => o.irradiance(scene, a, &b_rows[start..end], acc),
                     }
                     .map_err(|e| errors::lux(e, Some(file)))?;
                     let m = end - start;
@@ -576,8 +602,9 @@ impl Stage {
     ///
     /// ``points``, ``normals``: (N, 3) each, paired row by row; normals any non-zero length.
     /// Returns float32 (N, 3), or (L, N, 3) with ``per_light=True``. Options and errors as
-    /// ``emission``.
-    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
+    /// ``emission``. ``tolerance``: relative, from 1e-9 to 0.1, as ``luxeval irradiance
+    /// --tolerance`` (the CPU's quadrature stops there; the GPU takes none below 1e-4).
+    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", tolerance = 1e-4))]
     #[allow(clippy::too_many_arguments)]
     fn irradiance<'py>(
         &self,
@@ -589,8 +616,10 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
+        let o = Options::parse(lights, device, temperature_mode, texture_filter)?
+            .with_tolerance(tolerance)?;
         self.query(py, Query::Irradiance, points, Some(normals), per_light, o)
     }
 
@@ -599,8 +628,9 @@ impl Stage {
     /// ``normalize(u × v)``. ``origin``, ``u``, ``v``: three numbers each; ``res``:
     /// (width, height). Returns float32 (height, width, 3), row 0 at the top of the image
     /// (``origin + v`` side), column 0 at the ``origin`` side: pixel (row j, column i) is at
-    /// ``origin + (i + ½)/W·u + (1 − (j + ½)/H)·v``. Options and errors as ``emission``.
-    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
+    /// ``origin + (i + ½)/W·u + (1 − (j + ½)/H)·v``. Options and errors as ``emission``;
+    /// ``tolerance`` as ``irradiance``.
+    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", tolerance = 1e-4))]
     #[allow(clippy::too_many_arguments)]
     fn falloff<'py>(
         &self,
@@ -613,8 +643,10 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
+        let o = Options::parse(lights, device, temperature_mode, texture_filter)?
+            .with_tolerance(tolerance)?;
         let origin = vec3(py, origin, "origin")?;
         let u = vec3(py, u, "u")?;
         let v = vec3(py, v, "v")?;
@@ -648,8 +680,8 @@ impl Stage {
                         .map(|(i, j)| plane.pixel_centre(i, j).as_vec3().to_array())
                         .collect();
                     let normals = vec![normal; points.len()];
-                    let rgb = scene
-                        .irradiance(&points, &normals, Accumulate::Sum)
+                    let rgb = o
+                        .irradiance(scene, &points, &normals, Accumulate::Sum)
                         .map_err(|e| errors::lux(e, Some(file)))?;
                     let at = j0 as usize * w as usize * 3;
                     out[at..at + rgb.len() * 3].copy_from_slice(rgb.as_flattened());

@@ -21,7 +21,7 @@ import pytest
 
 import luxeval
 import luxeval._luxeval as native
-from helpers import STUDIO, cli_query, floor_points, run_cli, sphere_dirs
+from helpers import LUXTEST, STUDIO, cli_query, floor_points, run_cli, sphere_dirs
 
 
 @pytest.fixture(scope="module")
@@ -194,6 +194,31 @@ def test_falloff_equals_cli_irradiance_on_a_tilted_plane(cli, tmp_path, device):
     want = cli_query(cli, tmp_path, "irradiance", STUDIO, {"points": pts, "normals": normals},
                      "--device", device)
     np.testing.assert_array_equal(m.reshape(-1, 3), want)
+
+
+def test_tolerance_equals_the_cli(cli, tmp_path):
+    """``tolerance=`` is the CLI's ``--tolerance`` (default 1e-4 on both), and the reference's
+    1e-9 on the CPU moves the shaped spot's floor by less than 1e-4."""
+    scene = LUXTEST / "sphere.usda"
+    stage = luxeval.Stage(scene, time=31)
+    pts = floor_points(6)
+    normals = np.tile(np.array([0, 1, 0], np.float32), (len(pts), 1))
+    for tol in (1e-4, 1e-9):
+        got = stage.irradiance(pts, normals, device="cpu", tolerance=tol)
+        flags = ["--device", "cpu", "--time", "31"]
+        if tol != 1e-4:
+            flags += ["--tolerance", str(tol)]
+        want = cli_query(cli, tmp_path, "irradiance", scene, {"points": pts, "normals": normals},
+                         *flags)
+        np.testing.assert_array_equal(got, want)
+    loose = stage.irradiance(pts, normals, device="cpu")
+    exact = stage.irradiance(pts, normals, device="cpu", tolerance=1e-9)
+    assert exact.max() > 0
+    np.testing.assert_allclose(loose, exact, rtol=1e-4, atol=0)
+    with pytest.raises(luxeval.InputError, match="tolerance"):
+        stage.irradiance(pts, normals, device="cpu", tolerance=0.5)
+    with pytest.raises(luxeval.InputError, match="tolerance"):
+        stage.falloff([-1, 0, 1], [2, 0, 0], [0, 0, -2], (2, 2), device="cpu", tolerance=0.0)
 
 
 def test_prepared_lights_are_reused(device):

@@ -31,6 +31,30 @@ pub(crate) enum Backend {
 /// The relative tolerances [`Evaluator::with_irradiance_tolerance`] accepts.
 pub(crate) const IRRADIANCE_TOLERANCE_RANGE: (f64, f64) = (1e-9, 0.1);
 
+/// Refuses an irradiance tolerance out of [`IRRADIANCE_TOLERANCE_RANGE`], or below the GPU's
+/// bound on a GPU (see [`Evaluator::with_irradiance_tolerance`]).
+pub(crate) fn check_tolerance(rel: f64, gpu: bool) -> Result<()> {
+    if !(IRRADIANCE_TOLERANCE_RANGE.0..=IRRADIANCE_TOLERANCE_RANGE.1).contains(&rel) {
+        return Err(LuxError::input(
+            "tolerance",
+            format!(
+                "{rel}: a relative tolerance must be from {:e} (the reference's own) to {}",
+                IRRADIANCE_TOLERANCE_RANGE.0, IRRADIANCE_TOLERANCE_RANGE.1
+            ),
+        ));
+    }
+    if gpu && rel < crate::rules::GPU_TOLERANCE {
+        return Err(LuxError::input(
+            "tolerance",
+            format!(
+                "{rel} is tighter than the GPU's irradiance rule is held to ({:e}, f32); use the CPU reference for it",
+                crate::rules::GPU_TOLERANCE
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Sum the lights per sample, or keep one row per (light, sample).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Accumulate {
@@ -88,24 +112,7 @@ impl Evaluator {
     /// tighter `rel`. Errors: `rel` not in [1e-9, 0.1], or below the GPU's bound on
     /// a GPU evaluator.
     pub fn with_irradiance_tolerance(mut self, rel: f64) -> Result<Self> {
-        if !(IRRADIANCE_TOLERANCE_RANGE.0..=IRRADIANCE_TOLERANCE_RANGE.1).contains(&rel) {
-            return Err(LuxError::input(
-                "tolerance",
-                format!(
-                    "{rel}: a relative tolerance must be from {:e} (the reference's own) to {}",
-                    IRRADIANCE_TOLERANCE_RANGE.0, IRRADIANCE_TOLERANCE_RANGE.1
-                ),
-            ));
-        }
-        if self.is_gpu() && rel < crate::rules::GPU_TOLERANCE {
-            return Err(LuxError::input(
-                "tolerance",
-                format!(
-                    "{rel} is tighter than the GPU's irradiance rule is held to ({:e}, f32); use the CPU reference for it",
-                    crate::rules::GPU_TOLERANCE
-                ),
-            ));
-        }
+        check_tolerance(rel, self.is_gpu())?;
         self.irradiance_tolerance = Some(rel);
         Ok(self)
     }

@@ -168,13 +168,37 @@ impl PreparedScene {
         normals: &[[f32; 3]],
         acc: Accumulate,
     ) -> Result<Vec<[f32; 3]>> {
+        self.irradiance_by(points, normals, acc, &self.rule)
+    }
+
+    /// [`PreparedScene::irradiance`] to relative tolerance `rel` for this call, whatever the
+    /// evaluator's (see [`crate::Evaluator::with_irradiance_tolerance`] for what it means and
+    /// which values each backend takes).
+    pub fn irradiance_with_tolerance(
+        &self,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        acc: Accumulate,
+        rel: f64,
+    ) -> Result<Vec<[f32; 3]>> {
+        super::check_tolerance(rel, matches!(self.backend, Backend::Gpu(_)))?;
+        self.irradiance_by(points, normals, acc, &Adaptive::for_tolerance(rel))
+    }
+
+    fn irradiance_by(
+        &self,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        acc: Accumulate,
+        rule: &Adaptive,
+    ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", normals, "normals")?;
         let per_light = acc == Accumulate::PerLight;
         let mut out = self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
-            cpu::irradiance_batch(&self.lights, points, normals, per_light, &self.rule)
+            cpu::irradiance_batch(&self.lights, points, normals, per_light, rule)
         })?;
         if matches!(self.backend, Backend::Gpu(_)) {
-            self.add_host_irradiance(points, normals, per_light, &mut out);
+            self.add_host_irradiance(points, normals, per_light, rule, &mut out);
         }
         Ok(out)
     }
@@ -186,6 +210,7 @@ impl PreparedScene {
         points: &[[f32; 3]],
         normals: &[[f32; 3]],
         per_light: bool,
+        rule: &Adaptive,
         out: &mut [[f32; 3]],
     ) {
         let n = points.len();
@@ -198,7 +223,7 @@ impl PreparedScene {
                 points,
                 normals,
                 true,
-                &self.rule,
+                rule,
             );
             for (i, v) in values.into_iter().enumerate() {
                 let row = if per_light { k * n + i } else { i };
