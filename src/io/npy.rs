@@ -768,6 +768,99 @@ mod tests {
 }
 
 #[cfg(test)]
+mod streaming {
+    use super::*;
+
+    fn rows(n: usize) -> Vec<[f32; 3]> {
+        (0..n)
+            .map(|i| [i as f32 + 0.5, -(i as f32), 1.0 / (i as f32 + 1.0)])
+            .collect()
+    }
+
+    /// The streaming writer's bytes are `write_f32`'s, with rows written in any order and any
+    /// pieces; the file appears only at `finish`.
+    #[test]
+    fn the_writer_writes_what_write_f32_writes() {
+        let dir = tempfile::tempdir().unwrap();
+        let want_path = dir.path().join("want.npy");
+        let r = rows(2 * 7);
+        write_f32(&want_path, &[2, 7, 3], &r).unwrap();
+        let path = dir.path().join("got.npy");
+        let mut w = Writer::create(&path, &[2, 7, 3]).unwrap();
+        assert_eq!(w.rows(), 14);
+        // Light-major pieces, the second light first, in chunks of 3 samples.
+        for start in (0..7).step_by(3) {
+            let end = (start + 3).min(7);
+            w.write_rows(7 + start as u64, &r[7 + start..7 + end]).unwrap();
+            w.write_rows(start as u64, &r[start..end]).unwrap();
+        }
+        assert!(!path.exists(), "the output appears only when finished");
+        w.finish().unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), std::fs::read(&want_path).unwrap());
+
+        // Unfinished or misused: nothing at the path, no temporary left.
+        let p = dir.path().join("partial.npy");
+        let mut w = Writer::create(&p, &[4, 3]).unwrap();
+        w.write_rows(0, &r[..3]).unwrap();
+        assert!(w.write_rows(2, &r[..3]).is_err(), "rows past the end");
+        let e = w.finish().unwrap_err().to_string();
+        assert!(e.contains("3 rows were written of the 4"), "{e}");
+        assert!(Writer::create(&p, &[4, 2]).is_err());
+        let names: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert_eq!(names.len(), 2, "{names:?}");
+    }
+
+    /// Chunks of any size give the rows of the whole file, in every layout.
+    #[test]
+    fn chunks_of_any_size_read_the_whole_file() {
+        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/npy");
+        let want = read_vec3(&data.join("dirs_f32.npy")).unwrap();
+        for f in [
+            "dirs_f32.npy",
+            "dirs_f64.npy",
+            "dirs_f32_fortran.npy",
+            "dirs_f32_bigendian.npy",
+        ] {
+            for chunk in [0, 1, 2, 3, 1000] {
+                let mut r = Reader::open(&data.join(f), RowKind::Vec3).unwrap();
+                assert_eq!(r.rows(), want.len() as u64);
+                let mut got = Vec::new();
+                while let Some(c) = r.next_chunk(chunk).unwrap() {
+                    assert!(c.len() <= chunk.max(1));
+                    got.extend(c);
+                }
+                assert_eq!(got, want, "{f}, chunks of {chunk}");
+            }
+        }
+    }
+
+    /// A bad row is named by its row in the file, whatever chunk it falls in; the first bad
+    /// row is reported whatever the chunk size.
+    #[test]
+    fn bad_rows_are_named_by_their_row_in_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("p.npy");
+        let mut r = rows(10);
+        r[4] = [0.0, 0.0, 0.0];
+        r[7] = [f32::NAN, 0.0, 0.0];
+        write_f32(&p, &[10, 3], &r).unwrap();
+        for (kind, row) in [(RowKind::Points, "row 7 "), (RowKind::Directions, "row 4 ")] {
+            for chunk in [1, 3, 10] {
+                let mut rd = Reader::open(&p, kind).unwrap();
+                let e = loop {
+                    match rd.next_chunk(chunk) {
+                        Ok(Some(_)) => {}
+                        Ok(None) => panic!("no error"),
+                        Err(e) => break e.to_string(),
+                    }
+                };
+                assert!(e.contains("p.npy") && e.contains(row), "{kind:?} {chunk}: {e}");
+            }
+        }
+    }
+}
+
+#[cfg(test)]
 mod numpy_files {
     use super::*;
 
