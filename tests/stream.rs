@@ -94,7 +94,11 @@ fn write_f64(path: &Path, rows: &[[f64; 3]]) {
 fn run_bytes(args: &[&str], out: &Path, chunk: Option<&str>) -> Vec<u8> {
     let _ = std::fs::remove_file(out);
     let o = luxeval(args, chunk);
-    assert!(o.status.success(), "{args:?} chunk {chunk:?}: {}", stderr(&o));
+    assert!(
+        o.status.success(),
+        "{args:?} chunk {chunk:?}: {}",
+        stderr(&o)
+    );
     std::fs::read(out).unwrap()
 }
 
@@ -141,7 +145,14 @@ fn chunked_emission_and_radiance_equal_one_chunk_and_the_library() {
         };
         let mut emission = vec!["emission", &scene, "--dirs", s(&dirs), "-o", s(&out)];
         let mut radiance = vec![
-            "radiance", &scene, "--points", s(&points), "--dirs", s(&dirs), "-o", s(&out),
+            "radiance",
+            &scene,
+            "--points",
+            s(&points),
+            "--dirs",
+            s(&dirs),
+            "-o",
+            s(&out),
         ];
         for a in [&mut emission, &mut radiance] {
             a.extend(["--device", "cpu"]);
@@ -171,7 +182,10 @@ fn chunked_emission_and_radiance_equal_one_chunk_and_the_library() {
             assert_eq!(shape, want_shape, "{args:?}");
             let want: Vec<f32> = want.iter().flatten().copied().collect();
             assert!(
-                values.iter().map(|v| v.to_bits()).eq(want.iter().map(|v| v.to_bits())),
+                values
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .eq(want.iter().map(|v| v.to_bits())),
                 "{args:?}: the CLI differs from the library"
             );
         }
@@ -191,11 +205,27 @@ fn chunked_irradiance_and_intensity_equal_one_chunk() {
     let out = d.join("out.npy");
     let scene = asset("studio.usda");
     let irradiance = [
-        "irradiance", &scene, "--points", s(&points), "--normals", s(&normals), "-o", s(&out),
-        "--device", "cpu", "--per-light",
+        "irradiance",
+        &scene,
+        "--points",
+        s(&points),
+        "--normals",
+        s(&normals),
+        "-o",
+        s(&out),
+        "--device",
+        "cpu",
+        "--per-light",
     ];
     let intensity = [
-        "intensity", &scene, "--dirs", s(&normals), "-o", s(&out), "--device", "cpu",
+        "intensity",
+        &scene,
+        "--dirs",
+        s(&normals),
+        "-o",
+        s(&out),
+        "--device",
+        "cpu",
     ];
     for args in [&irradiance[..], &intensity[..]] {
         let whole = run_bytes(args, &out, Some("61"));
@@ -222,7 +252,14 @@ fn float64_and_fortran_inputs_stream_like_float32() {
     let out = d.join("out.npy");
     let scene = asset("studio.usda");
     let args = [
-        "emission", &scene, "--dirs", s(&dirs64), "-o", s(&out), "--device", "cpu",
+        "emission",
+        &scene,
+        "--dirs",
+        s(&dirs64),
+        "-o",
+        s(&out),
+        "--device",
+        "cpu",
     ];
     let whole = run_bytes(&args, &out, Some("100000"));
     assert!(run_bytes(&args, &out, Some("10")) == whole);
@@ -231,7 +268,11 @@ fn float64_and_fortran_inputs_stream_like_float32() {
         .evaluable(&[])
         .unwrap();
     let want = Evaluator::cpu()
-        .emission(&lights, &npy::read_directions(&dirs64).unwrap(), Accumulate::Sum)
+        .emission(
+            &lights,
+            &npy::read_directions(&dirs64).unwrap(),
+            Accumulate::Sum,
+        )
         .unwrap();
     let (_, values) = f32_values(&whole);
     assert_eq!(values, want.iter().flatten().copied().collect::<Vec<_>>());
@@ -241,14 +282,37 @@ fn float64_and_fortran_inputs_stream_like_float32() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/npy");
     let c_order = data.join("dirs_f32.npy");
     let c_args = [
-        "emission", &scene, "--dirs", s(&c_order), "-o", s(&out), "--device", "cpu",
+        "emission",
+        &scene,
+        "--dirs",
+        s(&c_order),
+        "-o",
+        s(&out),
+        "--device",
+        "cpu",
     ];
     let want = run_bytes(&c_args, &out, None);
-    for f in ["dirs_f32_fortran.npy", "dirs_f64.npy", "dirs_f32_bigendian.npy"] {
+    for f in [
+        "dirs_f32_fortran.npy",
+        "dirs_f64.npy",
+        "dirs_f32_bigendian.npy",
+    ] {
         let p = data.join(f);
-        let args = ["emission", &scene, "--dirs", s(&p), "-o", s(&out), "--device", "cpu"];
+        let args = [
+            "emission",
+            &scene,
+            "--dirs",
+            s(&p),
+            "-o",
+            s(&out),
+            "--device",
+            "cpu",
+        ];
         for chunk in ["1", "2", "3"] {
-            assert!(run_bytes(&args, &out, Some(chunk)) == want, "{f}, chunk {chunk}");
+            assert!(
+                run_bytes(&args, &out, Some(chunk)) == want,
+                "{f}, chunk {chunk}"
+            );
         }
     }
 }
@@ -283,7 +347,12 @@ fn a_bad_row_in_a_later_chunk_names_its_row_and_leaves_no_output() {
         ),
         (
             vec![
-                "radiance", &scene, "--points", s(&points), "--dirs", s(&good_dirs),
+                "radiance",
+                &scene,
+                "--points",
+                s(&points),
+                "--dirs",
+                s(&good_dirs),
             ],
             &["points_inf.npy", "row 871 ", "not finite"],
         ),
@@ -330,8 +399,16 @@ fn a_result_overflowing_in_a_later_chunk_names_its_row() {
     let scene = bad("point_light.usda");
     for per_light in [false, true] {
         let mut args = vec![
-            "irradiance", &scene, "--points", s(&points), "--normals", s(&normals), "-o",
-            s(&out), "--device", "cpu",
+            "irradiance",
+            &scene,
+            "--points",
+            s(&points),
+            "--normals",
+            s(&normals),
+            "-o",
+            s(&out),
+            "--device",
+            "cpu",
         ];
         if per_light {
             args.push("--per-light");
@@ -373,7 +450,12 @@ fn truncated_files_and_mismatched_rows_are_refused_before_evaluation() {
         ),
         (
             vec![
-                "irradiance", &scene, "--points", s(&dirs), "--normals", s(&short),
+                "irradiance",
+                &scene,
+                "--points",
+                s(&dirs),
+                "--normals",
+                s(&short),
             ],
             &["dirs.npy", "100 rows", "short.npy", "99"],
         ),
@@ -406,8 +488,16 @@ fn a_truncated_pipe_is_refused_when_it_ends() {
     let out = d.join("out.npy");
     let scene = asset("studio.usda");
     for (data, code, says) in [
-        (bytes[..bytes.len() - 12 * 30].to_vec(), Some(2), "ends inside the data"),
-        ([&bytes[..], b"xyz"].concat(), Some(2), "more data than the 100 rows"),
+        (
+            bytes[..bytes.len() - 12 * 30].to_vec(),
+            Some(2),
+            "ends inside the data",
+        ),
+        (
+            [&bytes[..], b"xyz"].concat(),
+            Some(2),
+            "more data than the 100 rows",
+        ),
         (bytes.clone(), Some(0), ""),
     ] {
         let writer = {
@@ -419,14 +509,32 @@ fn a_truncated_pipe_is_refused_when_it_ends() {
                 let _ = f.write_all(&data);
             })
         };
-        let args = ["emission", &scene, "--dirs", s(&pipe), "-o", s(&out), "--device", "cpu"];
+        let args = [
+            "emission",
+            &scene,
+            "--dirs",
+            s(&pipe),
+            "-o",
+            s(&out),
+            "--device",
+            "cpu",
+        ];
         let o = luxeval(&args, Some("10"));
         writer.join().unwrap();
         assert_eq!(o.status.code(), code, "{}", stderr(&o));
         assert!(stderr(&o).contains(says), "{says:?} in {}", stderr(&o));
         if code == Some(0) {
             let want = run_bytes(
-                &["emission", &scene, "--dirs", s(&dirs), "-o", s(&out), "--device", "cpu"],
+                &[
+                    "emission",
+                    &scene,
+                    "--dirs",
+                    s(&dirs),
+                    "-o",
+                    s(&out),
+                    "--device",
+                    "cpu",
+                ],
                 &out,
                 None,
             );
@@ -445,8 +553,14 @@ fn chunk_rows_must_be_a_positive_integer() {
     for bad in ["0", "-3", "lots", "1.5", ""] {
         let o = luxeval(
             &[
-                "emission", &asset("studio.usda"), "--dirs", &asset("dirs.npy"), "-o", s(&out),
-                "--device", "cpu",
+                "emission",
+                &asset("studio.usda"),
+                "--dirs",
+                &asset("dirs.npy"),
+                "-o",
+                s(&out),
+                "--device",
+                "cpu",
             ],
             Some(bad),
         );
@@ -477,15 +591,39 @@ fn gpu_chunked_results_equal_one_chunk() {
     let out = d.join("out.npy");
     let scene = asset("studio.usda");
     let emission = [
-        "emission", &scene, "--dirs", s(&dirs), "-o", s(&out), "--device", "gpu", "--per-light",
+        "emission",
+        &scene,
+        "--dirs",
+        s(&dirs),
+        "-o",
+        s(&out),
+        "--device",
+        "gpu",
+        "--per-light",
     ];
     let radiance = [
-        "radiance", &scene, "--points", s(&points), "--dirs", s(&dirs), "-o", s(&out),
-        "--device", "gpu",
+        "radiance",
+        &scene,
+        "--points",
+        s(&points),
+        "--dirs",
+        s(&dirs),
+        "-o",
+        s(&out),
+        "--device",
+        "gpu",
     ];
     let irradiance = [
-        "irradiance", &scene, "--points", s(&points), "--normals", s(&dirs), "-o", s(&out),
-        "--device", "gpu",
+        "irradiance",
+        &scene,
+        "--points",
+        s(&points),
+        "--normals",
+        s(&dirs),
+        "-o",
+        s(&out),
+        "--device",
+        "gpu",
     ];
     for args in [&emission[..], &radiance[..], &irradiance[..]] {
         let whole = run_bytes(args, &out, Some("1000"));

@@ -355,7 +355,13 @@ fn check_end(r: &mut impl Read, path: &Path, rows: u64) -> Result<()> {
 /// `m` rows from their bytes: row-major, or (`columns`) three columns of `m` values each.
 fn decode(bytes: &[u8], m: usize, item: usize, little_endian: bool, columns: bool) -> Rows {
     // Element k of `bytes` is row k / 3, column k % 3 (row-major) or row k % m, column k / m.
-    let at = |k: usize| if columns { (k % m, k / m) } else { (k / 3, k % 3) };
+    let at = |k: usize| {
+        if columns {
+            (k % m, k / m)
+        } else {
+            (k / 3, k % 3)
+        }
+    };
     if item == 4 {
         let mut rows = vec![[0f32; 3]; m];
         for (k, c) in bytes.chunks_exact(4).enumerate() {
@@ -723,12 +729,10 @@ impl Writer {
                 path: self.path.clone(),
                 source,
             })?;
-        self.tmp
-            .persist(&self.path)
-            .map_err(|e| LuxError::Io {
-                path: self.path.clone(),
-                source: e.error,
-            })?;
+        self.tmp.persist(&self.path).map_err(|e| LuxError::Io {
+            path: self.path.clone(),
+            source: e.error,
+        })?;
         Ok(())
     }
 }
@@ -791,12 +795,16 @@ mod streaming {
         // Light-major pieces, the second light first, in chunks of 3 samples.
         for start in (0..7).step_by(3) {
             let end = (start + 3).min(7);
-            w.write_rows(7 + start as u64, &r[7 + start..7 + end]).unwrap();
+            w.write_rows(7 + start as u64, &r[7 + start..7 + end])
+                .unwrap();
             w.write_rows(start as u64, &r[start..end]).unwrap();
         }
         assert!(!path.exists(), "the output appears only when finished");
         w.finish().unwrap();
-        assert_eq!(std::fs::read(&path).unwrap(), std::fs::read(&want_path).unwrap());
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            std::fs::read(&want_path).unwrap()
+        );
 
         // Unfinished or misused: nothing at the path, no temporary left.
         let p = dir.path().join("partial.npy");
@@ -854,7 +862,10 @@ mod streaming {
                         Err(e) => break e.to_string(),
                     }
                 };
-                assert!(e.contains("p.npy") && e.contains(row), "{kind:?} {chunk}: {e}");
+                assert!(
+                    e.contains("p.npy") && e.contains(row),
+                    "{kind:?} {chunk}: {e}"
+                );
             }
         }
     }

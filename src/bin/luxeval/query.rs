@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use luxeval::io::npy::{self, RowKind};
 use luxeval::io;
+use luxeval::io::npy::{self, RowKind};
 use luxeval::plot::polar;
 use luxeval::{Accumulate, Evaluator, Limits, PreparedScene, Reference};
 
@@ -103,7 +103,11 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
     // Rows go to a temporary file beside the output as they are evaluated; on any error below
     // it is removed (dropped) and the output path is left as it was.
     let mut writer = npy::Writer::create(output, &shape)?;
-    let bar = progress_bar(n, "rows", format!("{} on {}", query.name(), eval.device_name()));
+    let bar = progress_bar(
+        n,
+        "rows",
+        format!("{} on {}", query.name(), eval.device_name()),
+    );
     let mut start = 0u64;
     loop {
         let mut chunks = Vec::with_capacity(readers.len());
