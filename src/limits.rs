@@ -88,7 +88,8 @@ pub fn raise_hint(env: &str) -> String {
     format!("set {env} to raise it; see docs/INPUTS.md")
 }
 
-fn var(name: &str, default: u64) -> Result<u64> {
+/// A positive integer from the environment variable `name`, or `default` when it is unset.
+pub(crate) fn var(name: &str, default: u64) -> Result<u64> {
     match std::env::var(name) {
         Err(std::env::VarError::NotPresent) => Ok(default),
         Ok(s) => match s.trim().replace('_', "").parse::<u64>() {

@@ -125,7 +125,8 @@ np.save(os.path.join(OUT, "normal_down.npy"), np.array([[0, -1, 0]], dtype="<f4"
 np.save(os.path.join(OUT, "dirs_f64_huge.npy"), dirs.astype("<f8") * 1e300)
 np.save(os.path.join(OUT, "dirs_f32_subnormal.npy"), dirs * np.float32(1e-40))
 np.save(os.path.join(OUT, "dirs_f32_huge.npy"), dirs * np.float32(3e38))
-np.save(os.path.join(OUT, "points_f64_huge.npy"), np.array([[0, 0, 0], [1e300, 0, 0]], dtype="<f8"))
+# Four rows, to pair with dirs.npy: the row counts are compared from the headers, before any row.
+np.save(os.path.join(OUT, "points_f64_huge.npy"), np.array([[0, 0, 0], [1e300, 0, 0], [0, 0, 0], [0, 0, 0]], dtype="<f8"))
 
 # --- counts and sizes ---------------------------------------------------------------------------
 

@@ -105,7 +105,9 @@ impl Map {
     }
 }
 
-/// Rows evaluated per call, so that progress can be reported and memory stays bounded.
+/// Pixels evaluated per call (in whole image rows), so that progress can be reported and the
+/// points and normals of one band are all the input held; the map itself is held whole, for
+/// the EXR and PNG writers (docs/INPUTS.md "Streaming").
 const BLOCK_PIXELS: usize = 1 << 16;
 
 /// Evaluates the summed irradiance of the prepared lights over `plane`, in blocks of rows (the

@@ -28,6 +28,21 @@ pub fn write_atomic(
         path: path.to_path_buf(),
         source,
     };
+    let mut tmp = temp_beside(path)?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
+        write(&mut w).map_err(write_err)?;
+        w.flush().map_err(write_err)?;
+    }
+    tmp.as_file().sync_all().map_err(write_err)?;
+    tmp.persist(path).map_err(|e| io_err(e.error))?;
+    Ok(())
+}
+
+/// A new temporary file in the directory of `path` (so that it can be renamed over `path`),
+/// named `.luxeval-*.part`, removed when dropped. No file can be created there:
+/// [`LuxError::Io`].
+pub(crate) fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -41,15 +56,10 @@ pub fn write_atomic(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    let mut tmp = builder.tempfile_in(dir).map_err(io_err)?;
-    {
-        let mut w = std::io::BufWriter::new(tmp.as_file_mut());
-        write(&mut w).map_err(write_err)?;
-        w.flush().map_err(write_err)?;
-    }
-    tmp.as_file().sync_all().map_err(write_err)?;
-    tmp.persist(path).map_err(|e| io_err(e.error))?;
-    Ok(())
+    builder.tempfile_in(dir).map_err(|source| LuxError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// Where a path leads, for comparing spellings: the file's identity (device and inode) when it

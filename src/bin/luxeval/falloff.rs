@@ -82,19 +82,14 @@ pub fn run(a: &FalloffArgs) -> CliResult {
         return Err(Failure::bad_input("--range: a log scale needs LOW > 0"));
     }
     let (eval, scene) = open::prepare_irradiance(&a.scene, a.device, a.tolerance)?;
-    // A bar on a terminal, nothing when stderr is redirected (indicatif hides itself there).
-    let bar = indicatif::ProgressBar::new(plane.pixels() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:40}] {percent:>3}% {pos}/{len} px, eta {eta}",
-        )
-        .expect("static template")
-        .progress_chars("=> "),
+    let bar = crate::query::progress_bar(
+        plane.pixels() as u64,
+        "px",
+        format!("falloff on {}", eval.device_name()),
     );
-    bar.set_message(format!("falloff on {}", eval.device_name()));
     let map = falloff::evaluate(&scene, &plane, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    crate::query::check_finite(&scene, map.rgb.len(), &map.rgb)?;
+    crate::query::check_finite(&scene, 0, map.rgb.len(), &map.rgb)?;
     let n = plane.normal();
     let comment = format!(
         "luxeval falloff: {} at {}; origin {:?} u {:?} v {:?}; normal ({}, {}, {}); {} lights on {}",

@@ -2,7 +2,8 @@
 
 use std::path::Path;
 
-use luxeval::io::{self, npy};
+use luxeval::io;
+use luxeval::io::npy::{self, RowKind};
 use luxeval::plot::polar;
 use luxeval::{Accumulate, Evaluator, Limits, PreparedScene, Reference};
 
@@ -44,6 +45,16 @@ impl Query<'_> {
             Query::Intensity { dirs, .. } => vec![("--dirs", dirs)],
         }
     }
+
+    /// The command's name, for the progress bar.
+    fn name(&self) -> &'static str {
+        match self {
+            Query::Emission { .. } => "emission",
+            Query::Radiance { .. } => "radiance",
+            Query::Irradiance { .. } => "irradiance",
+            Query::Intensity { .. } => "intensity",
+        }
+    }
 }
 
 pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
@@ -55,84 +66,133 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
     }
     io::check_outputs(&outputs, &inputs)?;
     let acc = args.accumulate();
-    // Inputs are read before the stage is opened: a bad array is reported without the cost of
-    // opening a device. Directions and normals are normalised in f64 as they are read.
-    let (n, scene, out) = match query {
-        Query::Emission { dirs } => {
-            let dirs = npy::read_directions(dirs)?;
-            let (_, scene) = open::prepare(&args.scene, args.device)?;
-            check_output_rows(&scene, dirs.len(), args.per_light)?;
-            let out = scene.emission(&dirs, acc)?;
-            (dirs.len(), scene, out)
+    let chunk = npy::chunk_rows_from_env()?;
+    // The headers are read and checked (dtype, shape, size, paired row counts) before the stage
+    // is opened: a malformed array is reported without the cost of opening a device. The rows
+    // are read, checked and evaluated chunk by chunk below (docs/INPUTS.md "Streaming").
+    let mut readers = match query {
+        Query::Emission { dirs } | Query::Intensity { dirs, .. } => {
+            vec![npy::Reader::open(dirs, RowKind::Directions)?]
         }
-        Query::Radiance {
-            points: pp,
-            dirs: dp,
-        } => {
-            let points = npy::read_points(pp)?;
-            let dirs = npy::read_directions(dp)?;
-            same_rows(("--points", pp, points.len()), ("--dirs", dp, dirs.len()))?;
-            let (_, scene) = open::prepare(&args.scene, args.device)?;
-            check_output_rows(&scene, dirs.len(), args.per_light)?;
-            let out = scene.radiance(&points, &dirs, acc)?;
-            (dirs.len(), scene, out)
+        Query::Radiance { points, dirs } => {
+            let p = npy::Reader::open(points, RowKind::Points)?;
+            let d = npy::Reader::open(dirs, RowKind::Directions)?;
+            same_rows(("--points", &p), ("--dirs", &d))?;
+            vec![p, d]
         }
         Query::Irradiance {
-            points: pp,
-            normals: np,
-            tolerance,
+            points, normals, ..
         } => {
-            let points = npy::read_points(pp)?;
-            let normals = npy::read_directions(np)?;
-            same_rows(
-                ("--points", pp, points.len()),
-                ("--normals", np, normals.len()),
-            )?;
-            let (_, scene) = open::prepare_irradiance(&args.scene, args.device, tolerance)?;
-            check_output_rows(&scene, points.len(), args.per_light)?;
-            let out = scene.irradiance(&points, &normals, acc)?;
-            (points.len(), scene, out)
-        }
-        Query::Intensity { dirs, png } => {
-            let dirs = npy::read_directions(dirs)?;
-            if png.is_some() && args.scene.lights.len() != 1 {
-                return Err(Failure::bad_input(
-                    "--png plots one light: select it with --light PATH",
-                ));
-            }
-            let (eval, scene) = open::prepare(&args.scene, args.device)?;
-            check_output_rows(&scene, dirs.len(), args.per_light)?;
-            let out = scene.intensity(&dirs, acc)?;
-            if let Some(png) = png {
-                plot_light(&eval, &scene, &args.scene, png)?;
-            }
-            (dirs.len(), scene, out)
+            let p = npy::Reader::open(points, RowKind::Points)?;
+            let n = npy::Reader::open(normals, RowKind::Directions)?;
+            same_rows(("--points", &p), ("--normals", &n))?;
+            vec![p, n]
         }
     };
-    check_finite(&scene, n, &out)?;
-    write_rows(output, args, &scene, n, &out)
+    if let Query::Intensity { png: Some(_), .. } = query
+        && args.scene.lights.len() != 1
+    {
+        return Err(Failure::bad_input(
+            "--png plots one light: select it with --light PATH",
+        ));
+    }
+    let n = readers[0].rows();
+    let (eval, scene) = match query {
+        Query::Irradiance { tolerance, .. } => {
+            open::prepare_irradiance(&args.scene, args.device, tolerance)?
+        }
+        _ => open::prepare(&args.scene, args.device)?,
+    };
+    check_output_rows(&scene, n, args.per_light)?;
+    let lights = scene.len() as u64;
+    let shape: Vec<u64> = if args.per_light {
+        vec![lights, n, 3]
+    } else {
+        vec![n, 3]
+    };
+    // Rows go to a temporary file beside the output as they are evaluated; on any error below
+    // it is removed (dropped) and the output path is left as it was.
+    let mut writer = npy::Writer::create(output, &shape)?;
+    let bar = progress_bar(
+        n,
+        "rows",
+        format!("{} on {}", query.name(), eval.device_name()),
+    );
+    let mut start = 0u64;
+    loop {
+        let mut chunks = Vec::with_capacity(readers.len());
+        for r in &mut readers {
+            chunks.push(r.next_chunk(chunk)?);
+        }
+        // The readers hold the same number of rows and read the same chunk size: they end
+        // together.
+        let Some(Some(first)) = chunks.first() else {
+            break;
+        };
+        let m = first.len();
+        let second = || chunks[1].as_deref().expect("paired inputs end together");
+        let out = match query {
+            Query::Emission { .. } => scene.emission(first, acc)?,
+            Query::Intensity { .. } => scene.intensity(first, acc)?,
+            Query::Radiance { .. } => scene.radiance(first, second(), acc)?,
+            Query::Irradiance { .. } => scene.irradiance(first, second(), acc)?,
+        };
+        check_finite(&scene, start, m, &out)?;
+        if args.per_light {
+            // Light-major (L, N, 3): light l's rows of this chunk go to rows l·N + start…
+            for (l, rows) in out.chunks_exact(m.max(1)).enumerate() {
+                writer.write_rows(l as u64 * n + start, rows)?;
+            }
+        } else {
+            writer.write_rows(start, &out)?;
+        }
+        start += m as u64;
+        bar.set_position(start);
+    }
+    bar.finish_and_clear();
+    if let Query::Intensity { png: Some(png), .. } = query {
+        plot_light(&eval, &scene, &args.scene, png)?;
+    }
+    writer.finish()?;
+    Ok(())
 }
 
-/// Two arrays that pair up row by row, or an error naming both files.
-fn same_rows(a: (&str, &Path, usize), b: (&str, &Path, usize)) -> CliResult {
-    if a.2 != b.2 {
+/// A progress bar on a terminal for `total` items, nothing when stderr is redirected (indicatif
+/// hides itself there).
+pub fn progress_bar(total: u64, unit: &str, message: String) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(total);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&format!(
+            "{{msg}} [{{bar:40}}] {{percent:>3}}% {{pos}}/{{len}} {unit}, eta {{eta}}"
+        ))
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar.set_message(message);
+    bar
+}
+
+/// Two arrays that pair up row by row, or an error naming both files; from their headers,
+/// before any row is read.
+fn same_rows(a: (&str, &npy::Reader), b: (&str, &npy::Reader)) -> CliResult {
+    if a.1.rows() != b.1.rows() {
         return Err(Failure::bad_input(format!(
             "{} {} has {} rows but {} {} has {}; they pair up row by row",
             a.0,
-            a.1.display(),
-            a.2,
+            a.1.path().display(),
+            a.1.rows(),
             b.0,
-            b.1.display(),
-            b.2
+            b.1.path().display(),
+            b.1.rows()
         )));
     }
     Ok(())
 }
 
 /// `--per-light` writes lights × rows: bounded like any other array.
-fn check_output_rows(scene: &PreparedScene, n: usize, per_light: bool) -> CliResult {
+fn check_output_rows(scene: &PreparedScene, n: u64, per_light: bool) -> CliResult {
     let lights = if per_light { scene.len().max(1) } else { 1 };
-    let rows = (lights as u64).saturating_mul(n as u64);
+    let rows = (lights as u64).saturating_mul(n);
     Limits::from_env()?.check_samples("the output (lights × rows)", rows)?;
     Ok(())
 }
@@ -141,13 +201,20 @@ fn check_output_rows(scene: &PreparedScene, n: usize, per_light: bool) -> CliRes
 /// constant fits float32 (checked when the lights are prepared), but a sum over many lights, or
 /// the irradiance of a point-like light at a receiver almost on it, can still overflow float32.
 /// Such a result is refused, naming the row (and light), instead of writing `inf`.
-pub fn check_finite(scene: &PreparedScene, n: usize, rows: &[[f32; 3]]) -> CliResult {
+///
+/// `rows` are the results of the `m` samples from sample `start` on (`m` rows, or light-major
+/// L × `m` with `--per-light`); the message names the sample's row in the whole input.
+pub fn check_finite(scene: &PreparedScene, start: u64, m: usize, rows: &[[f32; 3]]) -> CliResult {
     if let Some(k) = rows.iter().position(|r| r.iter().any(|v| !v.is_finite())) {
-        let at = if rows.len() > n && n > 0 {
-            let light = scene.lights().nth(k / n).map(|l| l.path.clone());
-            format!("row {} of light {}", k % n, light.unwrap_or_default())
+        let at = if rows.len() > m && m > 0 {
+            let light = scene.lights().nth(k / m).map(|l| l.path.clone());
+            format!(
+                "row {} of light {}",
+                start + (k % m) as u64,
+                light.unwrap_or_default()
+            )
         } else {
-            format!("row {k}")
+            format!("row {}", start + k as u64)
         };
         let what = if rows[k].iter().any(|v| v.is_nan()) {
             // NaN from finite input is a defect of luxeval, not of the input.
@@ -164,22 +231,6 @@ pub fn check_finite(scene: &PreparedScene, n: usize, rows: &[[f32; 3]]) -> CliRe
             rows[k]
         )));
     }
-    Ok(())
-}
-
-fn write_rows(
-    path: &Path,
-    args: &QueryArgs,
-    scene: &PreparedScene,
-    n: usize,
-    rows: &[[f32; 3]],
-) -> CliResult {
-    let shape: Vec<u64> = if args.per_light {
-        vec![scene.len() as u64, n as u64, 3]
-    } else {
-        vec![n as u64, 3]
-    };
-    npy::write_f32(path, &shape, rows)?;
     Ok(())
 }
 
