@@ -7,6 +7,7 @@ pub(crate) mod dispatch;
 pub(crate) mod dome_atlas;
 pub(crate) mod ies_atlas;
 pub(crate) mod record;
+pub(crate) mod resident;
 pub(crate) mod shaders;
 
 use std::collections::HashMap;
@@ -79,6 +80,8 @@ pub(crate) struct GpuContext {
     /// Why the device was lost, once it is (set by wgpu's device-lost callback): reported
     /// instead of the validation errors a lost device's buffers then raise.
     lost: Arc<Mutex<Option<String>>>,
+    /// Whether the device is the caller's (`from_device`) rather than one luxeval opened.
+    callers_device: bool,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -150,6 +153,8 @@ impl GpuContext {
             })?;
         // wgpu's default handler panics; errors are caught by scopes around each dispatch, and
         // anything that escapes them is logged rather than aborting the process.
+        // (Only on luxeval's own device: a caller's device keeps the caller's handlers, see
+        // `from_device`.)
         device.on_uncaptured_error(Arc::new(|e| log::error!("wgpu: {e}")));
         let lost = Arc::new(Mutex::new(None));
         let on_lost = Arc::clone(&lost);
@@ -172,7 +177,18 @@ impl GpuContext {
         if std::env::var("LUXEVAL_TEST_FAULT").as_deref() == Ok("device-lost") {
             device.destroy();
         }
+        Ok(Self::with_device(device, queue, info, limits, lost))
+    }
 
+    /// The part of opening a context that follows the device: the bind group and pipeline
+    /// layouts every kernel shares.
+    fn with_device(
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        info: wgpu::AdapterInfo,
+        limits: wgpu::Limits,
+        lost: Arc<Mutex<Option<String>>>,
+    ) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("luxeval queries"),
             entries: &[
@@ -202,7 +218,7 @@ impl GpuContext {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        Ok(GpuContext {
+        GpuContext {
             device,
             queue,
             info,
@@ -211,7 +227,8 @@ impl GpuContext {
             pipeline_layout,
             pipelines: Mutex::new(HashMap::new()),
             lost,
-        })
+            callers_device: false,
+        }
     }
 
     /// The pipeline of `kernel`, compiled on first use; `ies` selects the variant with the IES
