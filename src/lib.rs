@@ -61,10 +61,6 @@ pub(crate) mod usd;
 struct ReadmeDoctests;
 
 pub use error::{GpuFailure, LuxError, Result};
-/// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
-/// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that
-/// the types match.
-pub use wgpu;
 pub use gpu::{AdapterSummary, DeviceLimits, adapters};
 pub use limits::Limits;
 pub use model::{
@@ -77,3 +73,7 @@ pub use query::lights_json;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
 #[cfg(feature = "usd")]
 pub use usd::{Scene, SceneLight, Stage, StageInfo, TimeRule};
+/// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
+/// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that
+/// the types match.
+pub use wgpu;

@@ -24,12 +24,10 @@ struct Renderer {
 fn renderer_with(limits: Option<wgpu::Limits>) -> Option<Renderer> {
     let instance =
         wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-    let adapter = match pollster::block_on(instance.request_adapter(
-        &wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            ..Default::default()
-        },
-    )) {
+    let adapter = match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        ..Default::default()
+    })) {
         Ok(a) => a,
         Err(e) => {
             if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") {
@@ -100,7 +98,12 @@ impl Renderer {
     }
 
     /// Submits `encoder` and reads the first `rows` rows of `out` back.
-    fn finish(&self, mut encoder: wgpu::CommandEncoder, out: &wgpu::Buffer, rows: usize) -> Vec<[f32; 3]> {
+    fn finish(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        out: &wgpu::Buffer,
+        rows: usize,
+    ) -> Vec<[f32; 3]> {
         let size = (rows * 12) as u64;
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -117,7 +120,8 @@ impl Renderer {
             .poll(wgpu::PollType::wait_indefinitely())
             .expect("the device finishes");
         rx.recv().unwrap().expect("the readback maps");
-        let data = bytemuck::cast_slice::<u8, [f32; 3]>(&slice.get_mapped_range().unwrap()).to_vec();
+        let data =
+            bytemuck::cast_slice::<u8, [f32; 3]>(&slice.get_mapped_range().unwrap()).to_vec();
         staging.unmap();
         data
     }
@@ -154,8 +158,15 @@ fn assert_same(what: &str, resident: &[[f32; 3]], host: &[[f32; 3]]) {
         }
     }
     let lit = host.iter().filter(|h| h.iter().any(|c| *c != 0.0)).count();
-    assert!(lit * 10 >= host.len(), "{what}: only {lit} of {} rows lit", host.len());
-    eprintln!("{what}: {} rows, {lit} lit, largest relative difference {worst:.3e}", host.len());
+    assert!(
+        lit * 10 >= host.len(),
+        "{what}: only {lit} of {} rows lit",
+        host.len()
+    );
+    eprintln!(
+        "{what}: {} rows, {lit} lit, largest relative difference {worst:.3e}",
+        host.len()
+    );
 }
 
 /// Lights for emission and radiance: the benchmark's mix (shaped and not) and two IES-shaped
@@ -163,8 +174,18 @@ fn assert_same(what: &str, resident: &[[f32; 3]], host: &[[f32; 3]]) {
 fn lights_with_ies() -> Vec<Light> {
     let mut rng = Rng::new(11);
     let mut lights = synthetic_lights(12);
-    lights.push(with_random_ies(random_light(1, "rotate", &mut rng, 100), &mut rng, 3, false));
-    lights.push(with_random_ies(random_light(3, "translate", &mut rng, 101), &mut rng, 1, true));
+    lights.push(with_random_ies(
+        random_light(1, "rotate", &mut rng, 100),
+        &mut rng,
+        3,
+        false,
+    ));
+    lights.push(with_random_ies(
+        random_light(3, "translate", &mut rng, 101),
+        &mut rng,
+        1,
+        true,
+    ));
     lights
 }
 
@@ -172,25 +193,44 @@ fn lights_with_ies() -> Vec<Light> {
 fn emission_and_intensity_match_the_host_path() {
     let Some(r) = renderer() else { return };
     let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
-    assert!(eval.device_name().contains("caller's device"), "{}", eval.device_name());
+    assert!(
+        eval.device_name().contains("caller's device"),
+        "{}",
+        eval.device_name()
+    );
     let scene = eval.prepare(&lights_with_ies()).unwrap();
     let mut rng = Rng::new(1);
     // Not a multiple of the workgroup size (64).
     let n = 10_007;
     let dirs = unit_rows(&mut rng, n);
     let dirs_buf = r.buffer(&dirs, wgpu::BufferUsages::STORAGE);
-    for (acc, rows) in [(Accumulate::Sum, n), (Accumulate::PerLight, scene.len() * n)] {
+    for (acc, rows) in [
+        (Accumulate::Sum, n),
+        (Accumulate::PerLight, scene.len() * n),
+    ] {
         let out = r.output(rows);
         let mut enc = r.encoder();
-        scene.encode_emission(&mut enc, &dirs_buf, &out, n as u32, acc).unwrap();
+        scene
+            .encode_emission(&mut enc, &dirs_buf, &out, n as u32, acc)
+            .unwrap();
         let got = r.finish(enc, &out, rows);
-        assert_same(&format!("emission {acc:?}"), &got, &scene.emission(&dirs, acc).unwrap());
+        assert_same(
+            &format!("emission {acc:?}"),
+            &got,
+            &scene.emission(&dirs, acc).unwrap(),
+        );
 
         let out = r.output(rows);
         let mut enc = r.encoder();
-        scene.encode_intensity(&mut enc, &dirs_buf, &out, n as u32, acc).unwrap();
+        scene
+            .encode_intensity(&mut enc, &dirs_buf, &out, n as u32, acc)
+            .unwrap();
         let got = r.finish(enc, &out, rows);
-        assert_same(&format!("intensity {acc:?}"), &got, &scene.intensity(&dirs, acc).unwrap());
+        assert_same(
+            &format!("intensity {acc:?}"),
+            &got,
+            &scene.intensity(&dirs, acc).unwrap(),
+        );
     }
 }
 
@@ -210,12 +250,18 @@ fn radiance_matches_the_host_path() {
         .map(|(i, p)| {
             let o = lights[i % lights.len()].world.w_axis.truncate();
             let p = glam::DVec3::from_array(p.map(f64::from));
-            ((o - p).normalize() + rng.unit() * 0.05).normalize().as_vec3().to_array()
+            ((o - p).normalize() + rng.unit() * 0.05)
+                .normalize()
+                .as_vec3()
+                .to_array()
         })
         .collect();
     let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
     let dirs_buf = r.buffer(&dirs, wgpu::BufferUsages::STORAGE);
-    for (acc, rows) in [(Accumulate::Sum, n), (Accumulate::PerLight, scene.len() * n)] {
+    for (acc, rows) in [
+        (Accumulate::Sum, n),
+        (Accumulate::PerLight, scene.len() * n),
+    ] {
         let out = r.output(rows);
         let mut enc = r.encoder();
         scene
@@ -253,7 +299,10 @@ fn irradiance_matches_the_host_path_over_several_light_groups() {
     let normals = unit_rows(&mut rng, n);
     let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
     let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
-    for (acc, rows) in [(Accumulate::Sum, n), (Accumulate::PerLight, scene.len() * n)] {
+    for (acc, rows) in [
+        (Accumulate::Sum, n),
+        (Accumulate::PerLight, scene.len() * n),
+    ] {
         // Garbage in `out` (see Renderer::output): summed mode must write, not add.
         let out = r.output(rows);
         let mut enc = r.encoder();
@@ -279,11 +328,15 @@ fn a_gpu_evaluators_device_serves_resident_calls_and_an_empty_scene_writes_zeros
     let empty = eval.prepare(&[]).unwrap();
     let out = r.output(n);
     let mut enc = r.encoder();
-    empty.encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum).unwrap();
+    empty
+        .encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum)
+        .unwrap();
     assert_eq!(r.finish(enc, &out, n), vec![[0.0; 3]; n]);
     // Per light over no lights: nothing to write, nothing written.
     let mut enc = r.encoder();
-    empty.encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::PerLight).unwrap();
+    empty
+        .encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::PerLight)
+        .unwrap();
     assert_eq!(r.finish(enc, &out, n), vec![[0.0; 3]; n]);
 }
 
@@ -378,7 +431,14 @@ fn host_irradiance_lights_are_refused_by_name() {
     let mut enc = r.encoder();
     match scene.encode_irradiance(&mut enc, &pts, &nrm, &out, n as u32, Accumulate::Sum) {
         Err(e @ LuxError::NotOnDevice { .. }) => {
-            let LuxError::NotOnDevice { light, query, reason } = &e else { unreachable!() };
+            let LuxError::NotOnDevice {
+                light,
+                query,
+                reason,
+            } = &e
+            else {
+                unreachable!()
+            };
             assert_eq!(light, &ies_path);
             assert_eq!(query, "irradiance");
             assert!(reason.contains("IES"), "{reason}");
@@ -388,7 +448,9 @@ fn host_irradiance_lights_are_refused_by_name() {
     }
     // Emission and radiance of the same scene are evaluated on the device (the IES lookup is
     // in those kernels).
-    scene.encode_emission(&mut enc, &nrm, &out, n as u32, Accumulate::Sum).unwrap();
+    scene
+        .encode_emission(&mut enc, &nrm, &out, n as u32, Accumulate::Sum)
+        .unwrap();
 }
 
 #[test]
@@ -404,7 +466,10 @@ fn counts_over_the_binding_limit_are_refused_with_the_most_one_call_takes() {
     let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
     let scene = eval.prepare(&synthetic_lights(2)).unwrap();
     let fits = (limit / 12) as usize;
-    let dirs = r.buffer(&vec![[0.0, 0.0, 1.0]; fits + 1], wgpu::BufferUsages::STORAGE);
+    let dirs = r.buffer(
+        &vec![[0.0, 0.0, 1.0]; fits + 1],
+        wgpu::BufferUsages::STORAGE,
+    );
     let out = r.output(2 * (fits + 1));
     let mut enc = r.encoder();
     let (what, reason) = invalid_input(
@@ -413,20 +478,27 @@ fn counts_over_the_binding_limit_are_refused_with_the_most_one_call_takes() {
             .unwrap_err(),
     );
     assert_eq!(what, "count");
-    assert!(reason.contains(&format!("at most {fits} samples")), "{reason}");
+    assert!(
+        reason.contains(&format!("at most {fits} samples")),
+        "{reason}"
+    );
     // Per light, the output binding holds both lights' rows: half as many samples fit.
     let (_, reason) = invalid_input(
         scene
             .encode_emission(&mut enc, &dirs, &out, fits as u32, Accumulate::PerLight)
             .unwrap_err(),
     );
-    assert!(reason.contains(&format!("at most {} samples", fits / 2)), "{reason}");
+    assert!(
+        reason.contains(&format!("at most {} samples", fits / 2)),
+        "{reason}"
+    );
     // The largest call that fits runs, over buffers larger than the binding limit.
     scene
         .encode_emission(&mut enc, &dirs, &out, fits as u32, Accumulate::Sum)
         .unwrap();
     let got = r.finish(enc, &out, fits);
-    let host = scene.emission(&vec![[0.0, 0.0, 1.0]; fits], Accumulate::Sum).unwrap();
+    let host = scene
+        .emission(&vec![[0.0, 0.0, 1.0]; fits], Accumulate::Sum)
+        .unwrap();
     assert_eq!(got, host);
 }
-

@@ -43,7 +43,10 @@ impl GpuContext {
             std::sync::Arc::new(std::sync::Mutex::new(None)),
         );
         if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(LuxError::gpu("creating luxeval's layouts on the caller's device", e));
+            return Err(LuxError::gpu(
+                "creating luxeval's layouts on the caller's device",
+                e,
+            ));
         }
         ctx.callers_device = true;
         Ok(ctx)
@@ -100,7 +103,10 @@ impl GpuContext {
             if op.buffer == out.buffer {
                 return Err(LuxError::input(
                     out.name,
-                    format!("the output buffer is also the {} buffer; use distinct buffers", op.name),
+                    format!(
+                        "the output buffer is also the {} buffer; use distinct buffers",
+                        op.name
+                    ),
                 ));
             }
         }
@@ -113,7 +119,11 @@ impl GpuContext {
                 format!(
                     "{count} samples{} need {} bytes in one binding, over this device's storage \
                      binding limit of {limit} bytes; encode at most {per_call} samples per call",
-                    if per_light { format!(" × {n_lights} lights") } else { String::new() },
+                    if per_light {
+                        format!(" × {n_lights} lights")
+                    } else {
+                        String::new()
+                    },
                     out_bytes.max(in_bytes),
                 ),
             ));
@@ -259,7 +269,11 @@ fn check_limits(l: &wgpu::Limits) -> Result<()> {
     let params = std::mem::size_of::<Params>() as u64;
     let needs: [(&str, u64, u64); 8] = [
         ("max_bind_groups", l.max_bind_groups as u64, 1),
-        ("max_bindings_per_bind_group", l.max_bindings_per_bind_group as u64, 7),
+        (
+            "max_bindings_per_bind_group",
+            l.max_bindings_per_bind_group as u64,
+            7,
+        ),
         (
             "max_storage_buffers_per_shader_stage",
             l.max_storage_buffers_per_shader_stage as u64,
@@ -275,7 +289,11 @@ fn check_limits(l: &wgpu::Limits) -> Result<()> {
             l.max_dynamic_uniform_buffers_per_pipeline_layout as u64,
             1,
         ),
-        ("max_uniform_buffer_binding_size", l.max_uniform_buffer_binding_size, params),
+        (
+            "max_uniform_buffer_binding_size",
+            l.max_uniform_buffer_binding_size,
+            params,
+        ),
         (
             "max_compute_workgroup_size_x",
             l.max_compute_workgroup_size_x as u64,

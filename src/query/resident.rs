@@ -82,7 +82,9 @@ impl PreparedScene {
     /// rows, or the output is an input; when `count` rows (times the lights, per light) exceed
     /// the device's storage binding limit (the message gives the most one call takes: split
     /// the batch); when the scene is on the CPU reference. [`LuxError::Gpu`] when wgpu rejects
-    /// the bind group (a buffer of another device, for one) or a pipeline.
+    /// the bind group (a buffer of another device, for one) or a pipeline. wgpu cannot tell a
+    /// buffer of another `wgpu::Instance` from one of its own (it panics or binds the wrong
+    /// buffer), so neither can luxeval: keep the device and the buffers of one instance.
     pub fn encode_emission(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -134,7 +136,15 @@ impl PreparedScene {
             name: "directions",
             buffer: dirs,
         };
-        self.encode(encoder, Kernel::Radiance, points, Some(dirs), out, count, acc)
+        self.encode(
+            encoder,
+            Kernel::Radiance,
+            points,
+            Some(dirs),
+            out,
+            count,
+            acc,
+        )
     }
 
     /// Records irradiance(x, n) (see [`PreparedScene::irradiance`]) for `count` (point, normal)
@@ -179,7 +189,15 @@ impl PreparedScene {
             name: "normals",
             buffer: normals,
         };
-        self.encode(encoder, Kernel::Irradiance, points, Some(normals), out, count, acc)
+        self.encode(
+            encoder,
+            Kernel::Irradiance,
+            points,
+            Some(normals),
+            out,
+            count,
+            acc,
+        )
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -200,7 +218,10 @@ impl PreparedScene {
                  with Evaluator::from_wgpu or Evaluator::gpu",
             ));
         };
-        let out = Operand { name: "out", buffer: out };
+        let out = Operand {
+            name: "out",
+            buffer: out,
+        };
         let per_light = acc == Accumulate::PerLight;
         // A scene with no lights uploads none; the kernel still needs a record array bound.
         let placeholder;
