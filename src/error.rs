@@ -26,6 +26,16 @@ pub enum LuxError {
     #[error("{what}: {reason}")]
     InvalidInput { what: String, reason: String },
 
+    /// A light that a GPU-resident query (`PreparedScene::encode_*`) cannot evaluate on the
+    /// device: its value is computed on the host (the irradiance of IES-shaped lights and of
+    /// textured domes and rects), and the GPU-resident path has no host step.
+    #[error("light {light}: {query} cannot be evaluated GPU-resident: {reason}")]
+    NotOnDevice {
+        light: String,
+        query: String,
+        reason: String,
+    },
+
     /// No wgpu adapter could be found.
     #[error(
         "no GPU adapter found ({reason}); use --device cpu, or install a Vulkan driver (e.g. Mesa's lavapipe: mesa-vulkan-drivers)"
@@ -182,6 +192,7 @@ impl LuxError {
             LuxError::InvalidAttribute { .. }
                 | LuxError::InvalidTransform { .. }
                 | LuxError::InvalidInput { .. }
+                | LuxError::NotOnDevice { .. }
                 | LuxError::Io { .. }
                 | LuxError::Asset { .. }
                 | LuxError::Format { .. }

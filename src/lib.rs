@@ -74,3 +74,7 @@ pub use query::lights_json;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
 #[cfg(feature = "usd")]
 pub use usd::{Scene, SceneLight, Stage, StageInfo, TimeRule};
+/// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
+/// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that
+/// the types match.
+pub use wgpu;

@@ -9,15 +9,27 @@ use super::{GpuContext, Kernel};
 
 /// A prepared scene's light records, IES atlas and dome texture atlas on the device.
 pub(crate) struct GpuLights {
-    buffer: wgpu::Buffer,
-    ies_atlas: wgpu::Buffer,
-    tex_atlas: wgpu::Buffer,
+    pub(super) buffer: wgpu::Buffer,
+    pub(super) ies_atlas: wgpu::Buffer,
+    pub(super) tex_atlas: wgpu::Buffer,
     count: usize,
     /// Whether any light has an IES profile (the pipelines with the lookup are needed).
     has_ies: bool,
     /// Whether any light has a dome or rect texture (the pipelines with the texture lookup are
     /// needed).
     has_dome: bool,
+}
+
+impl GpuLights {
+    /// The `(ies, dome)` pipeline variant `kernel` needs for these lights. The irradiance kernel
+    /// integrates no IES-shaped light or textured dome (the host does, see
+    /// prepare::Prepared::irradiance_on_host), so it never needs either lookup.
+    pub(super) fn variant(&self, kernel: Kernel) -> (bool, bool) {
+        (
+            self.has_ies && kernel != Kernel::Irradiance,
+            self.has_dome && kernel != Kernel::Irradiance,
+        )
+    }
 }
 
 /// The buffers of one size class: a chunk capacity (a power of two, or the device's largest
@@ -168,13 +180,8 @@ impl GpuContext {
         if n == 0 || count == 0 {
             return Ok(out);
         }
-        // The irradiance kernel integrates no IES-shaped light or textured dome (the host does,
-        // see prepare::Prepared::irradiance_on_host), so it never needs either lookup.
-        let pipeline = self.pipeline(
-            kernel,
-            lights.has_ies && kernel != Kernel::Irradiance,
-            lights.has_dome && kernel != Kernel::Irradiance,
-        )?;
+        let (ies, dome) = lights.variant(kernel);
+        let pipeline = self.pipeline(kernel, ies, dome)?;
         let capacity = self.chunk_capacity(count, per_light);
         let per_group = self.lights_per_dispatch(kernel).max(1);
         let key = ScratchKey {
@@ -389,7 +396,7 @@ impl GpuContext {
     }
 }
 
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+pub(super) fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry {
         binding,
         resource: buffer.as_entire_binding(),

@@ -8,6 +8,7 @@ pub(crate) mod dispatch;
 pub(crate) mod dome_atlas;
 pub(crate) mod ies_atlas;
 pub(crate) mod record;
+pub(crate) mod resident;
 pub(crate) mod shaders;
 
 use std::collections::HashMap;
@@ -108,6 +109,8 @@ pub(crate) struct GpuContext {
     /// Why the device was lost, once it is (set by wgpu's device-lost callback): reported
     /// instead of the validation errors a lost device's buffers then raise.
     lost: Arc<Mutex<Option<String>>>,
+    /// Whether the device is the caller's (`from_device`) rather than one luxeval opened.
+    callers_device: bool,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -183,6 +186,8 @@ impl GpuContext {
             })?;
         // wgpu's default handler panics; errors are caught by scopes around each dispatch, and
         // anything that escapes them is logged rather than aborting the process.
+        // (Only on luxeval's own device: a caller's device keeps the caller's handlers, see
+        // `from_device`.)
         device.on_uncaptured_error(Arc::new(|e| log::error!("wgpu: {e}")));
         let lost = Arc::new(Mutex::new(None));
         let on_lost = Arc::clone(&lost);
@@ -205,7 +210,25 @@ impl GpuContext {
         if std::env::var("LUXEVAL_TEST_FAULT").as_deref() == Ok("device-lost") {
             device.destroy();
         }
+        let startup = Startup {
+            instance: t_instance,
+            adapter: t_adapter,
+            device: t0.elapsed() - t_instance - t_adapter,
+            pipelines: Vec::new(),
+        };
+        Ok(Self::with_device(device, queue, info, limits, lost, startup))
+    }
 
+    /// The part of opening a context that follows the device: the bind group and pipeline
+    /// layouts every kernel shares.
+    fn with_device(
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+        info: wgpu::AdapterInfo,
+        limits: wgpu::Limits,
+        lost: Arc<Mutex<Option<String>>>,
+        startup: Startup,
+    ) -> Self {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("luxeval queries"),
             entries: &[
@@ -235,9 +258,9 @@ impl GpuContext {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let t_device = t0.elapsed() - t_instance - t_adapter;
+        // A caller's device gets a cache only if the caller enabled PIPELINE_CACHE on it.
         let (cache, cache_status) = cache::open(&device, &info);
-        Ok(GpuContext {
+        GpuContext {
             device,
             queue,
             info,
@@ -247,14 +270,10 @@ impl GpuContext {
             pipelines: Mutex::new(HashMap::new()),
             cache,
             cache_status,
-            startup: Mutex::new(Startup {
-                instance: t_instance,
-                adapter: t_adapter,
-                device: t_device,
-                pipelines: Vec::new(),
-            }),
+            startup: Mutex::new(startup),
             lost,
-        })
+            callers_device: false,
+        }
     }
 
     /// The pipeline of `kernel`, compiled on first use; `ies` selects the variant with the IES

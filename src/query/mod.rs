@@ -4,6 +4,7 @@
 //! returns float32 RGB rows. [`Reference`] is the f64 reference of one light, sample by sample.
 
 mod reference;
+mod resident;
 mod scene;
 
 use std::sync::Arc;
@@ -167,10 +168,16 @@ impl Evaluator {
         }
     }
 
-    /// "cpu (f64 reference)" or the adapter's name and backend.
+    /// "cpu (f64 reference)" or the adapter's name and backend (marked "caller's device" for
+    /// an evaluator made by [`Evaluator::from_wgpu`]).
     pub fn device_name(&self) -> String {
         match &self.backend {
             Backend::Cpu => "cpu (f64 reference)".into(),
+            Backend::Gpu(g) if g.is_callers_device() => format!(
+                "{} ({}, caller's device)",
+                g.adapter().name,
+                g.adapter().backend
+            ),
             Backend::Gpu(g) => format!("{} ({})", g.adapter().name, g.adapter().backend),
         }
     }

@@ -16,9 +16,9 @@ use crate::prepare::{self, Prepared, TemperatureMode};
 /// uploaded and the input/output buffers of the last size class kept), answering emission,
 /// radiance and irradiance for any number of batches.
 pub struct PreparedScene {
-    backend: Backend,
-    lights: Vec<Prepared>,
-    gpu: Option<GpuLights>,
+    pub(super) backend: Backend,
+    pub(super) lights: Vec<Prepared>,
+    pub(super) gpu: Option<GpuLights>,
     /// The buffers of the last GPU call, reused by the next call of the same size class.
     scratch: Mutex<Option<Scratch>>,
     /// What the caller should know about how the scene is evaluated (textures the GPU holds

@@ -1,0 +1,331 @@
+//! GPU-resident evaluation: a kernel recorded into the caller's command encoder over the
+//! caller's buffers, on the caller's device. Nothing is submitted, mapped or read back here; the
+//! caller submits when it wants the results and keeps them on the device.
+//!
+//! The bindings, the Params block per light group and the pass per group are those of
+//! `dispatch::run_chunks`, so both paths run the same kernels with the same accumulation order.
+
+use wgpu::util::DeviceExt;
+
+use crate::error::{LuxError, Result};
+
+use super::dispatch::{GpuLights, entry};
+use super::record::{Params, Record, WORKGROUP_SIZE};
+use super::{GpuContext, Kernel};
+
+/// One caller buffer and the name errors give it ("directions", "points", "out", ...).
+#[derive(Clone, Copy)]
+pub(crate) struct Operand<'a> {
+    pub name: &'static str,
+    pub buffer: &'a wgpu::Buffer,
+}
+
+/// Bytes per row of every input and output: three tightly packed f32.
+const ROW_BYTES: u64 = 12;
+
+impl GpuContext {
+    /// A context on a device the caller opened (a renderer's own device): its limits are those
+    /// the device was created with. luxeval installs no uncaptured-error handler and no
+    /// device-lost callback on it (wgpu keeps one of each per device, and they are the
+    /// caller's); luxeval's own calls catch their errors with error scopes.
+    pub(crate) fn from_device(device: wgpu::Device, queue: wgpu::Queue) -> Result<Self> {
+        let limits = device.limits();
+        check_limits(&limits)?;
+        let info = device.adapter_info();
+        // The layouts are created on the caller's device: a failure there must come back as
+        // an error, not reach the caller's uncaptured-error handler (wgpu's default panics).
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let mut ctx = Self::with_device(
+            device.clone(),
+            queue,
+            info,
+            limits,
+            std::sync::Arc::new(std::sync::Mutex::new(None)),
+            super::Startup::default(),
+        );
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(LuxError::gpu(
+                "creating luxeval's layouts on the caller's device",
+                e,
+            ));
+        }
+        ctx.callers_device = true;
+        Ok(ctx)
+    }
+
+    /// Whether the device is the caller's (opened by `from_device`).
+    pub(crate) fn is_callers_device(&self) -> bool {
+        self.callers_device
+    }
+
+    /// A light buffer for a scene with no lights: the kernels need a bound record array even
+    /// when they evaluate none (summed mode still writes its zero rows).
+    pub(crate) fn no_lights(&self) -> Result<GpuLights> {
+        let atlas = super::dome_atlas::Atlas::new();
+        Ok(self
+            .upload(&[Record::default()], &[], &atlas)?
+            .expect("one record uploaded"))
+    }
+
+    /// Records `kernel` over `count` rows of `a` (and `b`) into `encoder`, writing `out`:
+    /// `count` rows summed over lights `0..n_lights`, or `n_lights × count` rows, light-major,
+    /// with `per_light`. Validates the buffers first (usage, size, aliasing, the device's
+    /// binding and dispatch limits); the first call of a kernel builds its pipeline.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        kernel: Kernel,
+        lights: &GpuLights,
+        n_lights: usize,
+        a: Operand<'_>,
+        b: Option<Operand<'_>>,
+        out: Operand<'_>,
+        count: u32,
+        per_light: bool,
+    ) -> Result<()> {
+        let rows = if per_light { n_lights as u64 } else { 1 };
+        let in_bytes = count as u64 * ROW_BYTES;
+        let out_bytes = rows
+            .checked_mul(in_bytes)
+            .ok_or_else(|| LuxError::input(out.name, "the output size overflows u64"))?;
+        let limit = self.limits.max_storage_buffer_binding_size;
+        for (op, need, usage) in [
+            (Some(a), in_bytes, wgpu::BufferUsages::STORAGE),
+            (b, in_bytes, wgpu::BufferUsages::STORAGE),
+            (Some(out), out_bytes, wgpu::BufferUsages::STORAGE),
+        ] {
+            let Some(op) = op else { continue };
+            check_buffer(op, need, usage, count)?;
+        }
+        for op in [Some(a), b].into_iter().flatten() {
+            // A buffer bound both read-only and read-write in one pass is a wgpu usage conflict
+            // that would only surface when the caller finishes the encoder.
+            if op.buffer == out.buffer {
+                return Err(LuxError::input(
+                    out.name,
+                    format!(
+                        "the output buffer is also the {} buffer; use distinct buffers",
+                        op.name
+                    ),
+                ));
+            }
+        }
+        // The kernels index the output as f32 with u32 arithmetic (3 · row + 2), and each
+        // binding must fit the device's storage binding limit.
+        let per_call = limit.min(4 * u32::MAX as u64) / (ROW_BYTES * rows.max(1));
+        if out_bytes > limit || in_bytes > limit || count as u64 > per_call {
+            return Err(LuxError::input(
+                "count",
+                format!(
+                    "{count} samples{} need {} bytes in one binding, over this device's storage \
+                     binding limit of {limit} bytes; encode at most {per_call} samples per call",
+                    if per_light {
+                        format!(" × {n_lights} lights")
+                    } else {
+                        String::new()
+                    },
+                    out_bytes.max(in_bytes),
+                ),
+            ));
+        }
+        let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
+        let wg = count.div_ceil(WORKGROUP_SIZE);
+        let gx = wg.min(max_groups);
+        let gy = wg.div_ceil(gx.max(1));
+        if gy > max_groups {
+            return Err(LuxError::input(
+                "count",
+                format!(
+                    "{count} samples need {wg} workgroups, over this device's {max_groups} × \
+                     {max_groups} dispatch grid; encode fewer samples per call"
+                ),
+            ));
+        }
+        if count == 0 || rows == 0 {
+            return Ok(());
+        }
+
+        let per_group = self.lights_per_dispatch(kernel).max(1);
+        let groups: Vec<(usize, usize)> = if n_lights == 0 {
+            // Summed mode over no lights: one dispatch that writes the zero rows.
+            vec![(0, 0)]
+        } else {
+            (0..n_lights)
+                .step_by(per_group)
+                .map(|g| (g, (g + per_group).min(n_lights)))
+                .collect()
+        };
+        let (ies, dome) = lights.variant(kernel);
+        let pipeline = self.pipeline(kernel, ies, dome)?;
+
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        // One Params block per light group at the uniform offset alignment; a buffer of this
+        // call's own (written at creation, so that nothing goes through the queue), kept alive
+        // by the command buffer that uses it.
+        let align = (self.limits.min_uniform_buffer_offset_alignment as usize)
+            .max(std::mem::size_of::<Params>());
+        let mut block = vec![0u8; groups.len() * align];
+        for (g, &(first, end)) in groups.iter().enumerate() {
+            let p = Params {
+                count,
+                light_first: first as u32,
+                light_end: end as u32,
+                per_light: per_light as u32,
+                row_stride: gx * WORKGROUP_SIZE,
+                accumulate: (g > 0) as u32,
+                pad: [0; 2],
+            };
+            block[g * align..g * align + std::mem::size_of::<Params>()]
+                .copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        let params = self
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("luxeval params (resident)"),
+                contents: &block,
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("luxeval queries (resident)"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &params,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+                    }),
+                },
+                entry(1, &lights.buffer),
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: range(a, in_bytes),
+                },
+                // Emission and intensity read no second input; bind the first again
+                // (read-only aliasing is allowed).
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: range(b.unwrap_or(a), in_bytes),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: range(out, out_bytes),
+                },
+                entry(5, &lights.ies_atlas),
+                entry(6, &lights.tex_atlas),
+            ],
+        });
+        // Buffers of another device, for one, fail here.
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(LuxError::gpu(
+                format!("binding the caller's buffers for {}", kernel.entry_point()),
+                e,
+            ));
+        }
+        for g in 0..groups.len() {
+            // A pass per group: passes are ordered, so a group reads the sums of the last.
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(kernel.entry_point()),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[(g * align) as u32]);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        Ok(())
+    }
+}
+
+/// The buffer has `usage` and holds at least `need` bytes (`count` rows).
+fn check_buffer(op: Operand<'_>, need: u64, usage: wgpu::BufferUsages, count: u32) -> Result<()> {
+    if !op.buffer.usage().contains(usage) {
+        return Err(LuxError::input(
+            op.name,
+            format!(
+                "the buffer's usage {:?} lacks {usage:?}; create it with wgpu::BufferUsages::STORAGE",
+                op.buffer.usage()
+            ),
+        ));
+    }
+    if op.buffer.size() < need {
+        return Err(LuxError::input(
+            op.name,
+            format!(
+                "the buffer holds {} bytes; {count} samples need {need} ({} bytes a row: f32 \
+                 x, y, z, no padding)",
+                op.buffer.size(),
+                ROW_BYTES
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The device limits the kernels and their bind group layout need. A device opened with
+/// `wgpu::Limits::default()` or its adapter's limits has them; downlevel limits may not, and
+/// wgpu would then fail inside the layout with a less telling message.
+fn check_limits(l: &wgpu::Limits) -> Result<()> {
+    let params = std::mem::size_of::<Params>() as u64;
+    let needs: [(&str, u64, u64); 8] = [
+        ("max_bind_groups", l.max_bind_groups as u64, 1),
+        (
+            "max_bindings_per_bind_group",
+            l.max_bindings_per_bind_group as u64,
+            7,
+        ),
+        (
+            "max_storage_buffers_per_shader_stage",
+            l.max_storage_buffers_per_shader_stage as u64,
+            6,
+        ),
+        (
+            "max_uniform_buffers_per_shader_stage",
+            l.max_uniform_buffers_per_shader_stage as u64,
+            1,
+        ),
+        (
+            "max_dynamic_uniform_buffers_per_pipeline_layout",
+            l.max_dynamic_uniform_buffers_per_pipeline_layout as u64,
+            1,
+        ),
+        (
+            "max_uniform_buffer_binding_size",
+            l.max_uniform_buffer_binding_size,
+            params,
+        ),
+        (
+            "max_compute_workgroup_size_x",
+            l.max_compute_workgroup_size_x as u64,
+            WORKGROUP_SIZE as u64,
+        ),
+        (
+            "max_compute_invocations_per_workgroup",
+            l.max_compute_invocations_per_workgroup as u64,
+            WORKGROUP_SIZE as u64,
+        ),
+    ];
+    for (name, has, need) in needs {
+        if has < need {
+            return Err(LuxError::input(
+                "device",
+                format!(
+                    "limits.{name} is {has}, luxeval's kernels need at least {need}; open the \
+                     device with wgpu::Limits::default() or the adapter's limits"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first `size` bytes of a caller's buffer (it may be larger than the call needs, even
+/// larger than the binding limit).
+fn range<'a>(op: Operand<'a>, size: u64) -> wgpu::BindingResource<'a> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer: op.buffer,
+        offset: 0,
+        size: wgpu::BufferSize::new(size),
+    })
+}

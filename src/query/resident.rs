@@ -1,0 +1,248 @@
+//! GPU-resident queries: a renderer that already holds its directions, points and normals in
+//! `wgpu::Buffer`s on its own device gets the results in its own buffers, recorded into its own
+//! command encoder, with no host round trip (no upload, no readback, no submit by luxeval).
+//! The buffer contract is in the docs of `PreparedScene::encode_emission` (public, unlike this
+//! module's).
+
+use super::{Accumulate, Backend, Evaluator, PreparedScene};
+use crate::error::{LuxError, Result};
+use crate::gpu::resident::Operand;
+use crate::gpu::{GpuContext, Kernel};
+use crate::model::LightType;
+
+impl Evaluator {
+    /// An evaluator on the caller's device (a renderer's own `wgpu::Device` and `wgpu::Queue`,
+    /// from [`crate::wgpu`], luxeval's wgpu): every query, host path and GPU-resident, runs there.
+    /// luxeval installs no error handler or device-lost callback on it. Fails when the device's
+    /// limits are below what the kernels need (`wgpu::Limits::default()` is enough).
+    ///
+    /// [`Evaluator::device_name`] reports the adapter the device belongs to (wgpu keeps its
+    /// info), marked "caller's device".
+    pub fn from_wgpu(device: wgpu::Device, queue: wgpu::Queue) -> Result<Self> {
+        Ok(Evaluator {
+            backend: Backend::Gpu(std::sync::Arc::new(GpuContext::from_device(device, queue)?)),
+            temperature_mode: Default::default(),
+            irradiance_tolerance: None,
+        })
+    }
+
+    /// The device queries run on (the caller's, or the one [`Evaluator::gpu`] opened): create
+    /// the buffers of GPU-resident queries on it. `None` on the CPU reference.
+    pub fn wgpu_device(&self) -> Option<&wgpu::Device> {
+        match &self.backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(&g.device),
+        }
+    }
+
+    /// The queue of [`Evaluator::wgpu_device`]; submit GPU-resident work on it.
+    pub fn wgpu_queue(&self) -> Option<&wgpu::Queue> {
+        match &self.backend {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(&g.queue),
+        }
+    }
+}
+
+impl PreparedScene {
+    /// Records emission(light, ω) (see [`PreparedScene::emission`]) for `count` directions in
+    /// `dirs` into `encoder`, writing `out`: GPU-resident evaluation, for callers whose data is
+    /// already on the device. Nothing is uploaded, submitted or read back; the results are in
+    /// `out` once the caller submits the encoder. The first call of each query builds its
+    /// pipeline (seconds on a CPU driver such as lavapipe); each call creates a small uniform
+    /// buffer and a bind group.
+    ///
+    /// # Buffers
+    ///
+    /// Every buffer belongs to this scene's device ([`Evaluator::from_wgpu`], or
+    /// [`Evaluator::wgpu_device`] of a GPU evaluator) and has `wgpu::BufferUsages::STORAGE`.
+    /// Inputs and outputs are rows of three tightly packed `f32` (x, y, z or r, g, b): a 12-byte
+    /// stride with no padding (not a WGSL `array<vec3<f32>>`, whose stride is 16). Inputs hold
+    /// at least `count` rows; `out` at least `count` rows with [`Accumulate::Sum`], or
+    /// `lights × count` rows with [`Accumulate::PerLight`], light-major (row `l·count + i` is
+    /// light `l` at sample `i`). Only the first rows are read and written: larger buffers are
+    /// fine. The output may not be an input.
+    ///
+    /// The output rows are overwritten, never added to: in summed mode the first light group
+    /// writes each row and later groups (one dispatch per group, in order) add to it. Rows past
+    /// those the call covers are left as they are.
+    ///
+    /// # Directions
+    ///
+    /// Directions (and the normals of [`PreparedScene::encode_irradiance`]) need not be unit
+    /// length: the kernel normalises them in f32. The host path ([`PreparedScene::emission`]
+    /// and the others) checks them and normalises them in f64 first; here nothing is read on
+    /// the host, so nothing is checked: a zero or non-finite row gives an unspecified result
+    /// (NaN or zero), and rows with very large components (whose squares overflow f32, from
+    /// about 1.8e19) or subnormal ones (which a device may flush to zero) can give other values
+    /// than the host path. Pass unit vectors to get the host path's results.
+    ///
+    /// # Errors
+    ///
+    /// [`LuxError::InvalidInput`] when a buffer lacks `STORAGE`, is too small for `count`
+    /// rows, or the output is an input; when `count` rows (times the lights, per light) exceed
+    /// the device's storage binding limit (the message gives the most one call takes: split
+    /// the batch); when the scene is on the CPU reference. [`LuxError::Gpu`] when wgpu rejects
+    /// the bind group (a buffer of another device, for one) or a pipeline. wgpu cannot tell a
+    /// buffer of another `wgpu::Instance` from one of its own (it panics or binds the wrong
+    /// buffer), so neither can luxeval: keep the device and the buffers of one instance.
+    pub fn encode_emission(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        dirs: &wgpu::Buffer,
+        out: &wgpu::Buffer,
+        count: u32,
+        acc: Accumulate,
+    ) -> Result<()> {
+        let dirs = Operand {
+            name: "directions",
+            buffer: dirs,
+        };
+        self.encode(encoder, Kernel::Emission, dirs, None, out, count, acc)
+    }
+
+    /// Records intensity(light, ω) (see [`PreparedScene::intensity`]) for `count` directions,
+    /// as [`PreparedScene::encode_emission`] does.
+    pub fn encode_intensity(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        dirs: &wgpu::Buffer,
+        out: &wgpu::Buffer,
+        count: u32,
+        acc: Accumulate,
+    ) -> Result<()> {
+        let dirs = Operand {
+            name: "directions",
+            buffer: dirs,
+        };
+        self.encode(encoder, Kernel::Intensity, dirs, None, out, count, acc)
+    }
+
+    /// Records radiance(x, ω) (see [`PreparedScene::radiance`]) for `count` (point, direction)
+    /// pairs, as [`PreparedScene::encode_emission`] does.
+    pub fn encode_radiance(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        points: &wgpu::Buffer,
+        dirs: &wgpu::Buffer,
+        out: &wgpu::Buffer,
+        count: u32,
+        acc: Accumulate,
+    ) -> Result<()> {
+        let points = Operand {
+            name: "points",
+            buffer: points,
+        };
+        let dirs = Operand {
+            name: "directions",
+            buffer: dirs,
+        };
+        self.encode(
+            encoder,
+            Kernel::Radiance,
+            points,
+            Some(dirs),
+            out,
+            count,
+            acc,
+        )
+    }
+
+    /// Records irradiance(x, n) (see [`PreparedScene::irradiance`]) for `count` (point, normal)
+    /// pairs, as [`PreparedScene::encode_emission`] does.
+    ///
+    /// Refused with [`LuxError::NotOnDevice`] naming the first such light when the scene holds
+    /// a light whose irradiance the host path computes on the CPU (IES-shaped lights, textured
+    /// domes and textured rects): the kernel gives 0 for them, which this path would return as
+    /// if it were the answer. Prepare those lights in a scene of their own and use
+    /// [`PreparedScene::irradiance`] for them.
+    pub fn encode_irradiance(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        points: &wgpu::Buffer,
+        normals: &wgpu::Buffer,
+        out: &wgpu::Buffer,
+        count: u32,
+        acc: Accumulate,
+    ) -> Result<()> {
+        if let Some(p) = self.lights.iter().find(|p| p.irradiance_on_host()) {
+            let reason = if p.ies.is_some() {
+                "it is IES-shaped"
+            } else if matches!(p.light.kind, LightType::Dome) {
+                "it is a textured dome"
+            } else {
+                "it is a textured rect"
+            };
+            return Err(LuxError::NotOnDevice {
+                light: p.light.path.clone(),
+                query: "irradiance".into(),
+                reason: format!(
+                    "{reason}, and its irradiance is integrated on the host (exactly, in f64); \
+                     evaluate it with PreparedScene::irradiance"
+                ),
+            });
+        }
+        let points = Operand {
+            name: "points",
+            buffer: points,
+        };
+        let normals = Operand {
+            name: "normals",
+            buffer: normals,
+        };
+        self.encode(
+            encoder,
+            Kernel::Irradiance,
+            points,
+            Some(normals),
+            out,
+            count,
+            acc,
+        )
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        kernel: Kernel,
+        a: Operand<'_>,
+        b: Option<Operand<'_>>,
+        out: &wgpu::Buffer,
+        count: u32,
+        acc: Accumulate,
+    ) -> Result<()> {
+        let Backend::Gpu(g) = &self.backend else {
+            return Err(LuxError::input(
+                "backend",
+                "this scene was prepared on the CPU reference, which has no device; prepare it \
+                 with Evaluator::from_wgpu or Evaluator::gpu",
+            ));
+        };
+        let out = Operand {
+            name: "out",
+            buffer: out,
+        };
+        let per_light = acc == Accumulate::PerLight;
+        // A scene with no lights uploads none; the kernel still needs a record array bound.
+        let placeholder;
+        let lights = match &self.gpu {
+            Some(l) => l,
+            None => {
+                placeholder = g.no_lights()?;
+                &placeholder
+            }
+        };
+        g.encode(
+            encoder,
+            kernel,
+            lights,
+            self.lights.len(),
+            a,
+            b,
+            out,
+            count,
+            per_light,
+        )
+    }
+}

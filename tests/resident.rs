@@ -1,0 +1,504 @@
+//! GPU-resident evaluation (`Evaluator::from_wgpu`, `PreparedScene::encode_*`): a renderer
+//! opens its own device, hands it to luxeval, keeps its data in its own buffers and records the
+//! queries into its own encoder. The results must be those of the host path
+//! (`PreparedScene::emission` and the others) on the same lights and the same device: the same
+//! kernels run on the same inputs (up to the host path's f64 normalisation of unit vectors).
+
+mod common;
+
+use luxeval::testkit::{Rng, ies::with_random_ies, random_light, synthetic_lights};
+use luxeval::wgpu;
+use luxeval::{Accumulate, Evaluator, Light, LuxError};
+
+/// What a renderer holds: its own device and queue.
+struct Renderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    /// `None` for a device luxeval opened.
+    adapter: Option<wgpu::Adapter>,
+}
+
+/// The renderer's device, opened the way a renderer would (luxeval's wgpu, the default
+/// high-performance adapter, `limits` or the adapter's own); `None` (a skip, as
+/// `common::gpu` does) without an adapter, a failure under CI=true.
+fn renderer_with(limits: Option<wgpu::Limits>) -> Option<Renderer> {
+    let instance =
+        wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    let adapter = match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        ..Default::default()
+    })) {
+        Ok(a) => a,
+        Err(e) => {
+            if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") {
+                panic!("CI=true but no GPU adapter: {e}");
+            }
+            eprintln!("skipping GPU test: {e}");
+            return None;
+        }
+    };
+    let required_limits = limits.unwrap_or_else(|| adapter.limits());
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        label: Some("renderer"),
+        required_limits,
+        ..Default::default()
+    }))
+    .expect("the adapter opens a device");
+    Some(Renderer {
+        device,
+        queue,
+        adapter: Some(adapter),
+    })
+}
+
+fn renderer() -> Option<Renderer> {
+    renderer_with(None)
+}
+
+impl Renderer {
+    /// A second device on the same adapter (and so the same wgpu instance: wgpu cannot tell
+    /// objects of another instance apart from its own).
+    fn another_device(&self) -> Renderer {
+        let adapter = self.adapter.clone().expect("a renderer's own device");
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor::default()))
+                .expect("the adapter opens a second device");
+        Renderer {
+            device,
+            queue,
+            adapter: Some(adapter),
+        }
+    }
+
+    fn buffer(&self, rows: &[[f32; 3]], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        let b = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("renderer input"),
+            size: (rows.len() * 12).max(12) as u64,
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.queue.write_buffer(&b, 0, bytemuck::cast_slice(rows));
+        b
+    }
+
+    /// An output of `rows` rows, filled with garbage (1e6) so that a row the call should have
+    /// written but did not, or added to instead of writing, shows.
+    fn output(&self, rows: usize) -> wgpu::Buffer {
+        self.buffer(
+            &vec![[1.0e6; 3]; rows],
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        )
+    }
+
+    fn encoder(&self) -> wgpu::CommandEncoder {
+        self.device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("renderer frame"),
+            })
+    }
+
+    /// Submits `encoder` and reads the first `rows` rows of `out` back.
+    fn finish(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        out: &wgpu::Buffer,
+        rows: usize,
+    ) -> Vec<[f32; 3]> {
+        let size = (rows * 12) as u64;
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        encoder.copy_buffer_to_buffer(out, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| tx.send(r).unwrap());
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("the device finishes");
+        rx.recv().unwrap().expect("the readback maps");
+        let data =
+            bytemuck::cast_slice::<u8, [f32; 3]>(&slice.get_mapped_range().unwrap()).to_vec();
+        staging.unmap();
+        data
+    }
+}
+
+fn unit_rows(rng: &mut Rng, n: usize) -> Vec<[f32; 3]> {
+    (0..n).map(|_| rng.unit().as_vec3().to_array()).collect()
+}
+
+/// Points around the lights (synthetic lights sit within a few metres of the origin).
+fn points(rng: &mut Rng, n: usize) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|_| (rng.unit() * rng.range(0.5, 6.0)).as_vec3().to_array())
+        .collect()
+}
+
+/// Resident and host rows agree to 1e-6 of the larger magnitude of the pair (1e-30 absolute
+/// for zeros), component by component; and at least some are non-zero, so that the test sees
+/// values.
+fn assert_same(what: &str, resident: &[[f32; 3]], host: &[[f32; 3]]) {
+    assert_eq!(resident.len(), host.len(), "{what}: row count");
+    let mut worst = 0.0f64;
+    for (i, (r, h)) in resident.iter().zip(host).enumerate() {
+        for c in 0..3 {
+            let (r, h) = (r[c] as f64, h[c] as f64);
+            let scale = r.abs().max(h.abs());
+            assert!(
+                (r - h).abs() <= 1e-6 * scale + 1e-30,
+                "{what}: row {i} channel {c}: resident {r} vs host {h}"
+            );
+            if scale > 0.0 {
+                worst = worst.max((r - h).abs() / scale);
+            }
+        }
+    }
+    let lit = host.iter().filter(|h| h.iter().any(|c| *c != 0.0)).count();
+    assert!(
+        lit * 10 >= host.len(),
+        "{what}: only {lit} of {} rows lit",
+        host.len()
+    );
+    eprintln!(
+        "{what}: {} rows, {lit} lit, largest relative difference {worst:.3e}",
+        host.len()
+    );
+}
+
+/// Lights for emission and radiance: the benchmark's mix (shaped and not) and two IES-shaped
+/// lights, so the pipeline variant with the IES lookup runs too.
+fn lights_with_ies() -> Vec<Light> {
+    let mut rng = Rng::new(11);
+    let mut lights = synthetic_lights(12);
+    lights.push(with_random_ies(
+        random_light(1, "rotate", &mut rng, 100),
+        &mut rng,
+        3,
+        false,
+    ));
+    lights.push(with_random_ies(
+        random_light(3, "translate", &mut rng, 101),
+        &mut rng,
+        1,
+        true,
+    ));
+    lights
+}
+
+#[test]
+fn emission_and_intensity_match_the_host_path() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    assert!(
+        eval.device_name().contains("caller's device"),
+        "{}",
+        eval.device_name()
+    );
+    let scene = eval.prepare(&lights_with_ies()).unwrap();
+    let mut rng = Rng::new(1);
+    // Not a multiple of the workgroup size (64).
+    let n = 10_007;
+    let dirs = unit_rows(&mut rng, n);
+    let dirs_buf = r.buffer(&dirs, wgpu::BufferUsages::STORAGE);
+    for (acc, rows) in [
+        (Accumulate::Sum, n),
+        (Accumulate::PerLight, scene.len() * n),
+    ] {
+        let out = r.output(rows);
+        let mut enc = r.encoder();
+        scene
+            .encode_emission(&mut enc, &dirs_buf, &out, n as u32, acc)
+            .unwrap();
+        let got = r.finish(enc, &out, rows);
+        assert_same(
+            &format!("emission {acc:?}"),
+            &got,
+            &scene.emission(&dirs, acc).unwrap(),
+        );
+
+        let out = r.output(rows);
+        let mut enc = r.encoder();
+        scene
+            .encode_intensity(&mut enc, &dirs_buf, &out, n as u32, acc)
+            .unwrap();
+        let got = r.finish(enc, &out, rows);
+        assert_same(
+            &format!("intensity {acc:?}"),
+            &got,
+            &scene.intensity(&dirs, acc).unwrap(),
+        );
+    }
+}
+
+#[test]
+fn radiance_matches_the_host_path() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let scene = eval.prepare(&lights_with_ies()).unwrap();
+    let mut rng = Rng::new(2);
+    let n = 20_001;
+    // Directions aimed at a light's origin (jittered), so that many rays hit a shape.
+    let lights: Vec<Light> = scene.lights().cloned().collect();
+    let pts = points(&mut rng, n);
+    let dirs: Vec<[f32; 3]> = pts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let o = lights[i % lights.len()].world.w_axis.truncate();
+            let p = glam::DVec3::from_array(p.map(f64::from));
+            ((o - p).normalize() + rng.unit() * 0.05)
+                .normalize()
+                .as_vec3()
+                .to_array()
+        })
+        .collect();
+    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
+    let dirs_buf = r.buffer(&dirs, wgpu::BufferUsages::STORAGE);
+    for (acc, rows) in [
+        (Accumulate::Sum, n),
+        (Accumulate::PerLight, scene.len() * n),
+    ] {
+        let out = r.output(rows);
+        let mut enc = r.encoder();
+        scene
+            .encode_radiance(&mut enc, &pts_buf, &dirs_buf, &out, n as u32, acc)
+            .unwrap();
+        let got = r.finish(enc, &out, rows);
+        let host = scene.radiance(&pts, &dirs, acc).unwrap();
+        if acc == Accumulate::Sum {
+            assert_same("radiance Sum", &got, &host);
+        } else {
+            // Per light most rows miss; compare all, require hits only in the sum above.
+            assert_eq!(got.len(), host.len());
+            for (i, (g, h)) in got.iter().zip(&host).enumerate() {
+                for c in 0..3 {
+                    let scale = g[c].abs().max(h[c].abs()) as f64;
+                    assert!(
+                        ((g[c] - h[c]) as f64).abs() <= 1e-6 * scale + 1e-30,
+                        "radiance PerLight row {i}: {g:?} vs {h:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn irradiance_matches_the_host_path_over_several_light_groups() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    // Five lights: five dispatch groups on lavapipe (one light each), accumulating in order.
+    let scene = eval.prepare(&synthetic_lights(5)).unwrap();
+    let mut rng = Rng::new(3);
+    let n = 1_003;
+    let pts = points(&mut rng, n);
+    let normals = unit_rows(&mut rng, n);
+    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
+    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    for (acc, rows) in [
+        (Accumulate::Sum, n),
+        (Accumulate::PerLight, scene.len() * n),
+    ] {
+        // Garbage in `out` (see Renderer::output): summed mode must write, not add.
+        let out = r.output(rows);
+        let mut enc = r.encoder();
+        scene
+            .encode_irradiance(&mut enc, &pts_buf, &nrm_buf, &out, n as u32, acc)
+            .unwrap();
+        let got = r.finish(enc, &out, rows);
+        let host = scene.irradiance(&pts, &normals, acc).unwrap();
+        assert_same(&format!("irradiance {acc:?}"), &got, &host);
+    }
+}
+
+#[test]
+fn a_gpu_evaluators_device_serves_resident_calls_and_an_empty_scene_writes_zeros() {
+    let Some(eval) = common::gpu() else { return };
+    let r = Renderer {
+        device: eval.wgpu_device().unwrap().clone(),
+        queue: eval.wgpu_queue().unwrap().clone(),
+        adapter: None,
+    };
+    let n = 100;
+    let dirs = r.buffer(&vec![[0.0, 0.0, -1.0]; n], wgpu::BufferUsages::STORAGE);
+    let empty = eval.prepare(&[]).unwrap();
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    empty
+        .encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum)
+        .unwrap();
+    assert_eq!(r.finish(enc, &out, n), vec![[0.0; 3]; n]);
+    // Per light over no lights: nothing to write, nothing written.
+    let mut enc = r.encoder();
+    empty
+        .encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::PerLight)
+        .unwrap();
+    assert_eq!(r.finish(enc, &out, n), vec![[0.0; 3]; n]);
+}
+
+fn invalid_input(e: LuxError) -> (String, String) {
+    match e {
+        LuxError::InvalidInput { what, reason } => (what, reason),
+        other => panic!("expected InvalidInput, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_buffers_are_refused_with_typed_errors() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let scene = eval.prepare(&synthetic_lights(3)).unwrap();
+    let n = 64;
+    let dirs = r.buffer(&vec![[0.0, 0.0, 1.0]; n], wgpu::BufferUsages::STORAGE);
+    let out = r.output(3 * n);
+    let mut enc = r.encoder();
+
+    // No STORAGE usage.
+    let vertex = r.buffer(&vec![[0.0, 0.0, 1.0]; n], wgpu::BufferUsages::VERTEX);
+    let (what, reason) = invalid_input(
+        scene
+            .encode_emission(&mut enc, &vertex, &out, n as u32, Accumulate::Sum)
+            .unwrap_err(),
+    );
+    assert_eq!(what, "directions");
+    assert!(reason.contains("STORAGE"), "{reason}");
+
+    // An input too small for `count`.
+    let (what, reason) = invalid_input(
+        scene
+            .encode_emission(&mut enc, &dirs, &out, n as u32 + 1, Accumulate::Sum)
+            .unwrap_err(),
+    );
+    assert_eq!(what, "directions");
+    assert!(reason.contains(&format!("{} bytes", n * 12)), "{reason}");
+
+    // An output large enough summed but not per light (3 lights × n rows).
+    let small = r.output(n);
+    let (what, reason) = invalid_input(
+        scene
+            .encode_emission(&mut enc, &dirs, &small, n as u32, Accumulate::PerLight)
+            .unwrap_err(),
+    );
+    assert_eq!(what, "out");
+    assert!(reason.contains(&format!("need {}", 3 * n * 12)), "{reason}");
+
+    // The output is an input.
+    let both = r.buffer(&vec![[0.0, 0.0, 1.0]; n], wgpu::BufferUsages::STORAGE);
+    let (what, _) = invalid_input(
+        scene
+            .encode_emission(&mut enc, &both, &both, n as u32, Accumulate::Sum)
+            .unwrap_err(),
+    );
+    assert_eq!(what, "out");
+
+    // A buffer of another device: wgpu refuses the bind group, luxeval reports it.
+    let other = r.another_device();
+    let foreign = other.buffer(&vec![[0.0, 0.0, 1.0]; n], wgpu::BufferUsages::STORAGE);
+    match scene.encode_emission(&mut enc, &foreign, &out, n as u32, Accumulate::Sum) {
+        Err(LuxError::Gpu { .. }) => {}
+        other => panic!("expected a GPU error for another device's buffer, got {other:?}"),
+    }
+
+    // A scene on the CPU reference has no device.
+    let cpu_scene = Evaluator::cpu().prepare(&synthetic_lights(1)).unwrap();
+    let (what, _) = invalid_input(
+        cpu_scene
+            .encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum)
+            .unwrap_err(),
+    );
+    assert_eq!(what, "backend");
+
+    // Nothing was recorded by the refused calls: the encoder still finishes and submits.
+    r.queue.submit([enc.finish()]);
+    r.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+}
+
+#[test]
+fn host_irradiance_lights_are_refused_by_name() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let lights = lights_with_ies();
+    let ies_path = lights[12].path.clone();
+    let scene = eval.prepare(&lights).unwrap();
+    let n = 64;
+    let pts = r.buffer(&vec![[0.0, 0.0, 0.0]; n], wgpu::BufferUsages::STORAGE);
+    let nrm = r.buffer(&vec![[0.0, 1.0, 0.0]; n], wgpu::BufferUsages::STORAGE);
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    match scene.encode_irradiance(&mut enc, &pts, &nrm, &out, n as u32, Accumulate::Sum) {
+        Err(e @ LuxError::NotOnDevice { .. }) => {
+            let LuxError::NotOnDevice {
+                light,
+                query,
+                reason,
+            } = &e
+            else {
+                unreachable!()
+            };
+            assert_eq!(light, &ies_path);
+            assert_eq!(query, "irradiance");
+            assert!(reason.contains("IES"), "{reason}");
+            assert!(e.to_string().contains(&ies_path), "{e}");
+        }
+        other => panic!("expected NotOnDevice, got {other:?}"),
+    }
+    // Emission and radiance of the same scene are evaluated on the device (the IES lookup is
+    // in those kernels).
+    scene
+        .encode_emission(&mut enc, &nrm, &out, n as u32, Accumulate::Sum)
+        .unwrap();
+}
+
+#[test]
+fn counts_over_the_binding_limit_are_refused_with_the_most_one_call_takes() {
+    // A renderer whose device has a 1 MiB storage binding limit (its buffers may be larger).
+    let limit = 1u64 << 20;
+    let Some(r) = renderer_with(Some(wgpu::Limits {
+        max_storage_buffer_binding_size: limit,
+        ..wgpu::Limits::default()
+    })) else {
+        return;
+    };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let scene = eval.prepare(&synthetic_lights(2)).unwrap();
+    let fits = (limit / 12) as usize;
+    let dirs = r.buffer(
+        &vec![[0.0, 0.0, 1.0]; fits + 1],
+        wgpu::BufferUsages::STORAGE,
+    );
+    let out = r.output(2 * (fits + 1));
+    let mut enc = r.encoder();
+    let (what, reason) = invalid_input(
+        scene
+            .encode_emission(&mut enc, &dirs, &out, fits as u32 + 1, Accumulate::Sum)
+            .unwrap_err(),
+    );
+    assert_eq!(what, "count");
+    assert!(
+        reason.contains(&format!("at most {fits} samples")),
+        "{reason}"
+    );
+    // Per light, the output binding holds both lights' rows: half as many samples fit.
+    let (_, reason) = invalid_input(
+        scene
+            .encode_emission(&mut enc, &dirs, &out, fits as u32, Accumulate::PerLight)
+            .unwrap_err(),
+    );
+    assert!(
+        reason.contains(&format!("at most {} samples", fits / 2)),
+        "{reason}"
+    );
+    // The largest call that fits runs, over buffers larger than the binding limit.
+    scene
+        .encode_emission(&mut enc, &dirs, &out, fits as u32, Accumulate::Sum)
+        .unwrap();
+    let got = r.finish(enc, &out, fits);
+    let host = scene
+        .emission(&vec![[0.0, 0.0, 1.0]; fits], Accumulate::Sum)
+        .unwrap();
+    assert_eq!(got, host);
+}
