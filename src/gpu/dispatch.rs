@@ -266,14 +266,7 @@ impl GpuContext {
             label: Some("luxeval queries"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                    }),
-                },
+                params_entry(&params),
                 entry(1, &lights.buffer),
                 entry(2, &buf_a),
                 // Emission reads no second input; bind the first again (read-only aliasing).
@@ -393,6 +386,18 @@ impl GpuContext {
         };
         staging.unmap();
         Ok(bytes)
+    }
+}
+
+/// Binding 0: one `Params` block of `buffer`, at the dynamic offset of the pass.
+pub(super) fn params_entry(buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding: 0,
+        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
+        }),
     }
 }
 

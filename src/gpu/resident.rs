@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{LuxError, Result};
 
-use super::dispatch::{GpuLights, entry};
+use super::dispatch::{GpuLights, entry, params_entry};
 use super::record::{Params, Record, WORKGROUP_SIZE};
 use super::{GpuContext, Kernel};
 
@@ -190,14 +190,7 @@ impl GpuContext {
             label: Some("luxeval queries (resident)"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &params,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<Params>() as u64),
-                    }),
-                },
+                params_entry(&params),
                 entry(1, &lights.buffer),
                 wgpu::BindGroupEntry {
                     binding: 2,
