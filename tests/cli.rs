@@ -320,40 +320,57 @@ fn luxtest(name: &str) -> String {
         .into_owned()
 }
 
+/// The CLI's irradiance at its default `--tolerance` (1e-4) equals the library's at that
+/// tolerance, and at `--tolerance 1e-9` the library's reference.
 #[test]
 fn irradiance_on_the_bundled_floor_equals_the_library() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("e.npy");
-    let o = luxeval(&[
-        "irradiance",
-        &asset("studio.usda"),
-        "--points",
-        &asset("floor_points.npy"),
-        "--normals",
-        &asset("floor_up.npy"),
-        "-o",
-        out.to_str().unwrap(),
-        "--device",
-        "cpu",
-        "--per-light",
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let (shape, got) = read_npy_f32(&out);
     let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
     let lights = scene.evaluable(&[]).unwrap();
     let points = npy::read_vec3(Path::new(&asset("floor_points.npy"))).unwrap();
     let normals = npy::read_directions(Path::new(&asset("floor_up.npy"))).unwrap();
-    assert_eq!(
-        shape,
-        vec![lights.len() as u64, points.len() as u64, 3],
-        "(L, N, 3)"
+    let (studio, floor, up) = (
+        asset("studio.usda"),
+        asset("floor_points.npy"),
+        asset("floor_up.npy"),
     );
-    let want = Evaluator::cpu()
-        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
-        .unwrap();
-    let want: Vec<f32> = want.iter().flatten().copied().collect();
-    assert_eq!(got, want);
-    assert!(got.iter().any(|v| *v > 0.0), "the floor is lit");
+    for (flags, eval) in [
+        (
+            &[][..],
+            Evaluator::cpu().with_irradiance_tolerance(1e-4).unwrap(),
+        ),
+        (&["--tolerance", "1e-9"][..], Evaluator::cpu()),
+    ] {
+        let out = dir.path().join("e.npy");
+        let mut args = vec![
+            "irradiance",
+            &studio,
+            "--points",
+            &floor,
+            "--normals",
+            &up,
+            "-o",
+            out.to_str().unwrap(),
+            "--device",
+            "cpu",
+            "--per-light",
+        ];
+        args.extend(flags);
+        let o = luxeval(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let (shape, got) = read_npy_f32(&out);
+        assert_eq!(
+            shape,
+            vec![lights.len() as u64, points.len() as u64, 3],
+            "(L, N, 3)"
+        );
+        let want = eval
+            .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+            .unwrap();
+        let want: Vec<f32> = want.iter().flatten().copied().collect();
+        assert_eq!(got, want, "{flags:?}");
+        assert!(got.iter().any(|v| *v > 0.0), "the floor is lit");
+    }
 }
 
 #[test]
