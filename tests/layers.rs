@@ -19,8 +19,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("gpu", &["error", "model", "prepare", "rules", "gpu"]),
     (
         "query",
-        // `usd` only for the light records of a stage (query/lights.rs, feature `usd`).
-        &["error", "model", "usd", "prepare", "cpu", "gpu", "query"],
+        // `usd` only for the light records of a stage (query/lights.rs, feature `usd`);
+        // `rules` for the tolerance the GPU is held to (irradiance `--tolerance`).
+        &["error", "model", "usd", "prepare", "rules", "cpu", "gpu", "query"],
     ),
     ("io", &["error", "limits", "io"]),
     ("ies", &["assets", "prepare", "cpu", "plot", "ies"]),
@@ -29,7 +30,7 @@ const ALLOWED: &[(&str, &[&str])] = &[
     (
         "check",
         &[
-            "error", "model", "prepare", "cpu", "query", "testkit", "check",
+            "error", "model", "prepare", "rules", "cpu", "query", "testkit", "check",
         ],
     ),
 ];

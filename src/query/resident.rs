@@ -12,7 +12,7 @@ use crate::model::LightType;
 
 impl Evaluator {
     /// An evaluator on the caller's device (a renderer's own `wgpu::Device` and `wgpu::Queue`,
-    /// from [`crate::wgpu`], luxeval's wgpu): every query, host path and GPU-resident, runs there.
+    /// from `luxeval::wgpu`, luxeval's wgpu): every query, host path and GPU-resident, runs there.
     /// luxeval installs no error handler or device-lost callback on it. Fails when the device's
     /// limits are below what the kernels need (`wgpu::Limits::default()` is enough).
     ///

@@ -172,7 +172,7 @@ impl PreparedScene {
     }
 
     /// [`PreparedScene::irradiance`] to relative tolerance `rel` for this call, whatever the
-    /// evaluator's (see [`crate::Evaluator::with_irradiance_tolerance`] for what it means and
+    /// evaluator's (see [`Evaluator::with_irradiance_tolerance`](super::Evaluator::with_irradiance_tolerance) for what it means and
     /// which values each backend takes).
     pub fn irradiance_with_tolerance(
         &self,
