@@ -107,8 +107,9 @@ impl Evaluator {
 
     /// Computes irradiance to relative tolerance `rel` rather than to the reference's 1e-9
     /// (`luxeval irradiance --tolerance`, whose default is 1e-4): the CPU's adaptive rules stop
-    /// there (the CPU's `Adaptive::for_tolerance`; closed forms stay exact), which makes
-    /// shaped lights many times faster. The GPU's f32 rule is fixed and held to 1e-4 by the
+    /// there (the CPU's `Adaptive::for_tolerance`; closed forms stay exact): at 1e-4 a shaped
+    /// light's map costs about half the reference's time (BENCHMARKS.md; each smooth piece
+    /// still costs one 15-point rule). The GPU's f32 rule is fixed and held to 1e-4 by the
     /// conformance tests (the tolerance of `luxeval check`), so a GPU evaluator accepts no
     /// tighter `rel`. Errors: `rel` not in [1e-9, 0.1], or below the GPU's bound on
     /// a GPU evaluator.
