@@ -21,7 +21,9 @@ const ALLOWED: &[(&str, &[&str])] = &[
         "query",
         // `usd` only for the light records of a stage (query/lights.rs, feature `usd`);
         // `rules` for the tolerance the GPU is held to (irradiance `--tolerance`).
-        &["error", "model", "usd", "prepare", "rules", "cpu", "gpu", "query"],
+        &[
+            "error", "model", "usd", "prepare", "rules", "cpu", "gpu", "query",
+        ],
     ),
     ("io", &["error", "limits", "io"]),
     ("ies", &["assets", "prepare", "cpu", "plot", "ies"]),

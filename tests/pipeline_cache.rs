@@ -94,7 +94,10 @@ fn pipeline_cache_is_written_survives_corruption_and_can_be_disabled() {
     // Garbage, or a truncated copy, in place of the file: ignored (wgpu and the driver check
     // their headers), same results, and the file is rewritten whole.
     let good = std::fs::read(file).unwrap();
-    for bad in [b"not a pipeline cache".to_vec(), good[..good.len() / 2].to_vec()] {
+    for bad in [
+        b"not a pipeline cache".to_vec(),
+        good[..good.len() / 2].to_vec(),
+    ] {
         std::fs::write(file, &bad).unwrap();
         assert_eq!(emission(&cache, &out), first);
         assert_ne!(std::fs::read(file).unwrap(), bad);
@@ -104,5 +107,8 @@ fn pipeline_cache_is_written_survives_corruption_and_can_be_disabled() {
 
     // An empty LUXEVAL_CACHE_DIR disables the cache.
     let info = String::from_utf8_lossy(&luxeval(Path::new(""), &["info"]).stdout).into_owned();
-    assert!(info.contains("pipeline cache: not used: disabled"), "{info}");
+    assert!(
+        info.contains("pipeline cache: not used: disabled"),
+        "{info}"
+    );
 }

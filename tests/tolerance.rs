@@ -35,7 +35,9 @@ fn map(eval: &Evaluator, scene: &str, frame: f64) -> Vec<[f32; 3]> {
         .evaluable(&[])
         .unwrap();
     let prepared = eval.prepare(&lights).unwrap();
-    falloff::evaluate(&prepared, &floor(), |_, _| {}).unwrap().rgb
+    falloff::evaluate(&prepared, &floor(), |_, _| {})
+        .unwrap()
+        .rgb
 }
 
 /// The largest relative error of `got` against `want` over every pixel and channel; a pixel
@@ -70,7 +72,10 @@ fn tolerance_maps_hold_the_reference() {
             let err = worst(&got, &reference);
             eprintln!("{scene} frame 31, tolerance {tol:e}: worst relative error {err:.3e}");
             // f32 output rounding (6e-8) is far below either tolerance.
-            assert!(err <= tol, "{scene}: worst {err:e} over the tolerance {tol:e}");
+            assert!(
+                err <= tol,
+                "{scene}: worst {err:e} over the tolerance {tol:e}"
+            );
         }
     }
 }
@@ -90,6 +95,9 @@ fn tolerance_is_validated() {
     );
     let Some(gpu) = common::gpu() else { return };
     let e = gpu.clone().with_irradiance_tolerance(1e-5).unwrap_err();
-    assert!(e.to_string().contains("--device cpu") || e.to_string().contains("CPU"), "{e}");
+    assert!(
+        e.to_string().contains("--device cpu") || e.to_string().contains("CPU"),
+        "{e}"
+    );
     assert!(gpu.with_irradiance_tolerance(1e-4).is_ok());
 }

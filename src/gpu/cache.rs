@@ -70,7 +70,10 @@ pub(crate) fn open(
         return none("the adapter offers no pipeline cache".into());
     }
     let Some(key) = wgpu::util::pipeline_cache_key(info) else {
-        return none(format!("wgpu keeps no pipeline cache for {:?}", info.backend));
+        return none(format!(
+            "wgpu keeps no pipeline cache for {:?}",
+            info.backend
+        ));
     };
     let dir = match directory() {
         Ok(d) => d,

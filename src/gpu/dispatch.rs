@@ -183,14 +183,10 @@ impl GpuContext {
         let (ies, dome) = lights.variant(kernel);
         let pipeline = self.pipeline(kernel, ies, dome)?;
         let capacity = self.chunk_capacity(count, per_light);
-        let per_group = self.lights_per_dispatch(kernel).max(1);
         let key = ScratchKey {
             chunk: n.next_power_of_two().min(capacity),
             rows,
-            groups: (0..count)
-                .step_by(per_group)
-                .map(|g| (g, (g + per_group).min(count)))
-                .collect(),
+            groups: self.light_groups(kernel, count),
             two_inputs: b.is_some(),
         };
         let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -254,8 +250,7 @@ impl GpuContext {
             mapped_at_creation: false,
         });
         // One Params block per light group at the uniform offset alignment.
-        let align = (self.limits.min_uniform_buffer_offset_alignment as usize)
-            .max(std::mem::size_of::<Params>());
+        let align = self.params_align();
         let params = dev.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
             size: (key.groups.len() * align) as u64,
@@ -304,8 +299,6 @@ impl GpuContext {
         let rows = s.key.rows;
         let groups = &s.key.groups;
         let align = s.align;
-        let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
-        let mut block = vec![0u8; groups.len() * align];
         let mut start = 0;
         while start < n {
             let count = s.key.chunk.min(n - start);
@@ -315,38 +308,23 @@ impl GpuContext {
                 self.queue
                     .write_buffer(buf, 0, bytemuck::cast_slice(&b[start..start + count]));
             }
-            let wg = (count as u32).div_ceil(WORKGROUP_SIZE);
-            let gx = wg.min(max_groups);
-            let gy = wg.div_ceil(gx);
-            for (g, &(first, end)) in groups.iter().enumerate() {
-                let params = Params {
-                    count: count as u32,
-                    light_first: first as u32,
-                    light_end: end as u32,
-                    per_light: per_light as u32,
-                    row_stride: gx * WORKGROUP_SIZE,
-                    accumulate: (g > 0) as u32,
-                    pad: [0; 2],
-                };
-                block[g * align..g * align + std::mem::size_of::<Params>()]
-                    .copy_from_slice(bytemuck::bytes_of(&params));
-            }
+            let grid = self.grid(count as u32);
+            let block = params_block(groups, align, count as u32, per_light, grid);
             self.queue.write_buffer(&s.params, 0, &block);
             let mut enc = self
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some(kernel.entry_point()),
                 });
-            for g in 0..groups.len() {
-                // A pass per group: passes are ordered, so a group reads the sums of the last.
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some(kernel.entry_point()),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &s.bind_group, &[(g * align) as u32]);
-                pass.dispatch_workgroups(gx, gy, 1);
-            }
+            record_passes(
+                &mut enc,
+                kernel,
+                pipeline,
+                &s.bind_group,
+                groups.len(),
+                align,
+                grid,
+            );
             let used = (count * rows * 12) as u64;
             enc.copy_buffer_to_buffer(&s.buf_out, 0, &s.staging, 0, used);
             self.queue.submit([enc.finish()]);
@@ -386,6 +364,82 @@ impl GpuContext {
         };
         staging.unmap();
         Ok(bytes)
+    }
+}
+
+impl GpuContext {
+    /// The light groups `[first, end)` of `lights` lights that one dispatch each of `kernel`
+    /// evaluates ([`GpuContext::lights_per_dispatch`]).
+    pub(super) fn light_groups(&self, kernel: Kernel, lights: usize) -> Vec<(usize, usize)> {
+        let per_group = self.lights_per_dispatch(kernel).max(1);
+        (0..lights)
+            .step_by(per_group)
+            .map(|g| (g, (g + per_group).min(lights)))
+            .collect()
+    }
+
+    /// The 2D dispatch grid `(x, y)` of workgroups covering `count` samples: x up to the
+    /// device's per-dimension limit, then rows of x (`sample_index` in record.wgsl).
+    pub(super) fn grid(&self, count: u32) -> (u32, u32) {
+        let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
+        let wg = count.div_ceil(WORKGROUP_SIZE);
+        let gx = wg.min(max_groups).max(1);
+        (gx, wg.div_ceil(gx))
+    }
+
+    /// The stride of the Params blocks in their uniform buffer: the device's dynamic offset
+    /// alignment, at least one block.
+    pub(super) fn params_align(&self) -> usize {
+        (self.limits.min_uniform_buffer_offset_alignment as usize)
+            .max(std::mem::size_of::<Params>())
+    }
+}
+
+/// One Params block per light group at stride `align`: group g evaluates its lights over
+/// `count` samples and, after the first, adds to the sums the groups before it wrote.
+pub(super) fn params_block(
+    groups: &[(usize, usize)],
+    align: usize,
+    count: u32,
+    per_light: bool,
+    (gx, _): (u32, u32),
+) -> Vec<u8> {
+    let mut block = vec![0u8; groups.len() * align];
+    for (g, &(first, end)) in groups.iter().enumerate() {
+        let params = Params {
+            count,
+            light_first: first as u32,
+            light_end: end as u32,
+            per_light: per_light as u32,
+            row_stride: gx * WORKGROUP_SIZE,
+            accumulate: (g > 0) as u32,
+            pad: [0; 2],
+        };
+        block[g * align..g * align + std::mem::size_of::<Params>()]
+            .copy_from_slice(bytemuck::bytes_of(&params));
+    }
+    block
+}
+
+/// Records one compute pass per light group, each with its Params block (dynamic offset
+/// g · align): passes are ordered, so a group reads the sums of the last.
+pub(super) fn record_passes(
+    enc: &mut wgpu::CommandEncoder,
+    kernel: Kernel,
+    pipeline: &wgpu::ComputePipeline,
+    bind_group: &wgpu::BindGroup,
+    groups: usize,
+    align: usize,
+    (gx, gy): (u32, u32),
+) {
+    for g in 0..groups {
+        let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(kernel.entry_point()),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[(g * align) as u32]);
+        pass.dispatch_workgroups(gx, gy, 1);
     }
 }
 

@@ -216,7 +216,9 @@ impl GpuContext {
             device: t0.elapsed() - t_instance - t_adapter,
             pipelines: Vec::new(),
         };
-        Ok(Self::with_device(device, queue, info, limits, lost, startup))
+        Ok(Self::with_device(
+            device, queue, info, limits, lost, startup,
+        ))
     }
 
     /// The part of opening a context that follows the device: the bind group and pipeline

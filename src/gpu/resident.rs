@@ -9,7 +9,7 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{LuxError, Result};
 
-use super::dispatch::{GpuLights, entry, params_entry};
+use super::dispatch::{GpuLights, entry, params_block, params_entry, record_passes};
 use super::record::{Params, Record, WORKGROUP_SIZE};
 use super::{GpuContext, Kernel};
 
@@ -131,9 +131,8 @@ impl GpuContext {
         }
         let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
         let wg = count.div_ceil(WORKGROUP_SIZE);
-        let gx = wg.min(max_groups);
-        let gy = wg.div_ceil(gx.max(1));
-        if gy > max_groups {
+        let grid = self.grid(count);
+        if grid.1 > max_groups {
             return Err(LuxError::input(
                 "count",
                 format!(
@@ -146,15 +145,11 @@ impl GpuContext {
             return Ok(());
         }
 
-        let per_group = self.lights_per_dispatch(kernel).max(1);
         let groups: Vec<(usize, usize)> = if n_lights == 0 {
             // Summed mode over no lights: one dispatch that writes the zero rows.
             vec![(0, 0)]
         } else {
-            (0..n_lights)
-                .step_by(per_group)
-                .map(|g| (g, (g + per_group).min(n_lights)))
-                .collect()
+            self.light_groups(kernel, n_lights)
         };
         let (ies, dome) = lights.variant(kernel);
         let pipeline = self.pipeline(kernel, ies, dome)?;
@@ -163,22 +158,8 @@ impl GpuContext {
         // One Params block per light group at the uniform offset alignment; a buffer of this
         // call's own (written at creation, so that nothing goes through the queue), kept alive
         // by the command buffer that uses it.
-        let align = (self.limits.min_uniform_buffer_offset_alignment as usize)
-            .max(std::mem::size_of::<Params>());
-        let mut block = vec![0u8; groups.len() * align];
-        for (g, &(first, end)) in groups.iter().enumerate() {
-            let p = Params {
-                count,
-                light_first: first as u32,
-                light_end: end as u32,
-                per_light: per_light as u32,
-                row_stride: gx * WORKGROUP_SIZE,
-                accumulate: (g > 0) as u32,
-                pad: [0; 2],
-            };
-            block[g * align..g * align + std::mem::size_of::<Params>()]
-                .copy_from_slice(bytemuck::bytes_of(&p));
-        }
+        let align = self.params_align();
+        let block = params_block(&groups, align, count, per_light, grid);
         let params = self
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -217,16 +198,15 @@ impl GpuContext {
                 e,
             ));
         }
-        for g in 0..groups.len() {
-            // A pass per group: passes are ordered, so a group reads the sums of the last.
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some(kernel.entry_point()),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[(g * align) as u32]);
-            pass.dispatch_workgroups(gx, gy, 1);
-        }
+        record_passes(
+            encoder,
+            kernel,
+            &pipeline,
+            &bind_group,
+            groups.len(),
+            align,
+            grid,
+        );
         Ok(())
     }
 }

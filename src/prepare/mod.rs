@@ -119,9 +119,20 @@ impl Prepared {
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
     pub fn irradiance_on_host(&self) -> bool {
-        self.ies.is_some()
-            || (matches!(self.light.kind, LightType::Dome) && self.texture.is_some())
-            || self.rect_texture.is_some()
+        self.host_irradiance_reason().is_some()
+    }
+
+    /// Why [`Prepared::irradiance_on_host`] holds, as a phrase ("it is IES-shaped"), if it does.
+    pub fn host_irradiance_reason(&self) -> Option<&'static str> {
+        if self.ies.is_some() {
+            Some("it is IES-shaped")
+        } else if matches!(self.light.kind, LightType::Dome) && self.texture.is_some() {
+            Some("it is a textured dome")
+        } else if self.rect_texture.is_some() {
+            Some("it is a textured rect")
+        } else {
+            None
+        }
     }
 
     /// Validates `light` and computes its constants for `mode`.

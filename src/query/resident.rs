@@ -8,7 +8,6 @@ use super::{Accumulate, Backend, Evaluator, PreparedScene};
 use crate::error::{LuxError, Result};
 use crate::gpu::resident::Operand;
 use crate::gpu::{GpuContext, Kernel};
-use crate::model::LightType;
 
 impl Evaluator {
     /// An evaluator on the caller's device (a renderer's own `wgpu::Device` and `wgpu::Queue`,
@@ -165,14 +164,11 @@ impl PreparedScene {
         count: u32,
         acc: Accumulate,
     ) -> Result<()> {
-        if let Some(p) = self.lights.iter().find(|p| p.irradiance_on_host()) {
-            let reason = if p.ies.is_some() {
-                "it is IES-shaped"
-            } else if matches!(p.light.kind, LightType::Dome) {
-                "it is a textured dome"
-            } else {
-                "it is a textured rect"
-            };
+        if let Some((p, reason)) = self
+            .lights
+            .iter()
+            .find_map(|p| Some((p, p.host_irradiance_reason()?)))
+        {
             return Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),
                 query: "irradiance".into(),

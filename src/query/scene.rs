@@ -218,13 +218,8 @@ impl PreparedScene {
             if !light.irradiance_on_host() {
                 continue;
             }
-            let values = cpu::irradiance_batch(
-                std::slice::from_ref(light),
-                points,
-                normals,
-                true,
-                rule,
-            );
+            let values =
+                cpu::irradiance_batch(std::slice::from_ref(light), points, normals, true, rule);
             for (i, v) in values.into_iter().enumerate() {
                 let row = if per_light { k * n + i } else { i };
                 let sum = DVec3::from_array(out[row].map(f64::from)) + v;

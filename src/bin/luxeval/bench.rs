@@ -46,7 +46,11 @@ pub struct BenchArgs {
     #[arg(long)]
     sweep: bool,
     /// Sample counts of the sweep.
-    #[arg(long, value_delimiter = ',', default_value = "1000,10000,100000,1000000,10000000")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "1000,10000,100000,1000000,10000000"
+    )]
     sweep_samples: Vec<usize>,
     /// Light counts of the sweep.
     #[arg(long, value_delimiter = ',', default_value = "1,8,64")]
@@ -202,7 +206,11 @@ pub fn run(args: BenchArgs) -> CliResult {
                 "--sweep-samples and --sweep-lights must be at least 1",
             ));
         }
-        if let Some(&l) = args.sweep_lights.iter().find(|&&l| l as u64 > limits.max_prims) {
+        if let Some(&l) = args
+            .sweep_lights
+            .iter()
+            .find(|&&l| l as u64 > limits.max_prims)
+        {
             return Err(Failure::bad_input(format!(
                 "--sweep-lights {l} exceeds the limit of {} ({})",
                 limits.max_prims,
@@ -401,7 +409,10 @@ pub fn run(args: BenchArgs) -> CliResult {
         outln!("{query}: GPU/CPU throughput ratio {ratio:.2}× (same run)");
     }
     if let Some(rss) = peak_rss() {
-        outln!("peak RSS of this process: {:.0} MiB", rss as f64 / (1 << 20) as f64);
+        outln!(
+            "peak RSS of this process: {:.0} MiB",
+            rss as f64 / (1 << 20) as f64
+        );
     }
     Ok(())
 }

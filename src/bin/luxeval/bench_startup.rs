@@ -97,9 +97,8 @@ pub fn measure() -> CliResult<Vec<StartupRow>> {
                 String::from_utf8_lossy(&out.stderr).trim()
             )));
         }
-        let probe: Probe = serde_json::from_slice(&out.stdout).map_err(|e| {
-            Failure::runtime(format!("bench: the start-up probe's output: {e}"))
-        })?;
+        let probe: Probe = serde_json::from_slice(&out.stdout)
+            .map_err(|e| Failure::runtime(format!("bench: the start-up probe's output: {e}")))?;
         rows.push(StartupRow {
             cache,
             process_seconds,
