@@ -1,6 +1,11 @@
 //! Running a kernel over a batch: the lights uploaded once per prepared scene ([`GpuLights`]),
 //! input/output/readback buffers kept between calls of the same size class ([`Scratch`]), and
-//! the batch cut into chunks that fit the device's binding and dispatch limits.
+//! the batch cut into chunks that fit the device's binding and dispatch limits. The host's share
+//! of a call (mapping the inputs into the staging memory, copying the results out of the
+//! readback buffer) runs on every core: on a real GPU it is most of the call (issue 11 item 7,
+//! BENCHMARKS.md "A real GPU").
+
+use rayon::prelude::*;
 
 use crate::error::{GpuFailure, LuxError, Result};
 
@@ -41,6 +46,22 @@ struct ScratchKey {
     rows: usize,
     groups: Vec<(usize, usize)>,
     two_inputs: bool,
+}
+
+/// Rows per piece of the parallel readback copy: large enough to amortise rayon's scheduling,
+/// small enough to spread a chunk over every core.
+const PIECE_ROWS: usize = 1 << 14;
+
+/// Rows per staging view of the parallel upload (1.5 MiB): each view is a staging allocation of
+/// its own, so fewer and larger than the readback's pieces.
+const UPLOAD_PIECE_ROWS: usize = 1 << 17;
+
+/// One input of a batch: its rows and the map each row goes through on its way to the device
+/// (the query layer normalises directions in f64 there, DESIGN.md §3).
+#[derive(Clone, Copy)]
+pub(crate) struct Input<'a> {
+    pub rows: &'a [[f32; 3]],
+    pub map: &'a (dyn Fn([f32; 3]) -> [f32; 3] + Sync),
 }
 
 /// Reusable input, output, readback and parameter buffers with their bind group.
@@ -169,11 +190,11 @@ impl GpuContext {
         kernel: Kernel,
         lights: &GpuLights,
         scratch: &mut Option<Scratch>,
-        a: &[[f32; 3]],
-        b: Option<&[[f32; 3]]>,
+        a: Input<'_>,
+        b: Option<Input<'_>>,
         per_light: bool,
     ) -> Result<Vec<[f32; 3]>> {
-        let n = a.len();
+        let n = a.rows.len();
         let count = lights.count;
         let rows = if per_light { count } else { 1 };
         let mut out = vec![[0f32; 3]; rows * n];
@@ -195,7 +216,7 @@ impl GpuContext {
             *scratch = Some(self.scratch(key, lights));
         }
         let s = scratch.as_ref().expect("set above");
-        let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, count, &mut out);
+        let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, &mut out);
         let oom = pollster::block_on(oom.pop());
         let validation = pollster::block_on(validation.pop());
         // A lost device fails every later call with validation errors about invalid buffers;
@@ -289,24 +310,21 @@ impl GpuContext {
         pipeline: &wgpu::ComputePipeline,
         kernel: Kernel,
         s: &Scratch,
-        a: &[[f32; 3]],
-        b: Option<&[[f32; 3]]>,
+        a: Input<'_>,
+        b: Option<Input<'_>>,
         per_light: bool,
-        lights: usize,
         out: &mut [[f32; 3]],
     ) -> Result<()> {
-        let n = a.len();
+        let n = a.rows.len();
         let rows = s.key.rows;
         let groups = &s.key.groups;
         let align = s.align;
         let mut start = 0;
         while start < n {
             let count = s.key.chunk.min(n - start);
-            self.queue
-                .write_buffer(&s.buf_a, 0, bytemuck::cast_slice(&a[start..start + count]));
+            self.write_rows(&s.buf_a, a, start..start + count)?;
             if let (Some(buf), Some(b)) = (&s.buf_b, b) {
-                self.queue
-                    .write_buffer(buf, 0, bytemuck::cast_slice(&b[start..start + count]));
+                self.write_rows(buf, b, start..start + count)?;
             }
             let grid = self.grid(count as u32);
             let block = params_block(groups, align, count as u32, per_light, grid);
@@ -329,22 +347,59 @@ impl GpuContext {
             enc.copy_buffer_to_buffer(&s.buf_out, 0, &s.staging, 0, used);
             self.queue.submit([enc.finish()]);
 
-            let data = self.read_back(&s.staging, used)?;
-            let values: &[[f32; 3]] = bytemuck::cast_slice(&data);
-            if per_light {
-                for l in 0..lights {
-                    out[l * n + start..l * n + start + count]
-                        .copy_from_slice(&values[l * count..(l + 1) * count]);
-                }
-            } else {
-                out[start..start + count].copy_from_slice(values);
-            }
+            self.read_back(&s.staging, used, |values| {
+                // Light-major: this chunk's rows of light l go to rows l·n + start.. (per
+                // light), or to rows start.. (summed, one "light").
+                out.par_chunks_mut(n)
+                    .zip(values.par_chunks(count))
+                    .for_each(|(dst, src)| copy_rows(&mut dst[start..start + count], src));
+            })?;
             start += count;
         }
         Ok(())
     }
 
-    fn read_back(&self, staging: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+    /// Writes `input`'s rows `range`, mapped, to the start of `buffer`, in pieces on every core
+    /// (one staging view each: a view is `Send`, the pieces of one view are not).
+    fn write_rows(
+        &self,
+        buffer: &wgpu::Buffer,
+        input: Input<'_>,
+        range: std::ops::Range<usize>,
+    ) -> Result<()> {
+        let rows = &input.rows[range];
+        let views = rows
+            .chunks(UPLOAD_PIECE_ROWS)
+            .enumerate()
+            .map(|(i, piece)| {
+                let offset = (i * UPLOAD_PIECE_ROWS * 12) as u64;
+                let size = wgpu::BufferSize::new((piece.len() * 12) as u64)?;
+                // None only on a validation failure, which the caller's error scope reports.
+                self.queue.write_buffer_with(buffer, offset, size)
+            })
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| LuxError::gpu("staging the inputs", GpuFailure::Lost))?;
+        views
+            .into_par_iter()
+            .zip(rows.par_chunks(UPLOAD_PIECE_ROWS))
+            .for_each(|(mut view, piece)| {
+                let (slots, _) = view.slice(..).into_chunks::<12>();
+                slots.write_iter(
+                    piece
+                        .iter()
+                        .map(|&row| bytemuck::cast::<[f32; 3], [u8; 12]>((input.map)(row))),
+                );
+            });
+        Ok(())
+    }
+
+    /// Maps the first `size` bytes of `staging`, hands them to `take` as rows, and unmaps.
+    fn read_back(
+        &self,
+        staging: &wgpu::Buffer,
+        size: u64,
+        take: impl FnOnce(&[[f32; 3]]),
+    ) -> Result<()> {
         let slice = staging.slice(..size);
         let (tx, rx) = std::sync::mpsc::channel();
         slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -356,15 +411,26 @@ impl GpuContext {
         rx.recv()
             .map_err(|_| LuxError::gpu("reading the results back", GpuFailure::Lost))?
             .map_err(|e| LuxError::gpu("mapping the result buffer", e))?;
-        let bytes = {
+        {
             let view = slice
                 .get_mapped_range()
                 .map_err(|e| LuxError::gpu("reading the result buffer", e))?;
-            view.to_vec()
-        };
+            // Mapped memory is at least 4-byte aligned on every backend; copy if it ever is not.
+            match bytemuck::try_cast_slice::<u8, [f32; 3]>(&view) {
+                Ok(rows) => take(rows),
+                Err(_) => take(&bytemuck::pod_collect_to_vec::<u8, [f32; 3]>(&view)),
+            }
+        }
         staging.unmap();
-        Ok(bytes)
+        Ok(())
     }
+}
+
+/// `dst.copy_from_slice(src)` in pieces on every core.
+fn copy_rows(dst: &mut [[f32; 3]], src: &[[f32; 3]]) {
+    dst.par_chunks_mut(PIECE_ROWS)
+        .zip(src.par_chunks(PIECE_ROWS))
+        .for_each(|(d, s)| d.copy_from_slice(s));
 }
 
 impl GpuContext {

@@ -16,7 +16,7 @@ use std::sync::{Arc, Mutex};
 
 use crate::error::{LuxError, Result};
 pub use cache::CacheStatus;
-pub(crate) use dispatch::{GpuLights, Scratch};
+pub(crate) use dispatch::{GpuLights, Input, Scratch};
 pub(crate) use record::Params;
 pub(crate) use shaders::Kernel;
 

@@ -9,6 +9,8 @@ mod scene;
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use crate::error::{LuxError, Result};
 use crate::gpu::{AdapterSummary, CacheStatus, DeviceLimits, GpuContext, Startup};
 use crate::model::Light;
@@ -245,7 +247,10 @@ impl Evaluator {
 
 /// Every point must be finite.
 pub(crate) fn check_points(what: &str, points: &[[f32; 3]]) -> Result<()> {
-    if let Some(i) = points.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+    if let Some(i) = points
+        .par_iter()
+        .position_first(|p| p.iter().any(|c| !c.is_finite()))
+    {
         return Err(LuxError::input(
             what,
             format!("row {i} is not finite: {:?}", points[i]),
@@ -257,7 +262,10 @@ pub(crate) fn check_points(what: &str, points: &[[f32; 3]]) -> Result<()> {
 /// Every direction must be finite and non-zero (it is normalised before use).
 pub(crate) fn check_directions(what: &str, dirs: &[[f32; 3]]) -> Result<()> {
     check_points(what, dirs)?;
-    if let Some(i) = dirs.iter().position(|d| d.iter().all(|c| *c == 0.0)) {
+    if let Some(i) = dirs
+        .par_iter()
+        .position_first(|d| d.iter().all(|c| *c == 0.0))
+    {
         return Err(LuxError::input(
             what,
             format!("row {i} is the zero vector, which has no direction"),

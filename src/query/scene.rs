@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
-use crate::gpu::{GpuLights, Kernel, Scratch, dome_atlas, ies_atlas, record};
+use crate::gpu::{GpuLights, Input, Kernel, Scratch, dome_atlas, ies_atlas, record};
 use crate::model::Light;
 use crate::prepare::{self, Prepared, TemperatureMode};
 
@@ -246,23 +246,28 @@ impl PreparedScene {
                     .scratch
                     .lock()
                     .unwrap_or_else(std::sync::PoisonError::into_inner);
-                // Directions (and normals) are normalised here in f64, as the CPU reference
-                // normalises them: the kernels' f32 `normalize` overflows on components near
-                // 1e38 and loses subnormal ones (which a device may flush to zero).
-                match (kernel, b) {
-                    (Kernel::Emission, _) => {
-                        g.run(kernel, lights, &mut scratch, &unit_rows(a), b, per_light)
-                    }
-                    (_, Some(b)) => g.run(
-                        kernel,
-                        lights,
-                        &mut scratch,
-                        a,
-                        Some(&unit_rows(b)),
-                        per_light,
+                // Directions (and normals) are normalised in f64 as they are written to the
+                // device, as the CPU reference normalises them: the kernels' f32 `normalize`
+                // overflows on components near 1e38 and loses subnormal ones (which a device may
+                // flush to zero).
+                let unit = Input {
+                    rows: a,
+                    map: &unit_row,
+                };
+                let (a, b) = match (kernel, b) {
+                    (Kernel::Emission | Kernel::Intensity, _) => (unit, None),
+                    (_, b) => (
+                        Input {
+                            rows: a,
+                            map: &|r| r,
+                        },
+                        b.map(|rows| Input {
+                            rows,
+                            map: &unit_row,
+                        }),
                     ),
-                    (_, None) => g.run(kernel, lights, &mut scratch, a, b, per_light),
-                }
+                };
+                g.run(kernel, lights, &mut scratch, a, b, per_light)
             }
             // No lights: every row is zero.
             (Backend::Gpu(_), None) => {
@@ -273,18 +278,14 @@ impl PreparedScene {
     }
 }
 
-/// Rows scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The
+/// A row scaled to unit length in f64 (finite, non-zero rows: checked by the queries). The
 /// largest component is divided out first, so that neither 1e38 nor 1e-45 over- or underflows.
-fn unit_rows(rows: &[[f32; 3]]) -> Vec<[f32; 3]> {
-    rows.iter()
-        .map(|r| {
-            let d = DVec3::new(r[0] as f64, r[1] as f64, r[2] as f64);
-            let m = d.abs().max_element();
-            if m == 0.0 {
-                return *r;
-            }
-            let u = (d / m).normalize();
-            [u.x as f32, u.y as f32, u.z as f32]
-        })
-        .collect()
+fn unit_row(r: [f32; 3]) -> [f32; 3] {
+    let d = DVec3::new(r[0] as f64, r[1] as f64, r[2] as f64);
+    let m = d.abs().max_element();
+    if m == 0.0 {
+        return r;
+    }
+    let u = (d / m).normalize();
+    [u.x as f32, u.y as f32, u.z as f32]
 }

@@ -1,0 +1,137 @@
+#!/usr/bin/env bash
+# Issue 11 item 7: the benchmarks and the GPU test suite on a lent GPU (the `device` tool of the
+# developers' workplace; see BENCHMARKS.md "A real GPU"). Run there from the repository root as
+#     tools/lent_gpu.sh STEP...      (STEP: setup info tests resident cli bench)
+# with two carried folders, both ignored by git (.git/info/exclude):
+#   .gl/   the Vulkan loader's Debian packages (the machine has the NVIDIA driver, not the loader);
+#   .dev/  bins.tar.xz: x86-64 release binaries built here (luxeval, examples/resident and the
+#          GPU test binaries, `cargo test --release --no-run`), stripped; optionally
+#          luxeval_old, an earlier luxeval to compare with in the same run.
+# The test binaries were built in /work/main, so CARGO_MANIFEST_DIR and CARGO_BIN_EXE_luxeval
+# point there: /work/main is made a link to this copy. Every log goes to $OUT.
+set -u
+OUT=${OUT:-/tmp/lent-out}
+mkdir -p "$OUT"
+ROOT=$PWD
+TIMEFORMAT='%R s wall, %U s user, %S s sys'
+
+setup() {
+    for f in .gl/*.deb; do dpkg -x "$f" /; done
+    ldconfig
+    icd=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
+    [ -f "$icd" ] && echo "export VK_DRIVER_FILES=$icd" >> /tmp/lent-env
+    egl=/usr/local/nvidia/share/glvnd/egl_vendor.d/10_nvidia.json
+    [ -f "$egl" ] && echo "export __EGL_VENDOR_LIBRARY_FILENAMES=$egl" >> /tmp/lent-env
+    if [ "$ROOT" != /work/main ]; then mkdir -p /work && rm -rf /work/main && ln -s "$ROOT" /work/main; fi
+    mkdir -p target/release target/tmp /tmp/bins
+    tar xJf .dev/bins.tar.xz -C /tmp/bins
+    cp /tmp/bins/luxeval target/release/luxeval
+    # One receiver for the irradiance commands' start-up (the luxtest floor's centre, facing up).
+    python3 -c 'import numpy as np; np.save("/tmp/p1.npy", np.array([[0, 0, 0]], np.float32)); np.save("/tmp/n1.npy", np.array([[0, 1, 0]], np.float32))'
+    { nvidia-smi; nproc; free -g; cat /tmp/lent-env; } > "$OUT/machine.txt" 2>&1
+}
+
+info() {
+    target/release/luxeval info --json > "$OUT/info.json" 2>&1
+    target/release/luxeval info
+}
+
+tests() {
+    # CI=true: a GPU test fails, rather than skips, when no adapter is found.
+    for t in /tmp/bins/t_*; do
+        echo "=== ${t##*/t_}"
+        ( time CI=true timeout 240 "$t" --test-threads 8 2>&1 | tail -n 25 ) 2>&1
+    done > "$OUT/tests.log" 2>&1
+    grep -E '^(===|test result|real|.*FAILED|.*panicked)' "$OUT/tests.log" | head -n 80
+}
+
+resident() {
+    {
+        for args in "8 4000000 20 sum 10" "8 4000000 20 per-light 10" "1 16000000 20 sum 10" \
+            "1 16000000 20 per-light 10" "64 4000000 10 sum 4" "8 16000000 10 sum 4"; do
+            echo "=== resident $args"
+            /tmp/bins/resident $args 2>&1
+        done
+    } > "$OUT/resident.log" 2>&1
+    grep -E '^(===|emission)' "$OUT/resident.log"
+}
+
+cli() {
+    L=target/release/luxeval
+    floor="--origin -5,0,5 --u 10,0,0 --v 0,0,-10"
+    export LUXEVAL_CACHE_DIR=/tmp/lent-cache
+    rm -rf /tmp/lent-cache
+    {
+        for pass in "first (no cache file)" "second (cache file)"; do
+            echo "=== $pass"
+            echo "--- quick start"; time $L emission assets/studio.usda --dirs assets/dirs.npy -o /tmp/e.npy
+            echo "--- info"; time $L info > /dev/null
+            echo "--- irradiance rect one point"; time $L irradiance tests/data/luxtest/usd/rect.usda --time 31 --points /tmp/p1.npy --normals /tmp/n1.npy -o /tmp/i.npy
+            echo "--- irradiance studio one point"; time $L irradiance assets/studio.usda --points /tmp/p1.npy --normals /tmp/n1.npy -o /tmp/i.npy
+        done
+        ls -la /tmp/lent-cache
+        for scene in rect sphere; do
+            f=tests/data/luxtest/usd/$scene.usda
+            [ -f "$f" ] || { echo "no $f"; continue; }
+            for dev in gpu cpu; do
+                echo "--- falloff 128 $scene $dev"
+                time $L falloff "$f" --time 31 $floor --res 128,128 -o /tmp/m_$dev.exr --device $dev
+            done
+            echo "--- falloff 128 $scene cpu 1e-9"
+            time $L falloff "$f" --time 31 $floor --res 128,128 -o /tmp/m_ref.exr --device cpu --tolerance 1e-9
+        done
+        for dev in gpu cpu; do
+            echo "--- falloff 1024 rect $dev"
+            time $L falloff tests/data/luxtest/usd/rect.usda --time 31 $floor --res 1024,1024 -o /tmp/big_$dev.exr --device $dev
+        done
+        echo "--- check"; time $L check tests/data/luxtest/usd/rect.usda --time 31
+    } > "$OUT/cli.log" 2>&1
+    grep -E '^(===|---|[0-9.]+ s wall)' "$OUT/cli.log"
+}
+
+startup() {
+    # The irradiance command's start-up on a machine whose caches start empty: with neither the
+    # driver's shader cache nor luxeval's pipeline cache, with luxeval's alone, with the
+    # driver's alone (NVIDIA's is on by default; __GL_SHADER_DISK_CACHE=0 turns it off).
+    L=target/release/luxeval
+    cmd="irradiance tests/data/luxtest/usd/rect.usda --time 31 --points /tmp/p1.npy --normals /tmp/n1.npy -o /tmp/i.npy"
+    rm -rf /tmp/c1 ~/.cache/nvidia ~/.nv
+    {
+        for i in 1 2; do echo "--- no cache $i"; time env __GL_SHADER_DISK_CACHE=0 LUXEVAL_CACHE_DIR= $L $cmd; done
+        for i in 1 2; do echo "--- luxeval cache only $i"; time env __GL_SHADER_DISK_CACHE=0 LUXEVAL_CACHE_DIR=/tmp/c1 $L $cmd; done
+        ls -la /tmp/c1
+        for i in 1 2; do echo "--- driver cache only $i"; time env LUXEVAL_CACHE_DIR= $L $cmd; done
+        echo "--- quick start, luxeval cache"; time env LUXEVAL_CACHE_DIR=/tmp/c1 $L emission assets/studio.usda --dirs assets/dirs.npy -o /tmp/e.npy
+        echo "--- falloff 128 rect, luxeval cache"; time env LUXEVAL_CACHE_DIR=/tmp/c1 $L falloff tests/data/luxtest/usd/rect.usda --time 31 --origin -5,0,5 --u 10,0,0 --v 0,0,-10 --res 128,128 -o /tmp/m.exr
+        echo "--- falloff 128 sphere, luxeval cache"; time env LUXEVAL_CACHE_DIR=/tmp/c1 $L falloff tests/data/luxtest/usd/sphere.usda --time 31 --origin -5,0,5 --u 10,0,0 --v 0,0,-10 --res 128,128 -o /tmp/m.exr
+    } > "$OUT/startup.log" 2>&1
+    grep -E '^(---|[0-9.]+ s wall)' "$OUT/startup.log"
+}
+
+versus() {
+    # The host path before and after, alternating, in one run (luxeval_old: the earlier binary).
+    [ -x /tmp/bins/luxeval_old ] || { echo "no luxeval_old"; return; }
+    for i in 1 2; do
+        for b in luxeval_old luxeval; do
+            echo "=== $b $i"
+            /tmp/bins/$b bench --samples 4000000 --cpu-samples 4000000 --lights 8 --repeat 5 \
+                --no-dome --no-startup --json 2>/dev/null | python3 -c 'import json,sys; b=json.load(sys.stdin); [print(q["query"], q["device"], q["samples"], "%.4f s" % q["median_seconds"], "%.3e/s" % q["evals_per_second"]) for q in b["queries"]]; print("ratios", b["ratios"])'
+        done
+    done > "$OUT/versus.log" 2>&1
+    cat "$OUT/versus.log"
+}
+
+bench() {
+    ( time target/release/luxeval bench --samples 4000000 --cpu-samples 4000000 --lights 8 --repeat 3 \
+        --sweep --sweep-samples 1000,10000,100000,1000000,10000000 --sweep-lights 1,8,64 \
+        --json > "$OUT/bench.json" ) 2> "$OUT/bench.log"
+    tail -n 5 "$OUT/bench.log"
+    python3 -c 'import json,sys; json.dump(json.load(open(sys.argv[1])), sys.stdout, indent=1)' \
+        "$OUT/bench.json" | head -c 3000
+}
+
+for step in "$@"; do
+    [ -f /tmp/lent-env ] && . /tmp/lent-env
+    echo "##### $step"
+    time "$step"
+done
