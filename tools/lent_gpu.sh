@@ -39,6 +39,7 @@ info() {
 tests() {
     # CI=true: a GPU test fails, rather than skips, when no adapter is found.
     for t in /tmp/bins/t_*; do
+        case "${t##*/t_}" in ${SKIP_TESTS:-none}) echo "=== ${t##*/t_}: skipped this run"; continue ;; esac
         echo "=== ${t##*/t_}"
         ( time CI=true timeout 240 "$t" --test-threads 8 2>&1 | tail -n 25 ) 2>&1
     done > "$OUT/tests.log" 2>&1
@@ -119,6 +120,32 @@ versus() {
         done
     done > "$OUT/versus.log" 2>&1
     cat "$OUT/versus.log"
+}
+
+ceiling() {
+    # The card's two bounds, measured here (not datasheet figures): device memory bandwidth (a
+    # 2 GiB device-to-device copy, bytes read plus written) and PCIe each way (pinned host
+    # memory), through PyTorch's CUDA, which the machine's image holds.
+    python3 - <<'PY' 2>&1 | tee "$OUT/ceiling.log"
+import torch
+def timed(f, reps=20):
+    for _ in range(3): f()
+    torch.cuda.synchronize()
+    s, e = torch.cuda.Event(enable_timing=True), torch.cuda.Event(enable_timing=True)
+    s.record()
+    for _ in range(reps): f()
+    e.record(); torch.cuda.synchronize()
+    return s.elapsed_time(e) / reps / 1e3
+n = 1 << 29  # floats: 2 GiB
+x = torch.rand(n, device="cuda"); y = torch.empty_like(x)
+t = timed(lambda: y.copy_(x))
+print(f"device-to-device copy: {2 * 4 * n / t / 1e9:.0f} GB/s (read + write), {t * 1e3:.3f} ms")
+h = torch.rand(n // 4).pin_memory(); d = torch.empty(n // 4, device="cuda")
+t = timed(lambda: d.copy_(h, non_blocking=True))
+print(f"host-to-device (pinned): {4 * (n // 4) / t / 1e9:.1f} GB/s")
+t = timed(lambda: h.copy_(d, non_blocking=True))
+print(f"device-to-host (pinned): {4 * (n // 4) / t / 1e9:.1f} GB/s")
+PY
 }
 
 bench() {

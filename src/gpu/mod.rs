@@ -111,6 +111,9 @@ pub(crate) struct GpuContext {
     lost: Arc<Mutex<Option<String>>>,
     /// Whether the device is the caller's (`from_device`) rather than one luxeval opened.
     callers_device: bool,
+    /// A cap on the rows of one chunk, below what the limits allow: tests lower it to cut
+    /// small batches into many chunks (`usize::MAX` otherwise).
+    chunk_rows_cap: std::sync::atomic::AtomicUsize,
 }
 
 impl std::fmt::Debug for GpuContext {
@@ -275,6 +278,7 @@ impl GpuContext {
             startup: Mutex::new(startup),
             lost,
             callers_device: false,
+            chunk_rows_cap: std::sync::atomic::AtomicUsize::new(usize::MAX),
         }
     }
 
@@ -402,7 +406,17 @@ impl GpuContext {
         let by_input = budget / 12;
         let groups = self.limits.max_compute_workgroups_per_dimension as u64;
         let by_dispatch = groups * groups * record::WORKGROUP_SIZE as u64;
-        by_output.min(by_input).min(by_dispatch).max(1) as usize
+        let cap = self
+            .chunk_rows_cap
+            .load(std::sync::atomic::Ordering::Relaxed);
+        (by_output.min(by_input).min(by_dispatch).max(1) as usize).min(cap)
+    }
+
+    /// Caps the rows of one chunk (tests: many chunks from a small batch).
+    #[cfg(test)]
+    pub(crate) fn cap_chunk_rows(&self, rows: usize) {
+        self.chunk_rows_cap
+            .store(rows.max(1), std::sync::atomic::Ordering::Relaxed);
     }
 }
 

@@ -289,3 +289,64 @@ fn unit_row(r: [f32; 3]) -> [f32; 3] {
     let u = (d / m).normalize();
     [u.x as f32, u.y as f32, u.z as f32]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Accumulate, Backend, Evaluator};
+
+    /// A batch cut into many GPU chunks (the chunk size capped, the last chunk partial, the
+    /// first larger than one upload piece) gives the rows one chunk gives, summed and per light,
+    /// for one input (emission) and two (radiance).
+    #[test]
+    fn many_chunks_equal_one_chunk() {
+        let eval = match Evaluator::gpu() {
+            Ok(e) => e,
+            Err(e) if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") => {
+                panic!("CI=true but no GPU adapter: {e}")
+            }
+            Err(e) => return eprintln!("skipping GPU test: {e}"),
+        };
+        let Backend::Gpu(ctx) = &eval.backend else {
+            unreachable!("a GPU evaluator")
+        };
+        let scene = eval
+            .prepare(&crate::testkit::synthetic_lights(3))
+            .expect("the synthetic lights prepare");
+        let n = 300_007;
+        let dirs: Vec<[f32; 3]> = (0..n)
+            .map(|i| {
+                let t = i as f32 * 0.618_034;
+                [t.cos(), t.sin(), 1.0 - 2.0 * (i as f32 + 0.5) / n as f32]
+            })
+            .collect();
+        let points: Vec<[f32; 3]> = (0..n)
+            .map(|i| {
+                [
+                    (i % 17) as f32 - 8.0,
+                    (i % 5) as f32 * 0.5 - 1.0,
+                    (i % 11) as f32,
+                ]
+            })
+            .collect();
+        for acc in [Accumulate::Sum, Accumulate::PerLight] {
+            let emission = scene.emission(&dirs, acc).unwrap();
+            let radiance = scene.radiance(&points, &dirs, acc).unwrap();
+            // 131,077 rows a chunk: two chunks and a partial third, each of two upload pieces.
+            ctx.cap_chunk_rows((1 << 17) + 5);
+            assert!(
+                scene.emission(&dirs, acc).unwrap() == emission,
+                "{acc:?} emission"
+            );
+            assert!(
+                scene.radiance(&points, &dirs, acc).unwrap() == radiance,
+                "{acc:?} radiance"
+            );
+            ctx.cap_chunk_rows(usize::MAX);
+            assert_eq!(
+                emission.len(),
+                n * if acc == Accumulate::PerLight { 3 } else { 1 }
+            );
+            assert!(emission.iter().flatten().any(|&v| v > 0.0));
+        }
+    }
+}
