@@ -52,9 +52,8 @@ struct ScratchKey {
 /// small enough to spread a chunk over every core.
 const PIECE_ROWS: usize = 1 << 14;
 
-/// Rows per mapped view of the parallel upload (1.5 MiB): a view is `Send`, the pieces of one
-/// view are not, so each thread writes a view of its own; fewer and larger than the readback's
-/// pieces.
+/// Rows per staging view of the parallel upload (1.5 MiB): each view is a staging allocation of
+/// its own, so fewer and larger than the readback's pieces.
 const UPLOAD_PIECE_ROWS: usize = 1 << 17;
 
 /// One input of a batch: its rows and the map each row goes through on its way to the device
@@ -70,11 +69,6 @@ pub(crate) struct Scratch {
     key: ScratchKey,
     buf_a: wgpu::Buffer,
     buf_b: Option<wgpu::Buffer>,
-    /// Mappable upload buffers for `buf_a` and `buf_b`, kept between calls: wgpu's own
-    /// `write_buffer` staging is a new allocation of pinned host memory every call, which cost
-    /// more than the rest of the upload on an H100 (BENCHMARKS.md "A real GPU").
-    up_a: wgpu::Buffer,
-    up_b: Option<wgpu::Buffer>,
     buf_out: wgpu::Buffer,
     staging: wgpu::Buffer,
     params: wgpu::Buffer,
@@ -270,16 +264,6 @@ impl GpuContext {
             .two_inputs
             .then(|| storage("in_b", in_bytes, wgpu::BufferUsages::COPY_DST));
         let buf_out = storage("out", out_bytes, wgpu::BufferUsages::COPY_SRC);
-        let upload = |label| {
-            dev.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: in_bytes,
-                usage: wgpu::BufferUsages::MAP_WRITE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            })
-        };
-        let up_a = upload("upload_a");
-        let up_b = key.two_inputs.then(|| upload("upload_b"));
         let staging = dev.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size: out_bytes,
@@ -312,8 +296,6 @@ impl GpuContext {
             key,
             buf_a,
             buf_b,
-            up_a,
-            up_b,
             buf_out,
             staging,
             params,
@@ -340,14 +322,9 @@ impl GpuContext {
         let mut start = 0;
         while start < n {
             let count = s.key.chunk.min(n - start);
-            let mut uploads = vec![(&s.up_a, &s.buf_a, a)];
-            if let (Some(up), Some(buf), Some(b)) = (&s.up_b, &s.buf_b, b) {
-                uploads.push((up, buf, b));
-            }
-            let bytes = (count * 12) as u64;
-            self.map_for_writing(uploads.iter().map(|u| u.0), bytes)?;
-            for (up, _, input) in &uploads {
-                write_rows(up, *input, start..start + count)?;
+            self.write_rows(&s.buf_a, a, start..start + count)?;
+            if let (Some(buf), Some(b)) = (&s.buf_b, b) {
+                self.write_rows(buf, b, start..start + count)?;
             }
             let grid = self.grid(count as u32);
             let block = params_block(groups, align, count as u32, per_light, grid);
@@ -357,9 +334,6 @@ impl GpuContext {
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                     label: Some(kernel.entry_point()),
                 });
-            for (up, buf, _) in &uploads {
-                enc.copy_buffer_to_buffer(up, 0, buf, 0, bytes);
-            }
             record_passes(
                 &mut enc,
                 kernel,
@@ -385,32 +359,37 @@ impl GpuContext {
         Ok(())
     }
 
-    /// Maps the first `size` bytes of each of `buffers` for writing (they are idle: the last
-    /// chunk that read them has been waited for), and waits for the mappings.
-    fn map_for_writing<'b>(
+    /// Writes `input`'s rows `range`, mapped, to the start of `buffer`, in pieces on every core
+    /// (one staging view each: a view is `Send`, the pieces of one view are not).
+    fn write_rows(
         &self,
-        buffers: impl Iterator<Item = &'b wgpu::Buffer>,
-        size: u64,
+        buffer: &wgpu::Buffer,
+        input: Input<'_>,
+        range: std::ops::Range<usize>,
     ) -> Result<()> {
-        let receivers: Vec<_> = buffers
-            .map(|buffer| {
-                let (tx, rx) = std::sync::mpsc::channel();
-                buffer
-                    .slice(..size)
-                    .map_async(wgpu::MapMode::Write, move |r| {
-                        let _ = tx.send(r);
-                    });
-                rx
+        let rows = &input.rows[range];
+        let views = rows
+            .chunks(UPLOAD_PIECE_ROWS)
+            .enumerate()
+            .map(|(i, piece)| {
+                let offset = (i * UPLOAD_PIECE_ROWS * 12) as u64;
+                let size = wgpu::BufferSize::new((piece.len() * 12) as u64)?;
+                // None only on a validation failure, which the caller's error scope reports.
+                self.queue.write_buffer_with(buffer, offset, size)
             })
-            .collect();
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| LuxError::gpu("waiting for the device", e))?;
-        for rx in receivers {
-            rx.recv()
-                .map_err(|_| LuxError::gpu("mapping the input buffer", GpuFailure::Lost))?
-                .map_err(|e| LuxError::gpu("mapping the input buffer", e))?;
-        }
+            .collect::<Option<Vec<_>>>()
+            .ok_or_else(|| LuxError::gpu("staging the inputs", GpuFailure::Lost))?;
+        views
+            .into_par_iter()
+            .zip(rows.par_chunks(UPLOAD_PIECE_ROWS))
+            .for_each(|(mut view, piece)| {
+                let (slots, _) = view.slice(..).into_chunks::<12>();
+                slots.write_iter(
+                    piece
+                        .iter()
+                        .map(|&row| bytemuck::cast::<[f32; 3], [u8; 12]>((input.map)(row))),
+                );
+            });
         Ok(())
     }
 
@@ -445,40 +424,6 @@ impl GpuContext {
         staging.unmap();
         Ok(())
     }
-}
-
-/// Writes `input`'s rows `range`, mapped, to the start of `upload` (mapped for writing), in
-/// pieces on every core, and unmaps it.
-fn write_rows(
-    upload: &wgpu::Buffer,
-    input: Input<'_>,
-    range: std::ops::Range<usize>,
-) -> Result<()> {
-    let rows = &input.rows[range];
-    let views = rows
-        .chunks(UPLOAD_PIECE_ROWS)
-        .enumerate()
-        .map(|(i, piece)| {
-            let offset = (i * UPLOAD_PIECE_ROWS * 12) as u64;
-            upload.get_mapped_range_mut(offset..offset + (piece.len() * 12) as u64)
-        })
-        .collect::<std::result::Result<Vec<_>, _>>();
-    let written = views.map(|views| {
-        views
-            .into_par_iter()
-            .zip(rows.par_chunks(UPLOAD_PIECE_ROWS))
-            .for_each(|(mut view, piece)| {
-                let (slots, _) = view.slice(..).into_chunks::<12>();
-                slots.write_iter(
-                    piece
-                        .iter()
-                        .map(|&row| bytemuck::cast::<[f32; 3], [u8; 12]>((input.map)(row))),
-                );
-            })
-    });
-    // Unmapped either way, so that the next call can map it again.
-    upload.unmap();
-    written.map_err(|e| LuxError::gpu("writing the input buffer", e))
 }
 
 /// `dst.copy_from_slice(src)` in pieces on every core.
