@@ -7,6 +7,14 @@
 #   .dev/  bins.tar.xz: x86-64 release binaries built here (luxeval, examples/resident and the
 #          GPU test binaries, `cargo test --release --no-run`), stripped; optionally
 #          luxeval_old, an earlier luxeval to compare with in the same run.
+# Making .dev, here (release builds; --tests builds every test binary, --lib the unit tests):
+#     cargo test --release --ignore-rust-version --no-run --lib --tests 2>&1 | tee /tmp/b.log
+#     cargo build --release --ignore-rust-version --bins --example resident
+#     mkdir -p /tmp/stage && cp target/release/luxeval target/release/examples/resident /tmp/stage
+#     for f in $(grep Executable /tmp/b.log | awk '{print $NF}' | tr -d '()'); do
+#         cp "$f" /tmp/stage/t_$(basename "$f" | sed 's/-[0-9a-f]*$//'); done
+#     strip /tmp/stage/*; (cd /tmp/stage && tar cf - * | xz -9) > .dev/bins.tar.xz
+# and .gl with the README of the device tool (apt-get download libvulkan1 ... for amd64).
 # The test binaries were built in /work/main, so CARGO_MANIFEST_DIR and CARGO_BIN_EXE_luxeval
 # point there: /work/main is made a link to this copy. Every log goes to $OUT.
 set -u
