@@ -10,7 +10,7 @@
 //! adapter, or with LUXEVAL_A11_FULL=1, all 512 × 512.
 #![cfg(feature = "usd")]
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -10,7 +10,7 @@
 //! then one line in the `cases!` table below.
 #![cfg(feature = "cli")]
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::hash::{Hash, Hasher};

@@ -2,7 +2,7 @@
 //! codes and messages for bad input, and no partial output file after a failure.
 #![cfg(feature = "cli")]
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -6,7 +6,7 @@
 //! src/check.rs for exactly which samples it covers. The test prints its sample count, the
 //! excluded count and the largest errors.
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use luxeval::check;

@@ -2,7 +2,7 @@
 //! bitwise identical outputs, through the library and through the CLI; directions whose float32
 //! components are subnormal or near 1e38 give the CPU reference's answer on the GPU too.
 
-mod common;
+use crate::common;
 
 use luxeval::testkit::{Rng, synthetic_lights};
 use luxeval::{Accumulate, Evaluator};

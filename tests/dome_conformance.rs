@@ -11,7 +11,7 @@
 //! Texel values are linear in [0.21, 1] (8-bit sRGB 128..255), so a jump of one texel moves the
 //! bilinear value by at most ~5 × the f32 weight error, far below 1e-4.
 
-mod common;
+use crate::common;
 
 use glam::{DMat4, DVec3};
 use luxeval::testkit::Rng;

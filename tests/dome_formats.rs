@@ -5,7 +5,7 @@
 //! the GPU. A lookup that disagreed with the forward map of its format (a mirrored or rotated
 //! axis, a swapped face) would show another face's colour.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

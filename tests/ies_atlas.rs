@@ -1,5 +1,5 @@
 //! The packed f32 atlas and the CPU replay of ies.wgsl's reader against the f64 lookup.
-mod ies_common;
+use crate::ies_common;
 
 use glam::{DVec3, Vec3};
 use ies_common::*;

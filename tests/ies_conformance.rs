@@ -7,7 +7,7 @@
 //! reference's on the GPU path as well (the f32 quadrature does not split at a profile's angle
 //! nodes); the last test holds the GPU path to exactly that.
 
-mod common;
+use crate::common;
 
 use luxeval::check;
 use luxeval::testkit::ies::{SHAPES, with_random_ies};

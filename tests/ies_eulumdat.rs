@@ -1,6 +1,6 @@
 //! EULUMDAT: each Isym against hand values, the lamp flux rule, content detection whatever the
 //! extension, and malformed files with their line numbers.
-mod ies_common;
+use crate::ies_common;
 
 use ies_common::*;
 use luxeval::ies::Format;

@@ -1,7 +1,7 @@
 //! §6 I6: the exact mean intensity over the sphere. Worked values in closed form, and an
 //! independent check of `mean_intensity` by Gauss–Legendre quadrature of `ies_factor` over the
 //! whole sphere, for every type and symmetry.
-mod ies_common;
+use crate::ies_common;
 
 use std::f64::consts::PI;
 

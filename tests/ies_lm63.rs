@@ -1,6 +1,6 @@
 //! The LM-63 reader (DESIGN.md §6 I1): every header version, labels, TILT in all three forms,
 //! separators and line ends, and each malformed input with its line number.
-mod ies_common;
+use crate::ies_common;
 
 use ies_common::*;
 use luxeval::ies::IesErrorKind as K;

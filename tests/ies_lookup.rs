@@ -1,7 +1,7 @@
 //! The f64 lookup against hand values (DESIGN.md §6 I2–I4). Profiles linear in (H, V) are
 //! reproduced exactly by bilinear interpolation on any grid, so `I(H, V)` is known in closed form
 //! wherever the direction lands; a transposed or mirrored frame gives a different number.
-mod ies_common;
+use crate::ies_common;
 
 use glam::DVec3;
 use ies_common::*;

@@ -1,6 +1,6 @@
 //! The six luxtest profiles (reference/luxtest.md §6 A9; files copied byte-exact from
 //! pmolodo/luxtest, CC-BY-4.0, CRLF line ends).
-mod ies_common;
+use crate::ies_common;
 
 use glam::DVec3;
 use ies_common::*;

@@ -1,6 +1,6 @@
 //! Report numbers: peak, beam and field angles (profile.rs documents the definition), rated
 //! lumens against the integrated flux.
-mod ies_common;
+use crate::ies_common;
 
 use std::f64::consts::PI;
 

@@ -13,8 +13,6 @@
     clippy::too_many_arguments
 )]
 
-mod common;
-
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DMat3, DMat4, DQuat, DVec3};

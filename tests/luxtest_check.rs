@@ -6,7 +6,7 @@
 //! (`../dome_grid_2k.exr`). The test counts both.
 #![cfg(feature = "usd")]
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

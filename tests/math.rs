@@ -1,6 +1,6 @@
 //! The GPU's accurate atan2 (shaders/shared/math.wgsl) against f64, on lavapipe or any adapter:
 //! the shaping and distant-cone angles depend on it (WGSL's builtin only promises 4096 ULP).
-mod common;
+use crate::common;
 
 use luxeval::testkit::Rng;
 use luxeval::{Accumulate, Light, Reference, Shaping, TemperatureMode};

@@ -9,7 +9,7 @@
 //! and with the nearest filter within 1e-3 px of a texel edge (f32 may pick the neighbour).
 //! Both counted and printed. Texel values are linear in [0.21, 1] (8-bit sRGB 128..255).
 
-mod common;
+use crate::common;
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use luxeval::testkit::Rng;

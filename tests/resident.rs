@@ -4,7 +4,7 @@
 //! (`PreparedScene::emission` and the others) on the same lights and the same device: the same
 //! kernels run on the same inputs (up to the host path's f64 normalisation of unit vectors).
 
-mod common;
+use crate::common;
 
 use luxeval::testkit::{Rng, ies::with_random_ies, random_light, synthetic_lights};
 use luxeval::wgpu;

@@ -4,7 +4,7 @@
 //! no output (and an existing output untouched).
 #![cfg(feature = "cli")]
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

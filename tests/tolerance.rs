@@ -6,7 +6,7 @@
 //! tolerance below 1e-4 (its conformance bound).
 #![cfg(feature = "usd")]
 
-mod common;
+use crate::common;
 
 use glam::DVec3;
 use luxeval::falloff::{self, Plane};
