@@ -11,8 +11,12 @@
 //   (prepare::Prepared::irradiance_on_host gives the reasons): this f32 quadrature does not
 //   split at a profile's angle nodes as the reference's line integrals do, and misses lit
 //   features narrower than its nodes; a textured dome's exact integral splits at texel-centre
-//   lines (a textured rect's, texel lines on its surface). The pipeline is built with
-//   IES_ENABLED = false and DOME_ENABLED = false.
+//   lines (a textured rect's, texel lines on its surface). The pipeline is built without the
+//   optional parts IES and TEXTURE (gpu::shaders::Features).
+// Optional parts: the chart quadrature (CHART) and treatAsLine (LINE) are compiled in only for
+//   scenes with a light that may need them (gpu::record::Record::irradiance_parts, which
+//   follows this file's switch): on lavapipe the quadrature is nearly all of the pipeline's
+//   compile, and each call site of the line integral is a copy of it.
 // Structure (this file only): the sphere, rect, disk and cylinder cases choose their chart inside the
 //   switch and chart_integral is called once after it (the CPU calls it in each case). Every
 //   call site is inlined by the shader compiler, and one copy of the quadrature instead of four
@@ -90,7 +94,9 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         }
         case KIND_CYLINDER: {
             if has_flag(light, FLAG_TREAT_AS_POINT_OR_LINE) {
+                // #if LINE
                 e = line_irradiance(light, x, n);
+                // #endif
             } else {
                 chart = cylinder_chart(light, x);
                 use_chart = true;
@@ -98,9 +104,11 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         }
         default: {}
     }
+    // #if CHART
     if use_chart {
         e = base * chart_integral(light, chart, n);
     }
+    // #endif
     return e * light.irr.x;
 }
 

@@ -46,10 +46,12 @@ fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
     if !hit {
         return vec3<f32>(0.0);
     }
-    if DOME_ENABLED && has_flag(light, FLAG_RECT_TEXTURE) {
+    // #if TEXTURE
+    if has_flag(light, FLAG_RECT_TEXTURE) {
         // A textured rect: L(−ω) ⊙ tex(s, t) at the hit point, not the mean emission carries.
         return surface_emission(light, -w) * rect_factor(light, plane_hit(xl, dl).xy);
     }
+    // #endif
     return emission(light, -w);
 }
 

@@ -58,7 +58,10 @@ fn values_beyond_f32_are_refused() {
 #[test]
 fn wgsl_constants_are_generated_from_the_rust_codes() {
     // The prelude of every composed kernel carries them.
-    let s = luxeval::testkit::wgsl::compose(luxeval::testkit::wgsl::Kernel::Emission);
+    let s = luxeval::testkit::wgsl::compose(
+        luxeval::testkit::wgsl::Kernel::Emission,
+        luxeval::testkit::wgsl::Features::ALL,
+    );
     assert!(s.contains(&format!(
         "const IES_FOLD_FULL: u32 = {}u;",
         HFold::Full.code()

@@ -1,36 +1,118 @@
-//! Offline WGSL checks with naga (no GPU): every composed kernel parses and validates, and the
-//! GPU record layouts equal their Rust twins.
+//! Offline WGSL checks with naga (no GPU): every composed kernel, in every variant of its
+//! optional parts, parses and validates, and the GPU record layouts equal their Rust twins.
 
 use std::mem::{offset_of, size_of};
 
-use luxeval::testkit::wgsl::{IRR_GL_INNER, Kernel, Params, Record, SOURCES, compose};
+use luxeval::testkit::wgsl::{Features, IRR_GL_INNER, Kernel, Params, Record, SOURCES, compose};
 
-fn module(kernel: Kernel) -> naga::Module {
-    let src = compose(kernel);
-    naga::front::wgsl::parse_str(&src)
-        .unwrap_or_else(|e| panic!("{}:\n{}", kernel.file(), e.emit_to_string(&src)))
+fn module(kernel: Kernel, features: Features) -> naga::Module {
+    let src = compose(kernel, features);
+    naga::front::wgsl::parse_str(&src).unwrap_or_else(|e| {
+        panic!(
+            "{} {features:?}:\n{}",
+            kernel.file(),
+            e.emit_to_string(&src)
+        )
+    })
 }
 
 #[test]
 fn every_kernel_parses_and_validates() {
     for kernel in Kernel::ALL {
-        let m = module(kernel);
-        let info = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        )
-        .validate(&m)
-        .unwrap_or_else(|e| panic!("{}: {}", kernel.file(), e.emit_to_string(&compose(kernel))));
-        let _ = info;
-        assert!(
-            m.entry_points
-                .iter()
-                .any(|e| e.name == kernel.entry_point()),
-            "{} has no entry point {}",
-            kernel.file(),
-            kernel.entry_point()
+        for features in Features::variants(kernel) {
+            let m = module(kernel, features);
+            naga::valid::Validator::new(
+                naga::valid::ValidationFlags::all(),
+                naga::valid::Capabilities::default(),
+            )
+            .validate(&m)
+            .unwrap_or_else(|e| {
+                panic!(
+                    "{} {features:?}: {}",
+                    kernel.file(),
+                    e.emit_to_string(&compose(kernel, features))
+                )
+            });
+            assert!(
+                m.entry_points
+                    .iter()
+                    .any(|e| e.name == kernel.entry_point()),
+                "{} has no entry point {}",
+                kernel.file(),
+                kernel.entry_point()
+            );
+        }
+    }
+}
+
+/// Each kernel has the optional parts the pipelines select ([`Features`]), and a variant drops
+/// the code of a part that is off: the IES lookup and the texture lookups from emission and
+/// radiance, the chart quadrature and treatAsLine from irradiance.
+#[test]
+fn optional_parts_are_dropped_from_the_source() {
+    let used = |k| Features::used_by(k);
+    assert_eq!(
+        used(Kernel::Emission),
+        Features {
+            ies: true,
+            texture: true,
+            chart: false,
+            line: false
+        }
+    );
+    assert_eq!(
+        used(Kernel::Radiance),
+        Features {
+            ies: true,
+            texture: true,
+            chart: false,
+            line: false
+        }
+    );
+    // The irradiance kernel imports the IES lookup (through shaping) but no texture lookup.
+    assert_eq!(
+        used(Kernel::Irradiance),
+        Features {
+            ies: true,
+            texture: false,
+            chart: true,
+            line: true
+        }
+    );
+    assert_eq!(Features::variants(Kernel::Irradiance).len(), 8);
+    assert_eq!(Features::variants(Kernel::Emission).len(), 4);
+    let calls = |k, f, call: &str| {
+        compose(k, f)
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//") && l.contains(call))
+            .count()
+    };
+    let none = Features::default();
+    for k in [Kernel::Emission, Kernel::Radiance] {
+        assert!(calls(k, Features::ALL, "ies_factor(") >= 2, "{k:?}");
+        assert_eq!(
+            calls(k, none, "ies_factor("),
+            1,
+            "{k:?}: only its definition"
+        );
+        assert!(calls(k, Features::ALL, "dome_lookup(") >= 2, "{k:?}");
+        assert_eq!(
+            calls(k, none, "dome_lookup("),
+            1,
+            "{k:?}: only its definition"
         );
     }
+    let irr = Kernel::Irradiance;
+    // The definition and, with the part, its one call.
+    assert_eq!(calls(irr, Features::ALL, "chart_integral("), 2);
+    assert_eq!(calls(irr, none, "chart_integral("), 1);
+    assert_eq!(calls(irr, Features::ALL, "line_irradiance("), 2);
+    assert_eq!(calls(irr, none, "line_irradiance("), 1);
+    // Line numbers are kept: a variant has as many lines as the whole.
+    assert_eq!(
+        compose(irr, none).lines().count(),
+        compose(irr, Features::ALL).lines().count()
+    );
 }
 
 /// Offsets and sizes of a WGSL struct's members as naga lays them out for storage buffers.
@@ -59,7 +141,7 @@ fn wgsl_layout(m: &naga::Module, name: &str) -> (u32, u32, Vec<(String, u32)>) {
 
 #[test]
 fn record_layout_matches_naga() {
-    let m = module(Kernel::Radiance);
+    let m = module(Kernel::Radiance, Features::ALL);
     let (size, align, members) = wgsl_layout(&m, "Record");
     assert_eq!(size as usize, size_of::<Record>(), "struct size");
     assert_eq!(size_of::<Record>() % align as usize, 0, "array stride");
@@ -96,7 +178,7 @@ fn record_layout_matches_naga() {
 
 #[test]
 fn params_layout_matches_naga() {
-    let m = module(Kernel::Emission);
+    let m = module(Kernel::Emission, Features::ALL);
     let (size, _, members) = wgsl_layout(&m, "Params");
     assert_eq!(size as usize, size_of::<Params>());
     let rust = [
@@ -121,7 +203,7 @@ fn params_layout_matches_naga() {
 fn validation_rejects_a_type_error() {
     let src = format!(
         "{}\nfn broken() -> f32 {{ let x: f32 = 1u; return x; }}",
-        compose(Kernel::Emission)
+        compose(Kernel::Emission, Features::ALL)
     );
     assert!(naga::front::wgsl::parse_str(&src).is_err());
 }

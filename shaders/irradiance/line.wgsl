@@ -50,40 +50,64 @@ fn max3(v: vec3<f32>) -> f32 {
 // One span by halving until the halves agree with their parent to IRR_INNER_TOL (relative; the
 // integrand is ≥ 0) or IRR_INNER_DEPTH is reached, depth first (the CPU twin: Nodes::integrate
 // in src/cpu/irradiance.rs). A depth-first stack never holds more than depth + 1 entries.
+// Each pass of the loop applies the rule to one interval (the span, then the left and the right
+// half of the interval in hand), so that the rule, inlined with its ten shaping calls, is
+// compiled once rather than three times: on lavapipe those copies were half of the irradiance
+// pipeline's compile. The halves are compared and summed in the same order as before (and as
+// testkit::kernel_rule replays); the loop runs once per rule, 1 + 2 per halving, well inside
+// llvmpipe's loop budget (see GpuContext::lights_per_dispatch).
 fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap) -> vec3<f32> {
     var lo: array<f32, IRR_INNER_DEPTH + 1u>;
     var hi: array<f32, IRR_INNER_DEPTH + 1u>;
     var q: array<vec3<f32>, IRR_INNER_DEPTH + 1u>;
     var dep: array<u32, IRR_INNER_DEPTH + 1u>;
-    lo[0] = 0.0;
-    hi[0] = 1.0;
-    q[0] = inner_rule(light, n, a, e1, sp, 0.0, 1.0);
-    dep[0] = 0u;
-    var top = 1u;
+    var top = 0u;
     var sum = vec3<f32>(0.0);
-    while top > 0u {
-        top -= 1u;
-        let s0 = lo[top];
-        let s1 = hi[top];
-        let parent = q[top];
-        let d = dep[top];
-        let mid = 0.5 * (s0 + s1);
-        let ql = inner_rule(light, n, a, e1, sp, s0, mid);
-        let qr = inner_rule(light, n, a, e1, sp, mid, s1);
+    // The interval in hand [p0, p1] at depth d with its own rule's value `parent`; `step` says
+    // which rule this pass applies: 0 the whole span's, 1 the left half's, 2 the right half's.
+    var p0 = 0.0;
+    var p1 = 1.0;
+    var d = 0u;
+    var parent = vec3<f32>(0.0);
+    var ql = vec3<f32>(0.0);
+    var step = 0u;
+    loop {
+        let mid = 0.5 * (p0 + p1);
+        let r = inner_rule(light, n, a, e1, sp, select(p0, mid, step == 2u), select(p1, mid, step == 1u));
+        if step == 0u {
+            parent = r;
+            step = 1u;
+            continue;
+        }
+        if step == 1u {
+            ql = r;
+            step = 2u;
+            continue;
+        }
+        let qr = r;
         let fine = ql + qr;
         if d + 1u >= IRR_INNER_DEPTH || max3(abs(fine - parent)) <= IRR_INNER_TOL * max3(abs(fine)) {
             sum += fine;
+            if top == 0u {
+                break;
+            }
+            top -= 1u;
+            p0 = lo[top];
+            p1 = hi[top];
+            parent = q[top];
+            d = dep[top];
         } else {
+            // The right half waits on the stack; the left half is next.
             lo[top] = mid;
-            hi[top] = s1;
+            hi[top] = p1;
             q[top] = qr;
             dep[top] = d + 1u;
-            lo[top + 1u] = s0;
-            hi[top + 1u] = mid;
-            q[top + 1u] = ql;
-            dep[top + 1u] = d + 1u;
-            top += 2u;
+            top += 1u;
+            p1 = mid;
+            parent = ql;
+            d += 1u;
         }
+        step = 1u;
     }
     return sum;
 }

@@ -31,16 +31,15 @@
 // 4. dome_direction normalises in f32 (relative error ~1e-7); A_eff⁻¹ is rounded to f32 once.
 // 5. The texture's size and format come from the atlas header (tex_info reads it); the f64
 //    twin reads them from the image. The lookup has no loop (lavapipe's loop budget).
-// 6. DOME_ENABLED is a pipeline-overridable constant: kernels are built without the lookup
-//    (false) for scenes without a textured dome or rect, so their pipelines are unchanged.
+// 6. The lookups of dome_factor, rect_mean and rect_factor are the optional part TEXTURE
+//    (`// #if TEXTURE`, gpu::shaders::Features): kernels are built without them for scenes
+//    without a textured dome or rect, so their pipelines are unchanged.
 // 7. A rect's hit point is f32 (the ray–plane intersection), so (s, t) carries its rounding;
 //    its mean colour is computed in f64 by prepare and rounded once.
 // GPU-only TexInfo, FaceBasis: structs standing in for the Rust tuples.
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
-
-override DOME_ENABLED: bool = true;
 
 struct TexInfo {
     base: u32,
@@ -203,28 +202,34 @@ fn rect_texel(offset: u32, x: f32, y: f32, w: f32, h: f32, filt: u32) -> vec3<f3
 }
 
 // The texture factor of a dome record along the world direction e toward the environment: 1
-// without a texture (or in a pipeline built with DOME_ENABLED = false).
+// without a texture (or in a pipeline built without TEXTURE).
 fn dome_factor(light: Record, e: vec3<f32>) -> vec3<f32> {
-    if !DOME_ENABLED || !has_flag(light, FLAG_DOME_TEXTURE) {
-        return vec3<f32>(1.0);
+    // #if TEXTURE
+    if has_flag(light, FLAG_DOME_TEXTURE) {
+        let inv = mat3x3<f32>(light.tex_inv0.xyz, light.tex_inv1.xyz, light.tex_inv2.xyz);
+        return dome_lookup(light.tex.x, inv, e, light.tex.y);
     }
-    let inv = mat3x3<f32>(light.tex_inv0.xyz, light.tex_inv1.xyz, light.tex_inv2.xyz);
-    return dome_lookup(light.tex.x, inv, e, light.tex.y);
+    // #endif
+    return vec3<f32>(1.0);
 }
 
 // A rect record's texture factor for emission: the texture's exact area mean, rounded once
 // (tex_inv0.rgb, FLAG_RECT_TEXTURE); 1 without a texture.
 fn rect_mean(light: Record) -> vec3<f32> {
-    if !DOME_ENABLED || !has_flag(light, FLAG_RECT_TEXTURE) {
-        return vec3<f32>(1.0);
+    // #if TEXTURE
+    if has_flag(light, FLAG_RECT_TEXTURE) {
+        return light.tex_inv0.xyz;
     }
-    return light.tex_inv0.xyz;
+    // #endif
+    return vec3<f32>(1.0);
 }
 
 // A rect record's texture factor for radiance at the local hit point (x, y); 1 without one.
 fn rect_factor(light: Record, hit: vec2<f32>) -> vec3<f32> {
-    if !DOME_ENABLED || !has_flag(light, FLAG_RECT_TEXTURE) {
-        return vec3<f32>(1.0);
+    // #if TEXTURE
+    if has_flag(light, FLAG_RECT_TEXTURE) {
+        return rect_texel(light.tex.x, hit.x, hit.y, 2.0 * light.size.x, 2.0 * light.size.y, light.tex.y);
     }
-    return rect_texel(light.tex.x, hit.x, hit.y, 2.0 * light.size.x, 2.0 * light.size.y, light.tex.y);
+    // #endif
+    return vec3<f32>(1.0);
 }

@@ -27,10 +27,11 @@
 //    hi − lo > 1 and finds the same interval.
 // 5. Counts and offsets are read from f32 atlas values (u32(x)): exact because the packer refuses
 //    atlases of 2^24 floats or more.
-// 6. IES_ENABLED is a pipeline-overridable constant: each kernel is built without the lookup
-//    (false) for scenes with no profile, and the irradiance kernel always without it (it
-//    integrates no IES-shaped light, see shaders/irradiance.wgsl). Inlined at every shaping call
-//    of the irradiance quadrature, the lookup took lavapipe's compiler minutes.
+// 6. The lookup in ies_of is the optional part IES (`// #if IES`, gpu::shaders::Features): each
+//    kernel is built without it for scenes with no profile, and the irradiance kernel always
+//    without it (it integrates no IES-shaped light, see shaders/irradiance.wgsl). Inlined at
+//    every shaping call of the irradiance quadrature, the lookup took lavapipe's compiler
+//    minutes; left in but disabled by a pipeline-overridable constant, still 3 s.
 // GPU-only search_step: the CPU's loop body in find_interval, written out (divergence 4).
 // Not divergences (checked): at a frame's poles (both atan2 arguments zero) atan2_accurate gives
 // 0 and the CPU twin returns 0 explicitly (f64::atan2(0, −0) would be π); the folds 360 − H,
@@ -38,8 +39,6 @@
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
-
-override IES_ENABLED: bool = true;
 
 const IES_DEG_PER_RAD: f32 = 57.2957795130823;
 const IES_RAD_PER_DEG: f32 = 0.0174532925199433;
@@ -268,9 +267,11 @@ fn ies_factor(base: u32, e: vec3<f32>, s: f32) -> f32 {
 // The IES factor of a light record along unit world emission direction e (1 without FLAG_IES);
 // twin of cpu::ies::ies_of.
 fn ies_of(light: Record, e: vec3<f32>) -> f32 {
-    if !IES_ENABLED || !has_flag(light, FLAG_IES) {
-        return 1.0;
+    // #if IES
+    if has_flag(light, FLAG_IES) {
+        let el = normalize(to_local_dir(light, e));
+        return light.ies.z * ies_factor(u32(light.ies.x), el, light.ies.y);
     }
-    let el = normalize(to_local_dir(light, e));
-    return light.ies.z * ies_factor(u32(light.ies.x), el, light.ies.y);
+    // #endif
+    return 1.0;
 }

@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use crate::error::{GpuFailure, LuxError, Result};
 
 use super::record::{Params, Record, WORKGROUP_SIZE};
+use super::shaders::Features;
 use super::{GpuContext, Kernel};
 
 /// A prepared scene's light records, IES atlas and dome texture atlas on the device.
@@ -18,22 +19,22 @@ pub(crate) struct GpuLights {
     pub(super) ies_atlas: wgpu::Buffer,
     pub(super) tex_atlas: wgpu::Buffer,
     count: usize,
-    /// Whether any light has an IES profile (the pipelines with the lookup are needed).
-    has_ies: bool,
-    /// Whether any light has a dome or rect texture (the pipelines with the texture lookup are
-    /// needed).
-    has_dome: bool,
+    /// The optional kernel parts any of the lights needs (`Record::features`).
+    features: Features,
 }
 
 impl GpuLights {
-    /// The `(ies, dome)` pipeline variant `kernel` needs for these lights. The irradiance kernel
-    /// integrates no IES-shaped light or textured dome (the host does, see
-    /// prepare::Prepared::irradiance_on_host), so it never needs either lookup.
-    pub(super) fn variant(&self, kernel: Kernel) -> (bool, bool) {
-        (
-            self.has_ies && kernel != Kernel::Irradiance,
-            self.has_dome && kernel != Kernel::Irradiance,
-        )
+    /// The pipeline variant `kernel` needs for these lights: the optional parts of its source
+    /// that some light needs. The irradiance kernel integrates no IES-shaped or textured light
+    /// (the host does, see prepare::Prepared::irradiance_on_host), so it never needs either
+    /// lookup.
+    pub(super) fn variant(&self, kernel: Kernel) -> Features {
+        let mut f = self.features;
+        if kernel == Kernel::Irradiance {
+            f.ies = false;
+            f.texture = false;
+        }
+        f.restricted_to(Features::used_by(kernel))
     }
 }
 
@@ -173,12 +174,9 @@ impl GpuContext {
             ies_atlas: ies_atlas_buffer,
             tex_atlas: tex_atlas_buffer,
             count: records.len(),
-            has_ies: records
+            features: records
                 .iter()
-                .any(|r| r.flags & super::record::FLAG_IES != 0),
-            has_dome: records.iter().any(|r| {
-                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE) != 0
-            }),
+                .fold(Features::default(), |f, r| f.union(r.features())),
         }))
     }
 
@@ -201,8 +199,7 @@ impl GpuContext {
         if n == 0 || count == 0 {
             return Ok(out);
         }
-        let (ies, dome) = lights.variant(kernel);
-        let pipeline = self.pipeline(kernel, ies, dome)?;
+        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
         let capacity = self.chunk_capacity(count, per_light);
         let key = ScratchKey {
             chunk: n.next_power_of_two().min(capacity),

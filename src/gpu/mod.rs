@@ -18,7 +18,7 @@ use crate::error::{LuxError, Result};
 pub use cache::CacheStatus;
 pub(crate) use dispatch::{GpuLights, Input, Scratch};
 pub(crate) use record::Params;
-pub(crate) use shaders::Kernel;
+pub(crate) use shaders::{Features, Kernel};
 
 /// What `luxeval info` reports about an adapter.
 #[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
@@ -60,17 +60,13 @@ pub struct Startup {
     pub adapter: std::time::Duration,
     /// Opening the device.
     pub device: std::time::Duration,
-    /// Each pipeline compiled so far, in order, by name (kernel, with `+ies` / `+texture`).
+    /// Each pipeline compiled so far, in order, by name (the entry point, with the optional
+    /// parts it was built with: `+ies`, `+texture`, `+chart`, `+line`).
     pub pipelines: Vec<(String, std::time::Duration)>,
 }
 
-fn pipeline_name(kernel: Kernel, ies: bool, dome: bool) -> String {
-    format!(
-        "{}{}{}",
-        kernel.entry_point(),
-        if ies { "+ies" } else { "" },
-        if dome { "+texture" } else { "" }
-    )
+fn pipeline_name(kernel: Kernel, features: Features) -> String {
+    format!("{}{}", kernel.entry_point(), features.suffix())
 }
 
 /// Environment variable that picks an adapter by (case-insensitive) name substring.
@@ -100,7 +96,7 @@ pub(crate) struct GpuContext {
     pub(crate) limits: wgpu::Limits,
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<(Kernel, bool, bool), wgpu::ComputePipeline>>,
+    pipelines: Mutex<HashMap<(Kernel, Features), wgpu::ComputePipeline>>,
     /// The persistent pipeline cache and its file (gpu/cache.rs), where the adapter has one.
     cache: Option<(wgpu::PipelineCache, std::path::PathBuf)>,
     cache_status: CacheStatus,
@@ -282,21 +278,19 @@ impl GpuContext {
         }
     }
 
-    /// The pipeline of `kernel`, compiled on first use; `ies` selects the variant with the IES
-    /// lookup (the WGSL override `IES_ENABLED`, see the header of shared/ies.wgsl), needed only
-    /// when the scene has a profile; `dome` the variant with the dome texture lookup
-    /// (`DOME_ENABLED`, see the header of shared/dome.wgsl), needed only when the scene has a
-    /// textured dome (kernels that do not import shared/dome.wgsl ignore it).
-    pub fn pipeline(&self, kernel: Kernel, ies: bool, dome: bool) -> Result<wgpu::ComputePipeline> {
+    /// The pipeline of `kernel` with the optional parts `features` (see gpu::shaders::Features:
+    /// the IES lookup, the texture lookups, the irradiance chart quadrature and treatAsLine),
+    /// compiled on first use. Parts the kernel's source lacks are ignored.
+    pub fn pipeline(&self, kernel: Kernel, features: Features) -> Result<wgpu::ComputePipeline> {
+        let features = features.restricted_to(Features::used_by(kernel));
         let mut cache = self
             .pipelines
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        let source = shaders::compose(kernel);
-        let dome = dome && source.contains("override DOME_ENABLED");
-        if let Some(p) = cache.get(&(kernel, ies, dome)) {
+        if let Some(p) = cache.get(&(kernel, features)) {
             return Ok(p.clone());
         }
+        let source = shaders::compose(kernel, features);
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = self
             .device
@@ -304,10 +298,6 @@ impl GpuContext {
                 label: Some(kernel.file()),
                 source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
             });
-        let mut constants = vec![("IES_ENABLED", if ies { 1.0 } else { 0.0 })];
-        if source.contains("override DOME_ENABLED") {
-            constants.push(("DOME_ENABLED", if dome { 1.0 } else { 0.0 }));
-        }
         let t0 = std::time::Instant::now();
         let pipeline = self
             .device
@@ -316,10 +306,7 @@ impl GpuContext {
                 layout: Some(&self.pipeline_layout),
                 module: &module,
                 entry_point: Some(kernel.entry_point()),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &constants,
-                    ..Default::default()
-                },
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
                 cache: self.cache.as_ref().map(|(c, _)| c),
             });
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -337,8 +324,8 @@ impl GpuContext {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
             .pipelines
-            .push((pipeline_name(kernel, ies, dome), took));
-        cache.insert((kernel, ies, dome), pipeline.clone());
+            .push((pipeline_name(kernel, features), took));
+        cache.insert((kernel, features), pipeline.clone());
         Ok(pipeline)
     }
 

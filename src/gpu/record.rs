@@ -5,6 +5,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use super::shaders::Features;
 use crate::model::LightType;
 use crate::prepare::{Kink, Prepared};
 
@@ -99,6 +100,39 @@ pub struct Record {
     pub kind: u32,
     pub flags: u32,
     pub pad: [u32; 2],
+}
+
+impl Record {
+    /// The optional parts of the kernels this light needs (gpu::shaders::Features): IES and
+    /// TEXTURE from its flags; CHART and LINE by the switch of shaders/irradiance.wgsl, case by
+    /// case (a rect or disk takes the chart at some receivers and a closed form at others: it
+    /// counts as needing the chart). A light the host integrates needs neither.
+    pub fn features(&self) -> Features {
+        let has = |f: u32| self.flags & f != 0;
+        let (chart, line) = if has(FLAG_HOST_IRRADIANCE) {
+            (false, false)
+        } else {
+            match self.kind {
+                KIND_SPHERE => (
+                    !has(FLAG_TREAT_AS_POINT_OR_LINE)
+                        && (has(FLAG_SHAPING) || !has(FLAG_SIMILARITY)),
+                    false,
+                ),
+                KIND_RECT | KIND_DISK => (true, false),
+                KIND_CYLINDER => (
+                    !has(FLAG_TREAT_AS_POINT_OR_LINE),
+                    has(FLAG_TREAT_AS_POINT_OR_LINE),
+                ),
+                _ => (false, false),
+            }
+        };
+        Features {
+            ies: has(FLAG_IES),
+            texture: has(FLAG_DOME_TEXTURE | FLAG_RECT_TEXTURE),
+            chart,
+            line,
+        }
+    }
 }
 
 /// The kernel-side parameters of one dispatch (`Params` in `shaders/shared/record.wgsl`).

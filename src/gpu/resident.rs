@@ -151,8 +151,7 @@ impl GpuContext {
         } else {
             self.light_groups(kernel, n_lights)
         };
-        let (ies, dome) = lights.variant(kernel);
-        let pipeline = self.pipeline(kernel, ies, dome)?;
+        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
 
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         // One Params block per light group at the uniform offset alignment; a buffer of this

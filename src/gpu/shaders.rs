@@ -4,8 +4,16 @@
 //! atlas codes ([`super::ies_atlas::wgsl_constants`]), the dome texture codes
 //! ([`super::dome_atlas::wgsl_constants`]) and the
 //! quadrature rules and tuning constants of [`crate::rules`]. No constant is retyped in WGSL.
+//!
+//! Optional parts of a kernel sit between `// #if NAME` and `// #endif` lines ([`Features`]);
+//! the composer drops them from a pipeline that does not need them. Removing them from the
+//! source matters on lavapipe: Mesa inlines every call before it removes dead branches, and a
+//! branch disabled by a pipeline-overridable constant still cost its compile there (the IES
+//! lookup, dead at the irradiance quadrature's 60 shaping calls, took 3 of the irradiance
+//! pipeline's 5 seconds).
 
 use std::collections::HashSet;
+use std::sync::OnceLock;
 
 use super::record::WGSL_CONSTANTS;
 use super::{dome_atlas, ies_atlas};
@@ -88,7 +96,6 @@ pub enum Kernel {
 
 impl Kernel {
     /// Every kernel (tests/wgsl.rs validates each, through the `testkit` feature).
-    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
     pub const ALL: [Kernel; 4] = [
         Kernel::Emission,
         Kernel::Radiance,
@@ -112,6 +119,117 @@ impl Kernel {
             Kernel::Irradiance => "irradiance_main",
             Kernel::Intensity => "intensity_main",
         }
+    }
+}
+
+/// The optional parts of the kernels, each compiled in only where a scene needs it: the WGSL
+/// between `// #if NAME` and `// #endif` (NAME one of [`Features::NAMES`]) is kept when the
+/// feature is on and dropped when it is off. [`compose_file`] keeps every part.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct Features {
+    /// `IES`: the IES profile lookup (shared/ies.wgsl), for scenes with a profile.
+    pub ies: bool,
+    /// `TEXTURE`: the dome and rect texture lookups (shared/dome.wgsl), for scenes with one.
+    pub texture: bool,
+    /// `CHART`: the irradiance chart quadrature (irradiance/outer.wgsl), for the lights
+    /// [`super::record::Record::irradiance_parts`] says need it.
+    pub chart: bool,
+    /// `LINE`: the irradiance of a treatAsLine cylinder (a line integral of its own).
+    pub line: bool,
+}
+
+impl Features {
+    /// The names of `// #if` blocks, in the order of the fields.
+    pub const NAMES: [&'static str; 4] = ["IES", "TEXTURE", "CHART", "LINE"];
+
+    /// Every part on.
+    pub const ALL: Features = Features {
+        ies: true,
+        texture: true,
+        chart: true,
+        line: true,
+    };
+
+    fn get(self, name: &str) -> Option<bool> {
+        Some(match name {
+            "IES" => self.ies,
+            "TEXTURE" => self.texture,
+            "CHART" => self.chart,
+            "LINE" => self.line,
+            _ => return None,
+        })
+    }
+
+    /// Each combination of the parts `kernel`'s source has (tests/wgsl.rs validates each).
+    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
+    pub fn variants(kernel: Kernel) -> Vec<Features> {
+        let used = Features::used_by(kernel);
+        (0..16u32)
+            .map(|bits| Features {
+                ies: bits & 1 != 0,
+                texture: bits & 2 != 0,
+                chart: bits & 4 != 0,
+                line: bits & 8 != 0,
+            })
+            .filter(|f| f.restricted_to(used) == *f)
+            .collect()
+    }
+
+    /// The parts whose `// #if` blocks occur in `kernel`'s composed source (found once).
+    pub fn used_by(kernel: Kernel) -> Features {
+        static USED: OnceLock<Vec<(Kernel, Features)>> = OnceLock::new();
+        let used = USED.get_or_init(|| {
+            Kernel::ALL
+                .iter()
+                .map(|k| {
+                    let src = compose_file(k.file()).unwrap_or_default();
+                    let has = |name: &str| {
+                        src.lines()
+                            .any(|l| l.trim().strip_prefix("// #if ").map(str::trim) == Some(name))
+                    };
+                    let f = Features {
+                        ies: has("IES"),
+                        texture: has("TEXTURE"),
+                        chart: has("CHART"),
+                        line: has("LINE"),
+                    };
+                    (*k, f)
+                })
+                .collect()
+        });
+        used.iter()
+            .find(|(k, _)| *k == kernel)
+            .map(|(_, f)| *f)
+            .unwrap_or_default()
+    }
+
+    /// The parts either needs.
+    pub fn union(self, o: Features) -> Features {
+        Features {
+            ies: self.ies || o.ies,
+            texture: self.texture || o.texture,
+            chart: self.chart || o.chart,
+            line: self.line || o.line,
+        }
+    }
+
+    /// These features less those `used` lacks (a pipeline is keyed by the parts it has).
+    pub fn restricted_to(self, used: Features) -> Features {
+        Features {
+            ies: self.ies && used.ies,
+            texture: self.texture && used.texture,
+            chart: self.chart && used.chart,
+            line: self.line && used.line,
+        }
+    }
+
+    /// `+ies+texture+chart+line`, the parts that are on ("" for none).
+    pub fn suffix(self) -> String {
+        Features::NAMES
+            .iter()
+            .filter(|n| self.get(n) == Some(true))
+            .map(|n| format!("+{}", n.to_lowercase()))
+            .collect()
     }
 }
 
@@ -163,9 +281,35 @@ fn f32_literal(v: f64) -> String {
     format!("{f:?}")
 }
 
-/// The complete WGSL module for `kernel`.
-pub fn compose(kernel: Kernel) -> String {
-    compose_file(kernel.file()).unwrap_or_default()
+/// The complete WGSL module for `kernel` with the optional parts `features` selects.
+pub fn compose(kernel: Kernel, features: Features) -> String {
+    select(&compose_file(kernel.file()).unwrap_or_default(), features)
+}
+
+/// `src` without the `// #if NAME` … `// #endif` blocks whose feature is off (blocks nest). The
+/// markers and the dropped lines become empty lines, so that naga's line numbers are those of
+/// [`compose_file`]. An unknown name or an unbalanced marker is a bug in the shaders, which
+/// tests/wgsl.rs catches by composing every variant.
+fn select(src: &str, features: Features) -> String {
+    let mut out = String::with_capacity(src.len());
+    // One entry per open block: whether it is kept.
+    let mut open: Vec<bool> = Vec::new();
+    for line in src.lines() {
+        let t = line.trim();
+        if let Some(name) = t.strip_prefix("// #if ") {
+            let on = features
+                .get(name.trim())
+                .unwrap_or_else(|| panic!("unknown WGSL feature in `{t}`"));
+            open.push(on);
+        } else if t == "// #endif" {
+            assert!(open.pop().is_some(), "`// #endif` without `// #if`");
+        } else if open.iter().all(|on| *on) {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    assert!(open.is_empty(), "`// #if` without `// #endif`");
+    out
 }
 
 /// The prelude, the modules `path` imports and `path` itself: a module naga can parse on its

@@ -21,6 +21,6 @@ pub use samples::{emission_samples, irradiance_samples, radiance_samples};
 /// and `tests/twins.rs`.
 pub mod wgsl {
     pub use crate::gpu::record::{Params, Record};
-    pub use crate::gpu::shaders::{Kernel, SOURCES, compose, compose_file};
+    pub use crate::gpu::shaders::{Features, Kernel, SOURCES, compose, compose_file};
     pub use crate::rules::IRR_GL_INNER;
 }
