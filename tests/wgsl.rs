@@ -108,6 +108,9 @@ fn optional_parts_are_dropped_from_the_source() {
     assert_eq!(calls(irr, none, "chart_integral("), 1);
     assert_eq!(calls(irr, Features::ALL, "line_irradiance("), 2);
     assert_eq!(calls(irr, none, "line_irradiance("), 1);
+    // The inner rule (ten shaping calls written out) is applied from one place: each call site
+    // is a copy for Mesa's compiler (shaders/irradiance/line.wgsl, inner_adaptive).
+    assert_eq!(calls(irr, Features::ALL, "inner_rule("), 2);
     // Line numbers are kept: a variant has as many lines as the whole.
     assert_eq!(
         compose(irr, none).lines().count(),

@@ -143,6 +143,7 @@ impl Features {
     pub const NAMES: [&'static str; 4] = ["IES", "TEXTURE", "CHART", "LINE"];
 
     /// Every part on.
+    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
     pub const ALL: Features = Features {
         ies: true,
         texture: true,
