@@ -249,6 +249,78 @@ fn irradiance_matches_cpu_on_every_type_and_transform() {
     );
 }
 
+/// Each light alone: the GPU builds the irradiance pipeline with only the parts the scene's
+/// lights need (the chart quadrature, treatAsLine: gpu::shaders::Features, chosen by
+/// `Record::features`), so a light in a scene of its own must find every part it takes. One
+/// light of each type, shaped and not, and a treatAsPoint sphere and a treatAsLine cylinder,
+/// each within check::TOLERANCE of the CPU at receivers where the CPU's value is not zero.
+#[test]
+fn irradiance_of_each_light_alone_matches_cpu() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(0x0A10_4E11);
+    let xf = TRANSFORMS[TRANSFORMS.len() - 1];
+    let mut lights = Vec::new();
+    for ty in 0..6 {
+        for shaped in [false, true] {
+            let mut l = random_light(ty, xf, &mut rng, 2000 + 2 * ty + usize::from(shaped));
+            // The flags random_light draws by chance are set below, one light each.
+            l.kind = match l.kind {
+                LightType::Sphere { radius, .. } => LightType::Sphere {
+                    radius,
+                    treat_as_point: false,
+                },
+                LightType::Cylinder { length, radius, .. } => LightType::Cylinder {
+                    length,
+                    radius,
+                    treat_as_line: false,
+                },
+                k => k,
+            };
+            if !shaped {
+                l.shaping = None;
+            }
+            lights.push(l);
+        }
+    }
+    let mut p = random_light(1, xf, &mut rng, 2100);
+    p.kind = LightType::Sphere {
+        radius: 0.3,
+        treat_as_point: true,
+    };
+    let mut c = random_light(4, xf, &mut rng, 2101);
+    c.kind = LightType::Cylinder {
+        length: 1.5,
+        radius: 0.2,
+        treat_as_line: true,
+    };
+    lights.extend([p, c]);
+    let counts = check::Samples {
+        emission: 0,
+        intensity: 0,
+        radiance: 0,
+        irradiance: 40,
+    };
+    for (i, light) in lights.iter().enumerate() {
+        let prepared = references(std::slice::from_ref(light), TemperatureMode::Spec);
+        let report =
+            check::check_with(&gpu, &prepared, counts, 100 + i as u64).expect("GPU check runs");
+        let row = &report.rows[0];
+        assert!(
+            row.nonzero > 0,
+            "light {i} ({}): no receiver with a non-zero value",
+            row.light_type
+        );
+        assert!(
+            row.pass,
+            "light {i} ({}) alone: {:e} over tolerance {}; worst {:?}",
+            row.light_type,
+            row.max_rel_error,
+            check::TOLERANCE,
+            row.worst
+        );
+    }
+}
+
 /// Irradiance through the public Evaluator on both backends, many lights at once: the GPU sum
 /// equals the CPU sum, and per-light rows add up to the summed rows.
 #[test]
