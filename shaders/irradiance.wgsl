@@ -14,7 +14,7 @@
 //   lines (a textured rect's, texel lines on its surface). The pipeline is built without the
 //   optional parts IES and TEXTURE (gpu::shaders::Features).
 // Optional parts: the chart quadrature (CHART) and treatAsLine (LINE) are compiled in only for
-//   scenes with a light that may need them (gpu::record::Record::irradiance_parts, which
+//   scenes with a light that may need them (gpu::record::Record::features, which
 //   follows this file's switch): on lavapipe the quadrature is nearly all of the pipeline's
 //   compile, and each call site of the line integral is a copy of it.
 // Structure (this file only): the sphere, rect, disk and cylinder cases choose their chart inside the

@@ -50,28 +50,18 @@ fn every_kernel_parses_and_validates() {
 /// radiance, the chart quadrature and treatAsLine from irradiance.
 #[test]
 fn optional_parts_are_dropped_from_the_source() {
-    let used = |k| Features::used_by(k);
-    assert_eq!(
-        used(Kernel::Emission),
-        Features {
-            ies: true,
-            texture: true,
-            chart: false,
-            line: false
-        }
-    );
-    assert_eq!(
-        used(Kernel::Radiance),
-        Features {
-            ies: true,
-            texture: true,
-            chart: false,
-            line: false
-        }
-    );
+    let lookups = Features {
+        ies: true,
+        texture: true,
+        chart: false,
+        line: false,
+    };
+    for k in [Kernel::Emission, Kernel::Radiance] {
+        assert_eq!(Features::used_by(k), lookups, "{k:?}");
+    }
     // The irradiance kernel imports the IES lookup (through shaping) but no texture lookup.
     assert_eq!(
-        used(Kernel::Irradiance),
+        Features::used_by(Kernel::Irradiance),
         Features {
             ies: true,
             texture: false,

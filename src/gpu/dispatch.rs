@@ -24,17 +24,17 @@ pub(crate) struct GpuLights {
 }
 
 impl GpuLights {
-    /// The pipeline variant `kernel` needs for these lights: the optional parts of its source
-    /// that some light needs. The irradiance kernel integrates no IES-shaped or textured light
-    /// (the host does, see prepare::Prepared::irradiance_on_host), so it never needs either
-    /// lookup.
+    /// The pipeline variant `kernel` needs for these lights: the optional parts some light
+    /// needs (`GpuContext::pipeline` drops those the kernel's source lacks). The irradiance
+    /// kernel integrates no IES-shaped or textured light (the host does, see
+    /// prepare::Prepared::irradiance_on_host), so it never needs either lookup.
     pub(super) fn variant(&self, kernel: Kernel) -> Features {
         let mut f = self.features;
         if kernel == Kernel::Irradiance {
             f.ies = false;
             f.texture = false;
         }
-        f.restricted_to(Features::used_by(kernel))
+        f
     }
 }
 

@@ -132,7 +132,7 @@ pub struct Features {
     /// `TEXTURE`: the dome and rect texture lookups (shared/dome.wgsl), for scenes with one.
     pub texture: bool,
     /// `CHART`: the irradiance chart quadrature (irradiance/outer.wgsl), for the lights
-    /// [`super::record::Record::irradiance_parts`] says need it.
+    /// [`super::record::Record::features`] says need it.
     pub chart: bool,
     /// `LINE`: the irradiance of a treatAsLine cylinder (a line integral of its own).
     pub line: bool,
@@ -151,6 +151,7 @@ impl Features {
         line: true,
     };
 
+    /// Whether the part `name` is on (None for a name that is not one of [`Features::NAMES`]).
     fn get(self, name: &str) -> Option<bool> {
         Some(match name {
             "IES" => self.ies,
@@ -161,16 +162,27 @@ impl Features {
         })
     }
 
+    /// Each part on where `on(NAME)` says so: with [`Features::get`], the only places that
+    /// spell the fields out.
+    fn from_fn(on: impl Fn(&str) -> bool) -> Features {
+        Features {
+            ies: on("IES"),
+            texture: on("TEXTURE"),
+            chart: on("CHART"),
+            line: on("LINE"),
+        }
+    }
+
     /// Each combination of the parts `kernel`'s source has (tests/wgsl.rs validates each).
     #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
     pub fn variants(kernel: Kernel) -> Vec<Features> {
         let used = Features::used_by(kernel);
-        (0..16u32)
-            .map(|bits| Features {
-                ies: bits & 1 != 0,
-                texture: bits & 2 != 0,
-                chart: bits & 4 != 0,
-                line: bits & 8 != 0,
+        (0..1u32 << Features::NAMES.len())
+            .map(|bits| {
+                Features::from_fn(|name| {
+                    let i = Features::NAMES.iter().position(|n| *n == name);
+                    i.is_some_and(|i| bits & (1 << i) != 0)
+                })
             })
             .filter(|f| f.restricted_to(used) == *f)
             .collect()
@@ -184,16 +196,10 @@ impl Features {
                 .iter()
                 .map(|k| {
                     let src = compose_file(k.file()).unwrap_or_default();
-                    let has = |name: &str| {
+                    let f = Features::from_fn(|name| {
                         src.lines()
                             .any(|l| l.trim().strip_prefix("// #if ").map(str::trim) == Some(name))
-                    };
-                    let f = Features {
-                        ies: has("IES"),
-                        texture: has("TEXTURE"),
-                        chart: has("CHART"),
-                        line: has("LINE"),
-                    };
+                    });
                     (*k, f)
                 })
                 .collect()
@@ -206,22 +212,12 @@ impl Features {
 
     /// The parts either needs.
     pub fn union(self, o: Features) -> Features {
-        Features {
-            ies: self.ies || o.ies,
-            texture: self.texture || o.texture,
-            chart: self.chart || o.chart,
-            line: self.line || o.line,
-        }
+        Features::from_fn(|n| self.get(n) == Some(true) || o.get(n) == Some(true))
     }
 
     /// These features less those `used` lacks (a pipeline is keyed by the parts it has).
     pub fn restricted_to(self, used: Features) -> Features {
-        Features {
-            ies: self.ies && used.ies,
-            texture: self.texture && used.texture,
-            chart: self.chart && used.chart,
-            line: self.line && used.line,
-        }
+        Features::from_fn(|n| self.get(n) == Some(true) && used.get(n) == Some(true))
     }
 
     /// `+ies+texture+chart+line`, the parts that are on ("" for none).
