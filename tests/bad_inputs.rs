@@ -337,6 +337,9 @@ cases! {
     check_samples_1e12: Case { args: &["check", "{in}/ok.usda", "--samples", "1000000000000"], exit: 2, says: &["--samples", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
     bench_samples_1e12: Case { args: &["bench", "--samples", "1000000000000"], exit: 2, says: &["--samples", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
     bench_lights_1e12: Case { args: &["bench", "--lights", "1000000000000"], exit: 2, says: &["--lights", "LUXEVAL_MAX_PRIMS"], ..Case::default() };
+    bench_command_sets_device: Case { args: &["bench", "--no-startup", "--no-dome", "--command", "falloff {in}/ok.usda --device cpu"], exit: 2, says: &["--command", "--device"], ..Case::default() };
+    bench_command_empty: Case { args: &["bench", "--no-startup", "--no-dome", "--command", "  "], exit: 2, says: &["--command"], ..Case::default() };
+    bench_command_bad_scene: Case { args: &["bench", "--no-startup", "--no-dome", "--samples", "8", "--cpu-samples", "8", "--lights", "1", "--command", "emission {in}/missing.usda --dirs {in}/dirs.npy -o {out}/out.npy"], exit: 2, says: &["--command", "missing.usda"], ..Case::default() };
     falloff_res_1e10_pixels: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "100000,100000", "-o", "{out}/m.exr", "--device", "cpu"], exit: 2, says: &["--res", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
     dirs_link_to_dev_zero: Case { args: emission!("{in}/ok.usda", "{in}/zero.npy"), exit: 2, says: &["zero.npy"], setup: Some(zero_dirs), ..Case::default() };
     scene_link_to_dev_zero: Case { args: emission!("{in}/zero.usda", "{in}/dirs.npy"), exit: 2, says: &["zero.usda", "not a regular file"], setup: Some(zero_scene), ..Case::default() };

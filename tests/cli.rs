@@ -298,6 +298,65 @@ fn help_explains_every_subcommand() {
     }
 }
 
+/// `bench --command` runs the command line as a child on each device (the GPU's only where an
+/// adapter exists), last on the CPU: its output is then the CPU path's, and the report holds a
+/// row per device with one wall time per run and the child's peak RSS.
+#[test]
+fn bench_command_times_the_command_on_each_device() {
+    let gpu = common::gpu().is_some();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e.npy");
+    let command = format!(
+        "emission {} --dirs {} -o {}",
+        asset("studio.usda"),
+        asset("dirs.npy"),
+        out.display()
+    );
+    let o = luxeval(&[
+        "bench",
+        "--samples",
+        "64",
+        "--cpu-samples",
+        "64",
+        "--lights",
+        "1",
+        "--repeat",
+        "2",
+        "--no-dome",
+        "--no-startup",
+        "--json",
+        "--command",
+        &command,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = v["commands"].as_array().unwrap();
+    let devices: Vec<&str> = rows.iter().map(|r| r["device"].as_str().unwrap()).collect();
+    assert_eq!(devices, if gpu { vec!["gpu", "cpu"] } else { vec!["cpu"] });
+    for r in rows {
+        assert_eq!(r["command"].as_str().unwrap(), command);
+        let runs = r["runs_seconds"].as_array().unwrap();
+        assert_eq!(runs.len(), 2);
+        assert!(runs.iter().all(|t| t.as_f64().unwrap() > 0.0));
+        // A process that loaded this binary holds more than a mebibyte.
+        assert!(r["peak_rss_bytes"].as_u64().unwrap() > 1 << 20, "{r}");
+    }
+    assert_eq!(
+        v["command_speedups"].as_array().unwrap().len(),
+        usize::from(gpu)
+    );
+    let (shape, values) = read_npy_f32(&out);
+    assert_eq!(shape, vec![4096, 3]);
+    let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
+    let lights = scene.evaluable(&[]).unwrap();
+    let dirs = npy::read_directions(Path::new(&asset("dirs.npy"))).unwrap();
+    let want = Evaluator::cpu()
+        .emission(&lights, &dirs, Accumulate::Sum)
+        .unwrap();
+    let flat: Vec<f32> = want.iter().flatten().copied().collect();
+    assert_eq!(values, flat);
+}
+
 #[test]
 fn check_passes_on_the_bundled_scene() {
     let Some(_gpu) = common::gpu() else { return };

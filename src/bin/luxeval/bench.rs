@@ -55,6 +55,12 @@ pub struct BenchArgs {
     /// Light counts of the sweep.
     #[arg(long, value_delimiter = ',', default_value = "1,8,64")]
     sweep_lights: Vec<usize>,
+    /// Also time this luxeval command line as a whole process, with `--device gpu` and with
+    /// `--device cpu`, alternately, `min(--repeat, 3)` times each: wall time and peak RSS (e.g.
+    /// "falloff scene.usda --res 1024,1024 -o map.exr"). Split at whitespace, no quoting; the
+    /// bench adds `--device`. Repeatable.
+    #[arg(long = "command", value_name = "ARGS")]
+    commands: Vec<String>,
     /// The child process of the cold-start measurement (internal).
     #[arg(long = "startup-probe", hide = true)]
     startup_probe: bool,
@@ -86,6 +92,10 @@ struct Report {
     /// Warm latency: one call of 1,000 samples on a prepared scene (median).
     latency: Vec<Row>,
     startup: Vec<crate::bench_startup::StartupRow>,
+    /// `--command`: whole processes, spawn to exit, on each device.
+    commands: Vec<crate::bench_command::CommandRow>,
+    /// Per `--command` measured on both devices: CPU time ÷ GPU time.
+    command_speedups: Vec<(String, f64)>,
     sweep: Vec<Row>,
     dome: Vec<crate::bench_dome::DomeRow>,
     /// This process's peak resident set (Linux VmHWM), bytes.
@@ -218,6 +228,12 @@ pub fn run(args: BenchArgs) -> CliResult {
             )));
         }
     }
+    let commands = args
+        .commands
+        .iter()
+        .map(|c| crate::bench_command::parse(c))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(Failure::bad_input)?;
     // Cold start first, in child processes, before this process has touched the GPU.
     let startup = if args.no_startup {
         Vec::new()
@@ -231,6 +247,19 @@ pub fn run(args: BenchArgs) -> CliResult {
             }
         }
     };
+    let mut evaluators = vec![(Evaluator::cpu(), args.cpu_samples)];
+    match Evaluator::gpu() {
+        Ok(g) => evaluators.insert(0, (g, args.samples)),
+        Err(e) => eprintln!("warning: no GPU ({e}); measuring the CPU only"),
+    }
+    // Whole commands next, while this process holds no large arrays.
+    let devices: &[&'static str] = if evaluators.len() == 2 {
+        &["gpu", "cpu"]
+    } else {
+        &["cpu"]
+    };
+    let command_rows = crate::bench_command::measure(&commands, devices, args.repeat.min(3))?;
+    let command_speedups = crate::bench_command::speedups(&command_rows);
     let lights = synthetic_lights(args.lights);
     let mut rng = Rng::new(7);
     let sweep_max = if args.sweep {
@@ -244,11 +273,6 @@ pub fn run(args: BenchArgs) -> CliResult {
         .map(|_| (rng.unit() * rng.range(0.5, 6.0)).as_vec3().to_array())
         .collect();
 
-    let mut evaluators = vec![(Evaluator::cpu(), args.cpu_samples)];
-    match Evaluator::gpu() {
-        Ok(g) => evaluators.insert(0, (g, args.samples)),
-        Err(e) => eprintln!("warning: no GPU ({e}); measuring the CPU only"),
-    }
     // Irradiance is a quadrature per (light, receiver): 1/IRRADIANCE_SHARE of the samples.
     let share = |query: &str, m: usize| {
         if query == "irradiance" {
@@ -336,6 +360,8 @@ pub fn run(args: BenchArgs) -> CliResult {
             ratios,
             latency,
             startup,
+            commands: command_rows,
+            command_speedups,
             sweep,
             dome,
             peak_rss_bytes: peak_rss(),
@@ -404,6 +430,21 @@ pub fn run(args: BenchArgs) -> CliResult {
             p.device_seconds,
             pipelines.join(", ")
         );
+    }
+    for c in &command_rows {
+        let rss = c.peak_rss_bytes.map_or("n/a".to_string(), |b| {
+            format!("{:.0} MiB", b as f64 / (1 << 20) as f64)
+        });
+        outln!(
+            "command `luxeval {} --device {}`: median {:.3} s wall of {} runs, peak RSS {rss}",
+            c.command,
+            c.device,
+            c.median_seconds,
+            c.runs_seconds.len()
+        );
+    }
+    for (command, speedup) in &command_speedups {
+        outln!("command `luxeval {command}`: the GPU path {speedup:.2}× as fast as the CPU path");
     }
     for (query, ratio) in &ratios {
         outln!("{query}: GPU/CPU throughput ratio {ratio:.2}× (same run)");

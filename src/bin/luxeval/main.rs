@@ -11,6 +11,7 @@ macro_rules! outln {
 
 mod args;
 mod bench;
+mod bench_command;
 mod bench_dome;
 mod bench_startup;
 mod check;
