@@ -61,15 +61,8 @@ fn emission_on_the_bundled_scene_equals_the_library() {
     assert!(o.status.success(), "{}", stderr(&o));
     let (shape, values) = read_npy_f32(&out);
     assert_eq!(shape, vec![4096, 3]);
-    let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
-    let lights = scene.evaluable(&[]).unwrap();
-    // The CLI normalises directions in f64 as it reads them (docs/INPUTS.md).
-    let dirs = npy::read_directions(Path::new(&asset("dirs.npy"))).unwrap();
-    let want = Evaluator::cpu()
-        .emission(&lights, &dirs, Accumulate::Sum)
-        .unwrap();
-    let flat: Vec<f32> = want.iter().flatten().copied().collect();
-    assert_eq!(values, flat);
+    let (lights, want) = studio_emission_on_cpu(Accumulate::Sum);
+    assert_eq!(values, want);
 
     // Per light: (L, N, 3) in `lights` order, and each row matches the single-light result.
     let out = dir.path().join("p.npy");
@@ -87,10 +80,18 @@ fn emission_on_the_bundled_scene_equals_the_library() {
     assert!(o.status.success(), "{}", stderr(&o));
     let (shape, values) = read_npy_f32(&out);
     assert_eq!(shape, vec![lights.len() as u64, 4096, 3]);
-    let want = Evaluator::cpu()
-        .emission(&lights, &dirs, Accumulate::PerLight)
-        .unwrap();
-    assert_eq!(values, want.iter().flatten().copied().collect::<Vec<f32>>());
+    assert_eq!(values, studio_emission_on_cpu(Accumulate::PerLight).1);
+}
+
+/// The bundled scene's lights and the library's CPU emission of them along assets/dirs.npy,
+/// flattened as the CLI writes it.
+fn studio_emission_on_cpu(acc: Accumulate) -> (Vec<luxeval::Light>, Vec<f32>) {
+    let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
+    let lights = scene.evaluable(&[]).unwrap();
+    // The CLI normalises directions in f64 as it reads them (docs/INPUTS.md).
+    let dirs = npy::read_directions(Path::new(&asset("dirs.npy"))).unwrap();
+    let want = Evaluator::cpu().emission(&lights, &dirs, acc).unwrap();
+    (lights, want.iter().flatten().copied().collect())
 }
 
 #[test]
@@ -347,14 +348,7 @@ fn bench_command_times_the_command_on_each_device() {
     );
     let (shape, values) = read_npy_f32(&out);
     assert_eq!(shape, vec![4096, 3]);
-    let scene = Scene::load(Path::new(&asset("studio.usda")), None).unwrap();
-    let lights = scene.evaluable(&[]).unwrap();
-    let dirs = npy::read_directions(Path::new(&asset("dirs.npy"))).unwrap();
-    let want = Evaluator::cpu()
-        .emission(&lights, &dirs, Accumulate::Sum)
-        .unwrap();
-    let flat: Vec<f32> = want.iter().flatten().copied().collect();
-    assert_eq!(values, flat);
+    assert_eq!(values, studio_emission_on_cpu(Accumulate::Sum).1);
 }
 
 #[test]

@@ -122,8 +122,9 @@ const QUERIES: [&str; 3] = ["emission", "radiance", "irradiance"];
 /// normals).
 const IRRADIANCE_SHARE: usize = 64;
 
-fn median(mut v: Vec<Duration>) -> Duration {
-    v.sort();
+/// The middle value of `v` (the upper one of an even count); `v` is not empty.
+pub fn median<T: Copy + PartialOrd>(mut v: Vec<T>) -> T {
+    v.sort_by(|a, b| a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal));
     v[v.len() / 2]
 }
 

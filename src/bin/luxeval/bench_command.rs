@@ -57,39 +57,32 @@ pub fn measure(
 ) -> CliResult<Vec<CommandRow>> {
     let exe = std::env::current_exe()
         .map_err(|e| Failure::runtime(format!("finding this executable to re-run it: {e}")))?;
+    let runs = runs.max(1);
     let mut rows: Vec<CommandRow> = Vec::new();
     for words in commands {
+        let command = words.join(" ");
         let start = rows.len();
         for &device in devices {
             rows.push(CommandRow {
-                command: words.join(" "),
+                command: command.clone(),
                 device,
                 runs_seconds: Vec::new(),
                 median_seconds: 0.0,
                 peak_rss_bytes: None,
             });
         }
-        for run in 0..runs.max(1) {
+        for run in 1..=runs {
             for (k, &device) in devices.iter().enumerate() {
-                eprintln!(
-                    "bench: `luxeval {} --device {device}`, run {} of {} …",
-                    words.join(" "),
-                    run + 1,
-                    runs.max(1)
-                );
+                eprintln!("bench: `luxeval {command} --device {device}`, run {run} of {runs} …");
                 let (seconds, rss) = run_once(&exe, words, device)?;
                 let row = &mut rows[start + k];
                 row.runs_seconds.push(seconds);
-                row.peak_rss_bytes = match (row.peak_rss_bytes, rss) {
-                    (Some(a), Some(b)) => Some(a.max(b)),
-                    (a, b) => a.or(b),
-                };
+                // None < Some: the largest figure reported.
+                row.peak_rss_bytes = row.peak_rss_bytes.max(rss);
             }
         }
         for row in &mut rows[start..] {
-            let mut v = row.runs_seconds.clone();
-            v.sort_by(f64::total_cmp);
-            row.median_seconds = v[v.len() / 2];
+            row.median_seconds = crate::bench::median(row.runs_seconds.clone());
         }
     }
     Ok(rows)
@@ -112,12 +105,11 @@ pub fn speedups(rows: &[CommandRow]) -> Vec<(String, f64)> {
 /// it fail. A failing command fails the bench with the child's exit code (2 for bad input) and
 /// the end of its message.
 fn run_once(exe: &Path, words: &[String], device: &str) -> CliResult<(f64, Option<u64>)> {
-    let stderr = tempfile::tempfile().map_err(|e| {
+    let file_failed = |e: std::io::Error| {
         Failure::runtime(format!("creating a file for the command's messages: {e}"))
-    })?;
-    let keep = stderr.try_clone().map_err(|e| {
-        Failure::runtime(format!("creating a file for the command's messages: {e}"))
-    })?;
+    };
+    let stderr = tempfile::tempfile().map_err(file_failed)?;
+    let keep = stderr.try_clone().map_err(file_failed)?;
     let t = Instant::now();
     let child = Command::new(exe)
         .args(words)
