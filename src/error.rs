@@ -170,7 +170,8 @@ impl LuxError {
         }
     }
 
-    pub(crate) fn input(what: impl Into<String>, reason: impl Into<String>) -> Self {
+    /// [`LuxError::InvalidInput`]: `what` (an argument, a file, a prim) is refused for `reason`.
+    pub fn input(what: impl Into<String>, reason: impl Into<String>) -> Self {
         LuxError::InvalidInput {
             what: what.into(),
             reason: reason.into(),

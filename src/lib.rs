@@ -32,24 +32,26 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 // The data flow of DESIGN.md §1, each module depending only on those above it:
-// model → usd → prepare → cpu | gpu → query → io, falloff → the CLI (src/bin/luxeval).
-// `assets` (readers of referenced files) is a leaf that `prepare` uses.
-// `rules` holds what the WGSL kernels and their f64 counterparts share; neither backend owns it.
+// model → usd → prepare → cpu | gpu → query → falloff, conformance. The command line, the
+// Python package and the fuzz targets are crates of their own around this one (cli/, python/,
+// fuzz/). `assets` (readers of referenced files) is a leaf that `prepare` uses; `rules` holds
+// what the WGSL kernels and their f64 counterparts share, and neither backend owns it;
+// `synthetic` (seeded lights and samples) serves the conformance check and the benchmarks.
+//
+// Every module is private: the re-exports below are the library's API.
 pub(crate) mod assets;
-#[cfg(any(test, feature = "testkit"))]
-pub mod check;
+pub(crate) mod conformance;
 pub(crate) mod cpu;
 pub(crate) mod error;
-pub mod falloff;
+pub(crate) mod falloff;
 pub(crate) mod gpu;
-pub mod ies;
-pub mod io;
-pub mod limits;
+pub(crate) mod input;
+pub(crate) mod limits;
 pub(crate) mod model;
-pub mod plot;
 pub(crate) mod prepare;
 pub(crate) mod query;
 pub(crate) mod rules;
+pub(crate) mod synthetic;
 #[cfg(any(test, feature = "testkit"))]
 pub mod testkit;
 #[cfg(feature = "usd")]
@@ -60,20 +62,34 @@ pub(crate) mod usd;
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 
-pub use error::{GpuFailure, LuxError, Result};
+pub use assets::ies::eulumdat::{EulumdatInfo, LampSet};
+pub use assets::ies::lm63::{Format as IesFormat, Lm63Version, Tilt, TiltSource};
+pub use assets::ies::{IesError, IesErrorKind, IesFile, PhotometricType, read_file as read_ies};
+pub use assets::texture::{FormatError as TextureFormatError, TextureError};
+pub use conformance::{
+    BAND as CHECK_BAND, CONE_BAND as CHECK_CONE_BAND, CheckReport, CheckedQuery, QueryReport,
+    TOLERANCE as CHECK_TOLERANCE, WorstSample, check as check_against_reference,
+};
+pub use error::{AssetError, GpuFailure, LuxError, Result};
+pub use falloff::{FalloffMap, FalloffPlane};
 pub use gpu::cache::CACHE_DIR_ENV as PIPELINE_CACHE_DIR_ENV;
 pub use gpu::{AdapterSummary, CacheStatus, DeviceLimits, Startup, adapters};
+pub use input::{BadRow, RowKind, RowProblem};
 pub use limits::Limits;
 pub use model::{
     Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter,
     TextureFormat, UpAxis, Value, schema,
 };
 pub use prepare::TemperatureMode;
+pub use prepare::ies::{
+    FluxCheck, Peak as IesPeak, Plane as IesPlane, Profile as IesProfile, Spread as IesSpread,
+};
 #[cfg(feature = "usd")]
 pub use query::lights_json;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
+pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]
-pub use usd::{Scene, SceneLight, Stage, StageInfo, TimeRule};
+pub use usd::{Stage, StageInfo, StageLight, TimeRule, UsdStage};
 /// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
 /// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that
 /// the types match.

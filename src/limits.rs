@@ -26,11 +26,12 @@ pub struct Limits {
     pub max_prim_depth: u64,
 }
 
-/// Environment variables, in the order of the fields of [`Limits`].
-pub const ENV_MAX_FILE_BYTES: &str = "LUXEVAL_MAX_FILE_BYTES";
-pub const ENV_MAX_SAMPLES: &str = "LUXEVAL_MAX_SAMPLES";
-pub const ENV_MAX_PRIMS: &str = "LUXEVAL_MAX_PRIMS";
-pub const ENV_MAX_PRIM_DEPTH: &str = "LUXEVAL_MAX_PRIM_DEPTH";
+// Environment variables, in the order of the fields of [`Limits`] (also its associated
+// constants, which name them for callers).
+pub(crate) const ENV_MAX_FILE_BYTES: &str = "LUXEVAL_MAX_FILE_BYTES";
+pub(crate) const ENV_MAX_SAMPLES: &str = "LUXEVAL_MAX_SAMPLES";
+pub(crate) const ENV_MAX_PRIMS: &str = "LUXEVAL_MAX_PRIMS";
+pub(crate) const ENV_MAX_PRIM_DEPTH: &str = "LUXEVAL_MAX_PRIM_DEPTH";
 
 /// The longest chain of nested composition arcs (references, payloads, inherits, specializes)
 /// openusd 0.8 composes: measured, a prim at the head of a chain of 98 references composes and
@@ -38,7 +39,7 @@ pub const ENV_MAX_PRIM_DEPTH: &str = "LUXEVAL_MAX_PRIM_DEPTH";
 /// around the chain; usd-core has no such limit). Not configurable: luxeval cannot change its USD
 /// reader, so a longer chain is refused with this limit named instead of being composed without
 /// its light. `tests/bad_inputs.rs` checks both sides of it.
-pub const MAX_ARC_DEPTH: u64 = 98;
+pub(crate) const MAX_ARC_DEPTH: u64 = 98;
 
 impl Default for Limits {
     fn default() -> Self {
@@ -56,6 +57,27 @@ impl Default for Limits {
 }
 
 impl Limits {
+    /// The variable that sets [`Limits::max_file_bytes`].
+    pub const ENV_MAX_FILE_BYTES: &str = ENV_MAX_FILE_BYTES;
+    /// The variable that sets [`Limits::max_samples`].
+    pub const ENV_MAX_SAMPLES: &str = ENV_MAX_SAMPLES;
+    /// The variable that sets [`Limits::max_prims`].
+    pub const ENV_MAX_PRIMS: &str = ENV_MAX_PRIMS;
+    /// The variable that sets [`Limits::max_prim_depth`].
+    pub const ENV_MAX_PRIM_DEPTH: &str = ENV_MAX_PRIM_DEPTH;
+
+    /// "set NAME to raise it; see docs/INPUTS.md": the end of every message about a limit.
+    pub fn raise_hint(env: &str) -> String {
+        raise_hint(env)
+    }
+
+    /// A positive integer from the environment variable `name` (underscores allowed), or
+    /// `default` when it is unset; anything else is refused naming the variable. The one
+    /// parser of luxeval's `LUXEVAL_*` numbers.
+    pub fn env_var(name: &str, default: u64) -> Result<u64> {
+        var(name, default)
+    }
+
     /// The defaults, each overridden by its environment variable when set.
     pub fn from_env() -> Result<Limits> {
         let d = Limits::default();
@@ -84,7 +106,7 @@ impl Limits {
 }
 
 /// "set NAME to raise it": the end of every message about a limit.
-pub fn raise_hint(env: &str) -> String {
+pub(crate) fn raise_hint(env: &str) -> String {
     format!("set {env} to raise it; see docs/INPUTS.md")
 }
 

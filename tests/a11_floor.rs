@@ -15,9 +15,9 @@ use crate::common;
 use std::path::Path;
 
 use glam::DVec3;
-use luxeval::check::{self, BAND, TOLERANCE};
-use luxeval::falloff::Plane;
-use luxeval::{Accumulate, Reference, Scene, TemperatureMode};
+use luxeval::testkit::check::{self, BAND, TOLERANCE};
+use luxeval::FalloffPlane as Plane;
+use luxeval::{Accumulate, Reference, Stage, TemperatureMode};
 
 fn dvec(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
@@ -57,7 +57,7 @@ fn a11_floor_maps_gpu_match_cpu() {
         ("distant", 5),
     ] {
         for frame in 1..=last {
-            let scene = Scene::load(&dir.join(format!("{name}.usda")), Some(frame as f64))
+            let scene = Stage::load(&dir.join(format!("{name}.usda")), Some(frame as f64))
                 .unwrap_or_else(|e| panic!("{name} frame {frame}: {e}"));
             let lights = scene.evaluable(&[]).expect("evaluable lights");
             assert!(!lights.is_empty(), "{name} frame {frame}: no light");

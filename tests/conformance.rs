@@ -9,7 +9,7 @@
 use crate::common;
 
 use glam::DVec3;
-use luxeval::check;
+use luxeval::testkit::check;
 use luxeval::testkit::{Rng, TRANSFORMS, random_light, random_lights};
 use luxeval::{Accumulate, Evaluator, Light, LightType, Reference, TemperatureMode};
 

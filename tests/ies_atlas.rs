@@ -3,9 +3,10 @@ use crate::ies_common;
 
 use glam::{DVec3, Vec3};
 use ies_common::*;
-use luxeval::ies::lookup::{fold_h_type_c, fold_mirror, photometric_angles};
-use luxeval::ies::{HFold, VFold};
-use luxeval::ies::{PhotometricType, Profile, ies_factor};
+use luxeval::testkit::ies_parts::lookup::{fold_h_type_c, fold_mirror, photometric_angles};
+use luxeval::testkit::ies_parts::{HFold, VFold};
+use luxeval::testkit::ies_parts::ies_factor;
+use luxeval::{IesProfile as Profile, PhotometricType};
 use luxeval::testkit::ies_replay::{AtlasError, HEADER_LEN, pack_atlas, replay_ies_factor};
 
 /// The layout of atlas.rs, checked field by field on two small profiles.
@@ -107,8 +108,8 @@ fn folded(p: &Profile, e: DVec3, s: f64) -> Option<(f64, f64)> {
 }
 
 fn near_kink(p: &Profile, e: DVec3, s: f64, delta: f64) -> bool {
-    let (_, theta) = luxeval::ies::lookup::type_c_angles(e);
-    let t = luxeval::ies::lookup::scale_polar_angle(theta, s);
+    let (_, theta) = luxeval::testkit::ies_parts::lookup::type_c_angles(e);
+    let t = luxeval::testkit::ies_parts::lookup::scale_polar_angle(theta, s);
     if t.abs() < delta || (t - 180.0).abs() < delta {
         return true;
     }
@@ -215,7 +216,7 @@ fn replay_on_luxtest_profiles() {
         "test_vstripes_hquadrants_nonuniform.ies",
     ] {
         let p = Profile::new(
-            &luxeval::ies::read_file(std::path::Path::new(&format!("{dir}/{name}"))).unwrap(),
+            &luxeval::read_ies(std::path::Path::new(&format!("{dir}/{name}"))).unwrap(),
         )
         .unwrap();
         let atlas = pack_atlas(&[&p]).unwrap();

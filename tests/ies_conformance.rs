@@ -9,7 +9,7 @@
 
 use crate::common;
 
-use luxeval::check;
+use luxeval::testkit::check;
 use luxeval::testkit::ies::{SHAPES, with_random_ies};
 use luxeval::testkit::irradiance_samples;
 use luxeval::testkit::{Rng, TRANSFORMS, random_light};

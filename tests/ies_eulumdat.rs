@@ -3,9 +3,10 @@
 use crate::ies_common;
 
 use ies_common::*;
-use luxeval::ies::Format;
-use luxeval::ies::IesErrorKind as K;
-use luxeval::ies::{Profile, ies_factor};
+use luxeval::IesFormat as Format;
+use luxeval::IesErrorKind as K;
+use luxeval::IesProfile as Profile;
+use luxeval::testkit::ies_parts::ies_factor;
 
 /// An EULUMDAT file: `planes` are the stored planes (Mc1..=Mc2) in file order, cd/klm.
 struct Ldt {
@@ -193,14 +194,14 @@ fn content_detection_ignores_the_extension() {
         (
             "b.ldt",
             &lm63,
-            Format::Lm63(luxeval::ies::Lm63Version::V2002),
+            Format::Lm63(luxeval::Lm63Version::V2002),
         ),
-        ("b", &lm63, Format::Lm63(luxeval::ies::Lm63Version::V2002)),
+        ("b", &lm63, Format::Lm63(luxeval::Lm63Version::V2002)),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
         assert_eq!(
-            luxeval::ies::read_file(&path).unwrap().format,
+            luxeval::read_ies(&path).unwrap().format,
             want,
             "{name}"
         );

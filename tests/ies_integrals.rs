@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use glam::DVec3;
 use ies_common::*;
-use luxeval::ies::ies_factor;
+use luxeval::testkit::ies_parts::ies_factor;
 
 /// A constant profile's mean is the constant over 0–180 (so normalize gives 1 everywhere).
 #[test]
@@ -118,7 +118,7 @@ const GL5: [(f64, f64); 5] = [
 /// B: H ∈ [−90, 90], V ∈ [−180, 180], dω = cos H; A: V ∈ [−90, 90], H ∈ [−180, 180],
 /// dω = cos V), directions from §6 I2's inverse maps. Every test grid (and its fold images) lies
 /// on the 2.5° lattice, so each panel's integrand is smooth and the rule converges to ~1e-13.
-fn quadrature(p: &luxeval::ies::Profile, kind: u8) -> f64 {
+fn quadrature(p: &luxeval::IesProfile, kind: u8) -> f64 {
     let (xr, yr): ((f64, f64), (f64, f64)) = match kind {
         1 => ((0.0, 180.0), (0.0, 360.0)),
         2 => ((-90.0, 90.0), (-180.0, 180.0)),

@@ -3,8 +3,8 @@
 use crate::ies_common;
 
 use ies_common::*;
-use luxeval::ies::IesErrorKind as K;
-use luxeval::ies::{Format, Lm63Version as V, TiltSource};
+use luxeval::IesErrorKind as K;
+use luxeval::{IesFormat as Format, Lm63Version as V, TiltSource};
 
 /// §6 I1: candela used = value · m · b · (f₃ only for 1986/1991). With m = 2, b = 0.5, f₃ = 3
 /// (1.1 in 2019, its file generation type): 3 for 1986/1991, 1 afterwards.
@@ -24,7 +24,7 @@ fn every_header_version_and_the_f3_rule() {
         let file = f.file();
         assert_eq!(file.format, Format::Lm63(version), "{first}");
         assert_eq!(file.candela_scale(), scale, "{first}");
-        let p = luxeval::ies::Profile::new(&file).unwrap();
+        let p = luxeval::IesProfile::new(&file).unwrap();
         assert_eq!(p.candela, vec![10.0 * scale, 4.0 * scale], "{first}");
         // 1986 has no version line: its first line is a label.
         let want_labels = if version == V::V1986 { 2 } else { 1 };
@@ -48,7 +48,7 @@ fn labels_with_non_utf8_bytes_are_kept_lossily() {
     let body = &text[text.find("TILT=").unwrap()..];
     let mut bytes = b"IESNA:LM-63-2002\r\n[LUMINAIRE] Leuchte \xE9\xFC 3\r\n".to_vec();
     bytes.extend_from_slice(body.as_bytes());
-    let f = luxeval::ies::parse_any(&bytes, &no_tilt).unwrap();
+    let f = luxeval::testkit::ies_parts::parse_any(&bytes, &no_tilt).unwrap();
     assert_eq!(
         f.keywords,
         vec![("LUMINAIRE".into(), "Leuchte \u{FFFD}\u{FFFD} 3".into())]
@@ -93,7 +93,7 @@ fn commas_tabs_and_values_spread_over_lines() {
     assert_eq!(f.candela_multiplier, 2.0);
     assert_eq!(f.vertical_angles, vec![0.0, 90.0]);
     assert_eq!(f.horizontal_angles, vec![0.0, 45.0]);
-    assert_eq!(f.photometric_type, luxeval::ies::PhotometricType::B);
+    assert_eq!(f.photometric_type, luxeval::PhotometricType::B);
     assert_eq!(f.candela, vec![10.0, 20.0, 30.0, 40.0]);
 }
 
@@ -110,7 +110,7 @@ fn tilt_include_is_read_and_interpolated() {
         (t.angles.clone(), t.factors.clone()),
         (vec![0.0, 45.0, 90.0], vec![1.0, 0.8, 0.5])
     );
-    let p = luxeval::ies::Profile::new(&file).unwrap();
+    let p = luxeval::IesProfile::new(&file).unwrap();
     assert_close(p.tilt_factor(22.5), 0.9, 1e-15);
     assert_close(p.tilt_factor(60.0), 0.8 - 0.3 / 3.0, 1e-15); // 0.8 + (15/45)(0.5 − 0.8)
     assert_eq!(p.tilt_factor(-5.0), 1.0); // clamped below
@@ -134,7 +134,7 @@ fn tilt_file_is_resolved_by_name() {
         assert_eq!(name, "lamp tilt.dat");
         Ok(b"2\n2\n0 90\n1 0.25\n".to_vec())
     };
-    let file = luxeval::ies::parse_any(f.text().as_bytes(), &resolver).unwrap();
+    let file = luxeval::testkit::ies_parts::parse_any(f.text().as_bytes(), &resolver).unwrap();
     let t = file.tilt.unwrap();
     assert_eq!(t.source, TiltSource::File("lamp tilt.dat".into()));
     assert_eq!(
@@ -152,7 +152,7 @@ fn missing_tilt_file_names_both_files() {
     f.tilt = "gone.tlt".into();
     let path = dir.join("lamp.ies");
     std::fs::write(&path, f.text()).unwrap();
-    let e = luxeval::ies::read_file(&path).unwrap_err();
+    let e = luxeval::read_ies(&path).unwrap_err();
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(e.line, Some(3));
     assert!(matches!(e.kind, K::TiltFileUnreadable { .. }), "{e:?}");
@@ -168,7 +168,7 @@ fn errors_inside_a_tilt_file_name_its_line() {
     let mut f = Ies::new(1, &[0.0], &[0.0, 90.0], &[1.0, 1.0]);
     f.tilt = "t.dat".into();
     let resolver = |_: &str| Ok(b"1\n2\n0 90\n1 0.5\n7\n".to_vec());
-    let e = luxeval::ies::parse_any(f.text().as_bytes(), &resolver).unwrap_err();
+    let e = luxeval::testkit::ies_parts::parse_any(f.text().as_bytes(), &resolver).unwrap_err();
     assert_eq!(e.line, Some(3));
     match e.kind {
         K::InTiltFile { name, line, kind } => {
@@ -327,7 +327,7 @@ fn no_tilt_line() {
         .cloned()
         .collect::<Vec<_>>()
         .join("\n");
-    let e = luxeval::ies::parse_lm63(text.as_bytes(), &no_tilt).unwrap_err();
+    let e = luxeval::testkit::ies_parts::parse_lm63(text.as_bytes(), &no_tilt).unwrap_err();
     assert_eq!((e.line, e.kind), (None, K::NoTiltLine));
     assert_eq!(parse_err(&text).kind, K::UnknownFormat);
 }
@@ -348,7 +348,7 @@ fn truncated_files() {
 #[test]
 fn unreadable_file_names_it() {
     let path = std::env::temp_dir().join("ies-no-such-dir/none.ies");
-    let e = luxeval::ies::read_file(&path).unwrap_err();
+    let e = luxeval::read_ies(&path).unwrap_err();
     assert!(matches!(e.kind, K::Io(_)) && e.line.is_none(), "{e:?}");
     assert!(e.to_string().contains("none.ies"), "{e}");
 }

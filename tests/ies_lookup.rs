@@ -5,12 +5,12 @@ use crate::ies_common;
 
 use glam::DVec3;
 use ies_common::*;
-use luxeval::ies::ies_factor;
+use luxeval::testkit::ies_parts::ies_factor;
 
 const C_LINEAR: fn(f64, f64) -> f64 = |h, v| 100.0 + h + v;
 
 #[track_caller]
-fn check(p: &luxeval::ies::Profile, e: DVec3, want: f64) {
+fn check(p: &luxeval::IesProfile, e: DVec3, want: f64) {
     let got = ies_factor(p, e.normalize(), 0.0);
     assert!(
         (got - want).abs() <= 1e-9 * want.abs().max(1.0),
@@ -165,8 +165,8 @@ fn type_a_file_that_hangs_openusd_parses_and_evaluates() {
         1 -1 1 5 3 3 2 0 0 0\r\n1 1 0\r\n-90 -45 0 45 90\r\n0 45 90\r\n\
         0 500 1000 500 0\r\n0 250 500 250 0\r\n0 100 200 100 0\r\n";
     let file = parse(text);
-    assert_eq!(file.photometric_type, luxeval::ies::PhotometricType::A);
-    let p = luxeval::ies::Profile::new(&file).unwrap();
+    assert_eq!(file.photometric_type, luxeval::PhotometricType::A);
+    let p = luxeval::IesProfile::new(&file).unwrap();
     check(&p, DVec3::X, 1000.0); // beam axis along +X
     check(&p, dir_a(-45.0, 0.0), 500.0); // mirrored lateral
     check(

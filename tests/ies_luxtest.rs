@@ -4,12 +4,13 @@ use crate::ies_common;
 
 use glam::DVec3;
 use ies_common::*;
-use luxeval::ies::{Profile, ies_factor};
+use luxeval::IesProfile as Profile;
+use luxeval::testkit::ies_parts::ies_factor;
 
 fn load(name: &str) -> Profile {
     let path = format!("{}/tests/data/luxtest/{name}", env!("CARGO_MANIFEST_DIR"));
     let file =
-        luxeval::ies::read_file(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+        luxeval::read_ies(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
     Profile::new(&file).unwrap()
 }
 

@@ -5,11 +5,10 @@ use crate::ies_common;
 use std::f64::consts::PI;
 
 use ies_common::*;
-use luxeval::ies::{Plane, Spread};
-use luxeval::ies::{Profile, ies_factor};
+use luxeval::{IesPlane as Plane, IesProfile as Profile, IesSpread as Spread};
 
 fn spread(p: &Profile, plane: Plane) -> Spread {
-    p.spread(plane, &|e| ies_factor(p, e, 0.0))
+    p.spread(plane, &|e| p.candela(e, 0.0))
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! The integration tests: one test binary (Cargo.toml: `autotests = false` and this `[[test]]`)
+//! The library's integration tests (the command line's are in cli/tests/): one test binary (Cargo.toml: `autotests = false` and this `[[test]]`)
 //! whose modules are the files of tests/, each test named `FILE::TEST` (`cargo test
 //! --ignore-rust-version a11_floor::` runs tests/a11_floor.rs). One binary instead of one per
 //! file: each test binary links wgpu, naga and openusd, and 32 of those links were most of the
@@ -14,9 +14,7 @@ mod common;
 mod ies_common;
 
 mod a11_floor;
-mod bad_inputs;
 mod blackbody_fixture;
-mod cli;
 mod conformance;
 mod determinism;
 mod dome_conformance;
@@ -35,11 +33,9 @@ mod irradiance;
 mod layers;
 mod luxtest_check;
 mod math;
-mod pipeline_cache;
 mod rect_conformance;
 mod resident;
 mod robustness;
-mod stream;
 mod tolerance;
 mod twins;
 mod usd_fixtures;
@@ -51,26 +47,5 @@ mod wgsl;
 #[test]
 fn every_test_file_is_a_module_of_this_binary() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests");
-    let root = std::fs::read_to_string(dir.join("integration.rs")).unwrap();
-    let listed: Vec<&str> = root
-        .lines()
-        .filter_map(|l| l.strip_prefix("mod ")?.strip_suffix(';'))
-        .collect();
-    let mut files = 0;
-    for e in std::fs::read_dir(&dir).unwrap() {
-        let p = e.unwrap().path();
-        let name = if p.is_dir() && p.join("mod.rs").is_file() {
-            p.file_name().unwrap().to_string_lossy().into_owned()
-        } else if p.extension().is_some_and(|x| x == "rs") && !p.ends_with("integration.rs") {
-            p.file_stem().unwrap().to_string_lossy().into_owned()
-        } else {
-            continue;
-        };
-        files += 1;
-        assert!(
-            listed.contains(&name.as_str()),
-            "tests/{name} is not a module of tests/integration.rs: its tests would not run"
-        );
-    }
-    assert_eq!(files, listed.len(), "{listed:?}");
+    common::assert_every_file_is_a_module(&dir);
 }

@@ -1,5 +1,6 @@
 //! The data flow of DESIGN.md §1, enforced: each module under `src/` names (as `crate::…`) only
-//! the modules before it in model → usd → prepare → cpu | gpu → query → io, falloff → CLI.
+//! the modules before it in model → usd → prepare → cpu | gpu → query → falloff, conformance
+//! (the command line and Python are crates around the library, which names neither).
 //! In particular `src/cpu` never names the gpu module and `src/gpu` never names the cpu module.
 //! Test code (`#[cfg(test)]` sections) is not scanned.
 
@@ -12,6 +13,8 @@ const ALLOWED: &[(&str, &[&str])] = &[
     ("model", &["error", "model"]),
     // `limits` is a leaf like `error`: the bounds every reader checks (docs/INPUTS.md).
     ("limits", &["error", "limits"]),
+    // The one rule for query input rows, used by `query` and by the crates around the library.
+    ("input", &["input"]),
     ("usd", &["error", "limits", "model", "usd"]),
     ("prepare", &["assets", "error", "model", "prepare"]),
     ("rules", &["rules"]),
@@ -22,17 +25,23 @@ const ALLOWED: &[(&str, &[&str])] = &[
         // `usd` only for the light records of a stage (query/lights.rs, feature `usd`);
         // `rules` for the tolerance the GPU is held to (irradiance `--tolerance`).
         &[
-            "error", "model", "usd", "prepare", "rules", "cpu", "gpu", "query",
+            "error", "input", "model", "usd", "prepare", "rules", "cpu", "gpu", "query",
         ],
     ),
-    ("io", &["error", "limits", "io"]),
-    ("ies", &["assets", "prepare", "cpu", "plot", "ies"]),
-    ("plot", &["error", "io", "plot"]),
-    ("falloff", &["error", "io", "query", "plot", "falloff"]),
+    // Seeded lights and the samples aimed at them (through the f64 reference).
+    ("synthetic", &["model", "query", "synthetic"]),
+    ("falloff", &["error", "query", "falloff"]),
     (
-        "check",
+        "conformance",
         &[
-            "error", "model", "prepare", "rules", "cpu", "query", "testkit", "check",
+            "error",
+            "model",
+            "prepare",
+            "rules",
+            "cpu",
+            "query",
+            "synthetic",
+            "conformance",
         ],
     ),
 ];

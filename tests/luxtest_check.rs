@@ -10,8 +10,8 @@ use crate::common;
 
 use std::path::Path;
 
-use luxeval::check;
-use luxeval::{Reference, Scene, TemperatureMode};
+use luxeval::testkit::check;
+use luxeval::{Reference, Stage, TemperatureMode};
 
 /// The photometric files the luxtest scenes reference but the repository does not ship.
 const NOT_SHIPPED: [&str; 2] = [
@@ -44,7 +44,7 @@ fn every_luxtest_light_at_every_frame_is_within_tolerance() {
     ] {
         let path = dir.join(format!("{name}.usda"));
         for frame in 1..=frames {
-            let scene = Scene::load(&path, Some(frame as f64))
+            let scene = Stage::load(&path, Some(frame as f64))
                 .unwrap_or_else(|e| panic!("{name} frame {frame}: {e}"));
             let lights = scene.evaluable(&[]).expect("all lights");
             skipped.extend(
@@ -138,7 +138,7 @@ fn every_luxtest_light_at_every_frame_is_within_tolerance() {
 fn the_luxtest_dome_shows_the_blocks_luxtest_names() {
     use glam::DVec3;
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/luxtest/usd/dome.usda");
-    let scene = Scene::load(&path, Some(1.0)).unwrap();
+    let scene = Stage::load(&path, Some(1.0)).unwrap();
     assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
     let lights = scene.evaluable(&[]).unwrap();
     assert_eq!(lights.len(), 1);

@@ -9,8 +9,8 @@
 use crate::common;
 
 use glam::DVec3;
-use luxeval::falloff::{self, Plane};
-use luxeval::{Evaluator, Scene};
+use luxeval::FalloffPlane as Plane;
+use luxeval::{Evaluator, Stage};
 
 /// The luxtest floor (y = 0, x and z in [−5, 5]) at 24 × 24 pixel centres: coarse enough for a
 /// debug build, fine enough to cross the spot's cone edge and the rect's shaping falloff.
@@ -30,12 +30,12 @@ fn map(eval: &Evaluator, scene: &str, frame: f64) -> Vec<[f32; 3]> {
         "{}/tests/data/luxtest/usd/{scene}.usda",
         env!("CARGO_MANIFEST_DIR")
     );
-    let lights = Scene::load(std::path::Path::new(&path), Some(frame))
+    let lights = Stage::load(std::path::Path::new(&path), Some(frame))
         .unwrap()
         .evaluable(&[])
         .unwrap();
     let prepared = eval.prepare(&lights).unwrap();
-    falloff::evaluate(&prepared, &floor(), |_, _| {})
+    prepared.falloff(&floor(), |_, _| {})
         .unwrap()
         .rgb
 }

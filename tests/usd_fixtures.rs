@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use luxeval::{LightType, LuxError, Scene, SceneLight, Stage, TimeRule, Value};
+use luxeval::{LightType, LuxError, Stage, StageLight, TimeRule, UsdStage, Value};
 use serde_json::Value as Json;
 
 fn data() -> PathBuf {
@@ -33,7 +33,7 @@ fn close(a: f64, b: f64, rel: f64) -> bool {
 
 /// Compares one light with usd-core's record of it; returns every mismatch, each naming the
 /// scene, time, prim and attribute.
-fn compare(ctx: &str, ours: &SceneLight, exp: &Json, problems: &mut Vec<String>) {
+fn compare(ctx: &str, ours: &StageLight, exp: &Json, problems: &mut Vec<String>) {
     let mut bad = |what: String| problems.push(format!("{ctx} {}: {what}", ours.path));
     if ours.path != exp["path"] {
         bad(format!("path, usd-core has {}", exp["path"]));
@@ -46,7 +46,7 @@ fn compare(ctx: &str, ours: &SceneLight, exp: &Json, problems: &mut Vec<String>)
         ));
     }
     // usd-core's GetAppliedSchemas() drops authored names no registered schema declares;
-    // ours lists them after the known ones (see luxeval::SceneLight::applied_schemas).
+    // ours lists them after the known ones (see luxeval::StageLight::applied_schemas).
     let mut applied: Vec<String> = exp["applied_schemas"]
         .as_array()
         .unwrap()
@@ -144,7 +144,7 @@ fn compare(ctx: &str, ours: &SceneLight, exp: &Json, problems: &mut Vec<String>)
 fn check_scene(fixture: &str) {
     let exp = expected(fixture);
     let path = data().join(exp["scene"].as_str().unwrap());
-    let stage = Stage::open(&path).unwrap_or_else(|e| panic!("{fixture}: {e}"));
+    let stage = UsdStage::open(&path).unwrap_or_else(|e| panic!("{fixture}: {e}"));
     let info = stage.info();
     assert_eq!(info.up_axis, exp["up_axis"].as_str().unwrap(), "{fixture}");
     assert_eq!(
@@ -173,7 +173,7 @@ fn check_scene(fixture: &str) {
         };
         let ctx = format!("{fixture} @ {time:?}");
         let ours = stage
-            .scene_at(time)
+            .read_at(time)
             .unwrap_or_else(|e| panic!("{ctx}: {e}"))
             .lights;
         let theirs = sample["lights"].as_array().unwrap();
@@ -238,9 +238,9 @@ fn composition_usdz_matches_usd_core() {
 fn usda_usdc_usdz_are_identical() {
     let dir = data().join("usd/composition");
     for time in [None, Some(0.0), Some(1.5), Some(3.0), Some(10.0)] {
-        let a = Scene::load(&dir.join("root.usda"), time).unwrap();
-        let c = Scene::load(&dir.join("root.usdc"), time).unwrap();
-        let z = Scene::load(&dir.join("scene.usdz"), time).unwrap();
+        let a = Stage::load(&dir.join("root.usda"), time).unwrap();
+        let c = Stage::load(&dir.join("root.usdc"), time).unwrap();
+        let z = Stage::load(&dir.join("scene.usdz"), time).unwrap();
         assert_eq!(a.lights, c.lights, "usda vs usdc at {time:?}");
         assert_eq!(
             (&a.up_axis, a.meters_per_unit, a.time),
@@ -278,7 +278,7 @@ fn usda_usdc_usdz_are_identical() {
                 }
             }
             // The light's IES asset (shaping:ies:file) resolves the same way.
-            let ies_of = |l: &luxeval::SceneLight| {
+            let ies_of = |l: &luxeval::StageLight| {
                 l.light
                     .as_ref()
                     .and_then(|l| l.shaping.as_ref())
@@ -292,7 +292,7 @@ fn usda_usdc_usdz_are_identical() {
                 ies.ies.as_mut().unwrap().file.resolved = Some(ra);
             }
             // And the light's texture (texture:file).
-            let texture_of = |l: &luxeval::SceneLight| {
+            let texture_of = |l: &luxeval::StageLight| {
                 l.light
                     .as_ref()
                     .and_then(|l| l.texture.as_ref())
@@ -315,7 +315,7 @@ fn packaged_assets_are_readable() {
     // What a later IES or texture reader needs: the resolved path opens through openusd's
     // resolver... and at least names the package and the inner file.
     let dir = data().join("usd/composition");
-    let scene = Scene::load(&dir.join("rig_packaged.usdz"), None).unwrap();
+    let scene = Stage::load(&dir.join("rig_packaged.usdz"), None).unwrap();
     let spot = scene.lights.iter().find(|l| l.path == "/Rig/Spot").unwrap();
     let Some(Value::Asset { authored, resolved }) = spot
         .input("inputs:shaping:ies:file")
@@ -334,21 +334,21 @@ fn packaged_assets_are_readable() {
 fn time_rules() {
     let comp = data().join("usd/composition/root.usda");
     let sphere = data().join("luxtest/usd/sphere.usda");
-    assert_eq!(Scene::load(&comp, None).unwrap().time, TimeRule::Earliest);
+    assert_eq!(Stage::load(&comp, None).unwrap().time, TimeRule::Earliest);
     assert_eq!(
-        Scene::load(&sphere, None).unwrap().time,
+        Stage::load(&sphere, None).unwrap().time,
         TimeRule::StartTimeCode(1.0)
     );
     assert_eq!(
-        Scene::load(&sphere, Some(7.0)).unwrap().time,
+        Stage::load(&sphere, Some(7.0)).unwrap().time,
         TimeRule::Given(7.0)
     );
-    let e = Scene::load(&sphere, Some(f64::NAN)).unwrap_err();
+    let e = Stage::load(&sphere, Some(f64::NAN)).unwrap_err();
     assert!(e.to_string().contains("--time"), "{e}");
 
     // Interpolation: /World/Anim intensity 10 @1 → 30 @3 (linear), normalize 0 @1, 1 @2 (held).
-    let at = |t: f64| Scene::load(&comp, Some(t)).unwrap();
-    let intensity = |s: &Scene| {
+    let at = |t: f64| Stage::load(&comp, Some(t)).unwrap();
+    let intensity = |s: &Stage| {
         let l = s.lights.iter().find(|l| l.path == "/World/Anim").unwrap();
         (
             l.input("inputs:intensity").unwrap().value.clone(),
@@ -362,14 +362,14 @@ fn time_rules() {
     assert_eq!(intensity(&at(2.5)), (Value::Float(25.0), Value::Bool(true)));
     // The earliest rule and the stage's default rule agree on a stage without startTimeCode.
     assert_eq!(
-        intensity(&Scene::load(&comp, None).unwrap()),
+        intensity(&Stage::load(&comp, None).unwrap()),
         (Value::Float(10.0), Value::Bool(false))
     );
 }
 
 #[test]
 fn scene_lights_and_warnings() {
-    let scene = Scene::load(&data().join("usd/composition/root.usda"), Some(0.0)).unwrap();
+    let scene = Stage::load(&data().join("usd/composition/root.usda"), Some(0.0)).unwrap();
     assert_eq!(scene.up_axis, "Z");
     assert_eq!(scene.meters_per_unit, 0.5);
     let get = |p: &str| {
@@ -480,7 +480,7 @@ fn scene_lights_and_warnings() {
     ] {
         assert!(paths.contains(&kept), "{kept} not evaluated");
     }
-    let later = Scene::load(&data().join("usd/composition/root.usda"), Some(2.0)).unwrap();
+    let later = Stage::load(&data().join("usd/composition/root.usda"), Some(2.0)).unwrap();
     assert!(later.evaluable(&["/World/Blink".into()]).unwrap().len() == 1);
 
     let selected = scene
@@ -496,7 +496,7 @@ fn scene_lights_and_warnings() {
 #[test]
 fn malformed_usda_is_a_format_error_with_line() {
     let path = data().join("usd/errors/malformed.usda");
-    match Scene::load(&path, None) {
+    match Stage::load(&path, None) {
         Err(LuxError::Format {
             path: p,
             line,
@@ -508,26 +508,26 @@ fn malformed_usda_is_a_format_error_with_line() {
         }
         other => panic!("{other:?}"),
     }
-    let e = Scene::load(&path, None).unwrap_err().to_string();
+    let e = Stage::load(&path, None).unwrap_err().to_string();
     assert!(e.contains("malformed.usda:5:"), "{e}");
 
     let not_usd = data().join("usd/errors/not_usd.usda");
     assert!(matches!(
-        Scene::load(&not_usd, None),
+        Stage::load(&not_usd, None),
         Err(LuxError::Format { line: Some(1), .. })
     ));
     let ies = data().join("luxtest/test_linear_vertical.ies");
     assert!(
-        matches!(Scene::load(&ies, None), Err(LuxError::Format { .. })),
+        matches!(Stage::load(&ies, None), Err(LuxError::Format { .. })),
         "{:?}",
-        Scene::load(&ies, None).err()
+        Stage::load(&ies, None).err()
     );
 }
 
 #[test]
 fn missing_file_is_an_io_error() {
     let path = data().join("usd/errors/no_such_file.usda");
-    match Scene::load(&path, None) {
+    match Stage::load(&path, None) {
         Err(LuxError::Io { path: p, source }) => {
             assert_eq!(p, path);
             assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
@@ -539,13 +539,13 @@ fn missing_file_is_an_io_error() {
 #[test]
 fn a_directory_is_an_io_error() {
     let dir = data().join("usd");
-    assert!(matches!(Scene::load(&dir, None), Err(LuxError::Io { path, .. }) if path == dir));
+    assert!(matches!(Stage::load(&dir, None), Err(LuxError::Io { path, .. }) if path == dir));
 }
 
 #[test]
 fn missing_or_malformed_layers_name_the_layer() {
     let errs = data().join("usd/errors");
-    let e = Scene::load(&errs.join("missing_reference.usda"), None).unwrap_err();
+    let e = Stage::load(&errs.join("missing_reference.usda"), None).unwrap_err();
     assert!(e.is_bad_input());
     let msg = e.to_string();
     assert!(
@@ -553,12 +553,12 @@ fn missing_or_malformed_layers_name_the_layer() {
         "{msg}"
     );
 
-    let msg = Scene::load(&errs.join("missing_sublayer.usda"), None)
+    let msg = Stage::load(&errs.join("missing_sublayer.usda"), None)
         .unwrap_err()
         .to_string();
     assert!(msg.contains("missing_sublayer_target.usda"), "{msg}");
 
-    match Scene::load(&errs.join("malformed_reference.usda"), None) {
+    match Stage::load(&errs.join("malformed_reference.usda"), None) {
         Err(LuxError::Format { path, line, reason }) => {
             assert_eq!(path, errs.join("malformed.usda"));
             assert_eq!(line, Some(5));
@@ -570,7 +570,7 @@ fn missing_or_malformed_layers_name_the_layer() {
 
 #[test]
 fn a_broken_transform_is_a_warning_not_a_failed_load() {
-    let scene = Scene::load(&data().join("usd/errors/singular_invert.usda"), None).unwrap();
+    let scene = Stage::load(&data().join("usd/errors/singular_invert.usda"), None).unwrap();
     let broken = &scene.lights[0];
     assert_eq!(broken.path, "/World/Broken");
     assert!(broken.light.is_none());
@@ -595,7 +595,7 @@ fn splines_are_refused_naming_the_attribute() {
         ("spline_input.usdc", "inputs:intensity"),
         ("spline_xform.usda", "xformOp:rotateX"),
     ] {
-        match Scene::load(&errs.join(file), None) {
+        match Stage::load(&errs.join(file), None) {
             Err(LuxError::InvalidAttribute {
                 light,
                 attr: a,

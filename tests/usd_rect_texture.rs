@@ -7,7 +7,7 @@
 
 use std::path::Path;
 
-use luxeval::{Accumulate, Evaluator, Scene};
+use luxeval::{Accumulate, Evaluator, Stage};
 
 fn srgb(v: u8) -> f64 {
     let c = v as f64 / 255.0;
@@ -21,7 +21,7 @@ fn srgb(v: u8) -> f64 {
 #[test]
 fn a_textured_rect_light_is_read_and_evaluated() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
-    let scene = Scene::load(&root.join("usd/rect/textured_rect.usda"), None).unwrap();
+    let scene = Stage::load(&root.join("usd/rect/textured_rect.usda"), None).unwrap();
     assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
     let lights = scene.evaluable(&[]).unwrap();
     assert_eq!(lights.len(), 1);

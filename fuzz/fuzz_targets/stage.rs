@@ -45,7 +45,7 @@ pub fn load(ext: &str, data: &[u8]) {
         let mut f = std::fs::File::create(&path).expect("scratch file");
         f.write_all(data).expect("scratch write");
     }
-    if let Ok(scene) = luxeval::Scene::load(&path, None) {
+    if let Ok(scene) = luxeval::Stage::load(&path, None) {
         let _ = serde_json_free_walk(&scene);
         if let Ok(lights) = scene.evaluable(&[]) {
             for l in &lights {
@@ -56,7 +56,7 @@ pub fn load(ext: &str, data: &[u8]) {
 }
 
 /// Touches every listed input (what `lights` prints).
-fn serde_json_free_walk(scene: &luxeval::Scene) -> usize {
+fn serde_json_free_walk(scene: &luxeval::Stage) -> usize {
     scene
         .lights
         .iter()

@@ -1,7 +1,7 @@
 //! `luxeval._luxeval`: the extension module behind the Python package `luxeval` (python/luxeval).
 //!
 //! It mirrors the library, not the command line: a [`stage::Stage`] is a USD stage read once
-//! (`luxeval::Scene`), whose queries prepare the selected lights once per (selection, device,
+//! (`luxeval::Stage`), whose queries prepare the selected lights once per (selection, device,
 //! colour-temperature mode) and keep the prepared scene — pipelines, uploaded records, reusable
 //! buffers — for every later call. Arrays come in as anything NumPy reads as (N, 3) real numbers
 //! and go out as float32 NumPy arrays. The GIL is released while the device works, and large

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use glam::DVec3;
 use luxeval::falloff::{self, Plane};
-use luxeval::{Accumulate, PreparedScene, Scene, TemperatureMode, TextureFilter, TimeRule};
+use luxeval::{Accumulate, PreparedScene, Stage, TemperatureMode, TextureFilter, TimeRule};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyMemoryError, PyUserWarning};
@@ -87,7 +87,7 @@ pub struct Stage {
     absolute: PathBuf,
     /// The `time` argument (`None`: the stage's default rule).
     requested_time: Option<f64>,
-    scene: Scene,
+    scene: Stage,
     /// `scene.lights` as `luxeval lights --json` writes them.
     lights_json: String,
     prepared: Mutex<HashMap<Key, Arc<PreparedScene>>>,
@@ -412,7 +412,7 @@ impl Stage {
         }
         let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
         let scene =
-            py.detach(|| no_panic(|| Scene::load(&path, time).map_err(|e| errors::lux(e, None))))?;
+            py.detach(|| no_panic(|| Stage::load(&path, time).map_err(|e| errors::lux(e, None))))?;
         let lights_json = luxeval::lights_json(&scene)
             .map(|v| v.to_string())
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;

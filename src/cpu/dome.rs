@@ -298,7 +298,7 @@ mod tests {
     use crate::prepare::TemperatureMode;
     use crate::prepare::assets::AssetCache;
     use crate::prepare::dome::{DomeFrame, pole_offset, st_to_direction};
-    use crate::testkit::Rng;
+    use crate::synthetic::Rng;
 
     const CHART: &str = concat!(
         env!("CARGO_MANIFEST_DIR"),

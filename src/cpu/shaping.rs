@@ -126,7 +126,7 @@ mod tests {
     fn identity_shaping_is_dropped_without_changing_values() {
         use crate::model::{Light, Shaping};
         use crate::prepare::{Prepared, ShapingConsts, TemperatureMode, shaping_is_identity};
-        use crate::testkit::Rng;
+        use crate::synthetic::Rng;
         let cone180 = Shaping {
             cone_angle: 180.0,
             ..Shaping::default()

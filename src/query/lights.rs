@@ -2,14 +2,14 @@
 //! returns: the stage's records with each light's total power (one definition for both).
 
 use crate::prepare::TemperatureMode;
-use crate::usd::Scene;
+use crate::usd::Stage;
 
 use super::Reference;
 
 /// `scene.lights` as JSON, each record with `power` ([`Reference::power`]: `rgb`, `lumens`,
 /// `watts`; null for lights at infinity or not evaluated) and, when the light cannot be prepared
 /// (a missing IES file, ...), `power_error` with the reason.
-pub fn lights_json(scene: &Scene) -> serde_json::Result<serde_json::Value> {
+pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
     let mut v = serde_json::to_value(&scene.lights)?;
     if let Some(records) = v.as_array_mut() {
         for (json, l) in records.iter_mut().zip(&scene.lights) {

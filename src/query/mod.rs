@@ -3,15 +3,15 @@
 //! [`PreparedScene`], which answers any number of emission / radiance / irradiance calls and
 //! returns float32 RGB rows. [`Reference`] is the f64 reference of one light, sample by sample.
 
+mod ies;
 mod reference;
 mod resident;
 mod scene;
 
 use std::sync::Arc;
 
-use rayon::prelude::*;
-
 use crate::error::{LuxError, Result};
+use crate::input::RowKind;
 use crate::gpu::{AdapterSummary, CacheStatus, DeviceLimits, GpuContext, Startup};
 use crate::model::Light;
 use crate::prepare::TemperatureMode;
@@ -126,8 +126,7 @@ impl Evaluator {
         self.irradiance_tolerance
     }
 
-    /// Used by `check` (feature `testkit`).
-    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
+    /// The backend, for the conformance check.
     pub(crate) fn backend(&self) -> &Backend {
         &self.backend
     }
@@ -245,33 +244,18 @@ impl Evaluator {
     }
 }
 
-/// Every point must be finite.
+/// Every point must be finite (the one rule of [`crate::input`]).
 pub(crate) fn check_points(what: &str, points: &[[f32; 3]]) -> Result<()> {
-    if let Some(i) = points
-        .par_iter()
-        .position_first(|p| p.iter().any(|c| !c.is_finite()))
-    {
-        return Err(LuxError::input(
-            what,
-            format!("row {i} is not finite: {:?}", points[i]),
-        ));
-    }
-    Ok(())
+    RowKind::Points
+        .check_f32(0, points)
+        .map_err(|e| LuxError::input(what, e.to_string()))
 }
 
 /// Every direction must be finite and non-zero (it is normalised before use).
 pub(crate) fn check_directions(what: &str, dirs: &[[f32; 3]]) -> Result<()> {
-    check_points(what, dirs)?;
-    if let Some(i) = dirs
-        .par_iter()
-        .position_first(|d| d.iter().all(|c| *c == 0.0))
-    {
-        return Err(LuxError::input(
-            what,
-            format!("row {i} is the zero vector, which has no direction"),
-        ));
-    }
-    Ok(())
+    RowKind::Directions
+        .check_f32(0, dirs)
+        .map_err(|e| LuxError::input(what, e.to_string()))
 }
 
 /// Points and directions (or normals) that pair up row by row.

@@ -310,7 +310,7 @@ mod tests {
             unreachable!("a GPU evaluator")
         };
         let scene = eval
-            .prepare(&crate::testkit::synthetic_lights(3))
+            .prepare(&crate::synthetic::synthetic_lights(3))
             .expect("the synthetic lights prepare");
         let n = 300_007;
         let dirs: Vec<[f32; 3]> = (0..n)

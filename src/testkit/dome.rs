@@ -47,7 +47,7 @@ pub fn prepare_with_filter(
 
 /// Per direction (world, toward the environment), whether the textured dome `light` read
 /// through the nearest (`nearest`) or bilinear filter has a discontinuity within `margin` of it
-/// that f32 may straddle: `check`'s own exclusion, [`crate::check::near_texture_edge`].
+/// that f32 may straddle: `check`'s own exclusion, [`crate::conformance::band::near_texture_edge`].
 pub fn near_discontinuity(
     light: &Light,
     dirs: &[[f32; 3]],
@@ -57,7 +57,7 @@ pub fn near_discontinuity(
     let p = prepared_with_filter(light, nearest)?;
     Ok(dirs
         .iter()
-        .map(|d| crate::check::near_texture_edge(&p, crate::cpu::dvec(*d), margin))
+        .map(|d| crate::conformance::band::near_texture_edge(&p, crate::cpu::dvec(*d), margin))
         .collect())
 }
 

@@ -1,21 +1,20 @@
-//! Test support shared by the test suites, `luxeval check` and `luxeval bench` (behind the
-//! `testkit` feature; the `cli` feature enables it): a seeded generator, randomised lights of
-//! every type and transform, sample generators, and the WGSL irradiance kernel's rule replayed
-//! in f64 (so that tests can separate its quadrature error from f32 rounding).
+//! Test support for the test suites and benches (behind the `testkit` feature; nothing the
+//! command line ships): the seeded lights and samples of `synthetic`, textured and IES-shaped
+//! variants, the WGSL irradiance kernel's rule replayed in f64 (so that tests can separate its
+//! quadrature error from f32 rounding), and the internals the tests look into (the IES reader
+//! and lookup step by step, the WGSL sources, the conformance check's margins).
 
 pub mod dome;
 pub mod ies;
 pub mod ies_replay;
 pub mod kernel_rule;
-pub mod lights;
 pub mod rect;
-mod rng;
-pub mod samples;
 
+pub use crate::synthetic::{
+    Rng, TRANSFORMS, emission_samples, irradiance_samples, radiance_samples, random_light,
+    random_lights, synthetic_lights, transform,
+};
 pub use kernel_rule::kernel_rule_irradiance;
-pub use lights::{TRANSFORMS, random_light, random_lights, synthetic_lights, transform};
-pub use rng::Rng;
-pub use samples::{emission_samples, irradiance_samples, radiance_samples};
 
 /// The WGSL sources and the GPU record layouts, for the offline naga checks of `tests/wgsl.rs`
 /// and `tests/twins.rs`.
@@ -23,4 +22,35 @@ pub mod wgsl {
     pub use crate::gpu::record::{Params, Record};
     pub use crate::gpu::shaders::{Features, Kernel, SOURCES, compose, compose_file};
     pub use crate::rules::IRR_GL_INNER;
+}
+
+/// The IES reader and the f64 lookup step by step (twin of `shaders/shared/ies.wgsl`):
+/// light-space direction → photometric angles → angleScale → folds → bilinear on the file's
+/// own grid.
+pub mod ies_parts {
+    pub use crate::assets::ies::eulumdat::parse_eulumdat;
+    pub use crate::assets::ies::lm63::{TypeCCoverage, type_c_coverage};
+    pub use crate::assets::ies::{parse_any, parse_lm63};
+    pub use crate::prepare::ies::{HFold, VFold};
+
+    pub mod lookup {
+        pub use crate::cpu::ies::{
+            bilinear, fold_h_type_c, fold_mirror, ies_factor, photometric_angles,
+            scale_polar_angle, scaled_direction, type_a_angles, type_b_angles, type_c_angles,
+        };
+    }
+    pub use lookup::ies_factor;
+}
+
+/// The conformance check and its parts: per-sample errors, sample counts and the excluded
+/// band.
+pub mod check {
+    pub use crate::conformance::band::{
+        F32_ROUNDING, IRRADIANCE_SLIVER_FACTOR, emission_margin, intensity_margin,
+        irradiance_margin, near_texture_edge, radiance_margin, texture_floor,
+    };
+    pub use crate::conformance::{
+        BAND, CONE_BAND, CheckReport, CheckedQuery, QueryReport, Samples, TOLERANCE, WorstSample,
+        check, check_with, rel_error, rel_error_above,
+    };
 }

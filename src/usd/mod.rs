@@ -26,5 +26,5 @@ pub(crate) mod stage;
 mod values;
 mod xform;
 
-pub use scene::{Scene, SceneLight, TimeRule};
-pub use stage::{StageInfo, UsdStage as Stage};
+pub use scene::{Stage, StageLight, TimeRule};
+pub use stage::{StageInfo, UsdStage};

@@ -32,7 +32,7 @@ pub enum TimeRule {
 
 /// One light of the stage, listed whether or not luxeval evaluates it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SceneLight {
+pub struct StageLight {
     pub path: String,
     /// The prim's USD type, e.g. `SphereLight`, `DomeLight_1`, or `Mesh` for a MeshLightAPI prim.
     pub usd_type: String,
@@ -59,7 +59,7 @@ fn serialize_is_some<S: serde::Serializer>(
 
 /// A stage's lights at one time.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Scene {
+pub struct Stage {
     pub file: PathBuf,
     /// `Y` or `Z`; `Y` when the stage does not author it, as USD does.
     pub up_axis: String,
@@ -67,7 +67,7 @@ pub struct Scene {
     pub meters_per_unit: f64,
     pub time: TimeRule,
     /// In stage traversal order (depth-first, USD child order).
-    pub lights: Vec<SceneLight>,
+    pub lights: Vec<StageLight>,
 }
 
 impl std::fmt::Display for TimeRule {
@@ -80,16 +80,16 @@ impl std::fmt::Display for TimeRule {
     }
 }
 
-impl Scene {
+impl Stage {
     /// Opens `path` (`.usda`, `.usdc`, `.usdz`) with every composition arc and payload loaded and
     /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
     /// else at USD's EarliestTime (DESIGN.md §2).
     ///
     /// The stage is read on a thread of its own with a large stack (see [`STACK_BYTES`]), so
     /// that a legal deep stage does not overflow the caller's stack.
-    pub fn load(path: &Path, time: Option<f64>) -> Result<Scene> {
+    pub fn load(path: &Path, time: Option<f64>) -> Result<Stage> {
         check_time(time)?;
-        on_large_stack(path, || UsdStage::open(path)?.scene(time))
+        on_large_stack(path, || UsdStage::open(path)?.read(time))
     }
 
     /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
@@ -155,7 +155,7 @@ impl Scene {
 impl UsdStage {
     /// The stage's lights at `time`; without one, at its `startTimeCode` when authored, else at
     /// USD's EarliestTime (DESIGN.md §2 "Query time").
-    pub fn scene(&self, time: Option<f64>) -> Result<Scene> {
+    pub fn read(&self, time: Option<f64>) -> Result<Stage> {
         check_time(time)?;
         let rule = match time {
             Some(t) => TimeRule::Given(t),
@@ -164,11 +164,11 @@ impl UsdStage {
                 None => TimeRule::Earliest,
             },
         };
-        self.scene_at(rule)
+        self.read_at(rule)
     }
 
     /// The stage's lights read as `rule` says.
-    pub fn scene_at(&self, rule: TimeRule) -> Result<Scene> {
+    pub fn read_at(&self, rule: TimeRule) -> Result<Stage> {
         let at = match rule {
             TimeRule::Given(t) | TimeRule::StartTimeCode(t) => {
                 check_time(Some(t))?;
@@ -185,9 +185,9 @@ impl UsdStage {
         let lights = self
             .lights_at(at)?
             .into_iter()
-            .map(|p| SceneLight::from_prim(p, up))
+            .map(|p| StageLight::from_prim(p, up))
             .collect();
-        Ok(Scene {
+        Ok(Stage {
             file: self.file().to_path_buf(),
             up_axis: info.up_axis.clone(),
             meters_per_unit: info.meters_per_unit,
@@ -259,13 +259,13 @@ fn describe_time(rule: TimeRule) -> String {
     }
 }
 
-impl SceneLight {
-    fn from_prim(p: usd::LightPrim, up: UpAxis) -> SceneLight {
+impl StageLight {
+    fn from_prim(p: usd::LightPrim, up: UpAxis) -> StageLight {
         let (light, warning) = match convert(&p, up) {
             Ok((light, caveat)) => (Some(light), caveat),
             Err(why) => (None, Some(why)),
         };
-        SceneLight {
+        StageLight {
             path: p.path,
             usd_type: p.usd_type,
             applied_schemas: p.applied_schemas,
@@ -691,17 +691,17 @@ mod tests {
 
     #[test]
     fn evaluable_filters_and_rejects_unknown_selection() {
-        let mut hidden = SceneLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
+        let mut hidden = StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
         hidden.path = "/Lights/Hidden".into();
         hidden.visible = false;
-        let scene = Scene {
+        let scene = Stage {
             file: "x.usda".into(),
             up_axis: "Y".into(),
             meters_per_unit: 0.01,
             time: TimeRule::Earliest,
             lights: vec![
-                SceneLight::from_prim(prim("DiskLight", &[]), UpAxis::Y),
-                SceneLight::from_prim(prim("PortalLight", &[]), UpAxis::Y),
+                StageLight::from_prim(prim("DiskLight", &[]), UpAxis::Y),
+                StageLight::from_prim(prim("PortalLight", &[]), UpAxis::Y),
                 hidden,
             ],
         };
@@ -724,7 +724,7 @@ mod tests {
 
     #[test]
     fn json_shape() {
-        let l = SceneLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
+        let l = StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
         let v = serde_json::to_value(&l).unwrap();
         assert_eq!(v["evaluable"], serde_json::json!(true));
         assert_eq!(v["inputs"][0]["value"], serde_json::json!(1.0));

@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use glam::DVec3;
-use luxeval::ies::{IesFile, Profile};
+use luxeval::{IesFile, IesProfile as Profile};
 
 /// An LM-63 file to write. `values` are h-major (`values[i·nV + j]` at `(h[i], v[j])`).
 #[derive(Clone)]
@@ -99,11 +99,11 @@ pub fn no_tilt(name: &str) -> Result<Vec<u8>, String> {
 }
 
 pub fn parse(text: &str) -> IesFile {
-    luxeval::ies::parse_any(text.as_bytes(), &no_tilt).unwrap_or_else(|e| panic!("{e}\n{text}"))
+    luxeval::testkit::ies_parts::parse_any(text.as_bytes(), &no_tilt).unwrap_or_else(|e| panic!("{e}\n{text}"))
 }
 
-pub fn parse_err(text: &str) -> luxeval::ies::IesError {
-    match luxeval::ies::parse_any(text.as_bytes(), &no_tilt) {
+pub fn parse_err(text: &str) -> luxeval::IesError {
+    match luxeval::testkit::ies_parts::parse_any(text.as_bytes(), &no_tilt) {
         Ok(_) => panic!("accepted:\n{text}"),
         Err(e) => e,
     }

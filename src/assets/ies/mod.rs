@@ -9,4 +9,6 @@ mod text;
 
 pub use error::{IesError, IesErrorKind};
 pub use eulumdat::{parse_any, read_file};
-pub use lm63::{IesFile, PhotometricType, parse_lm63};
+#[cfg(any(test, feature = "testkit"))]
+pub use lm63::parse_lm63;
+pub use lm63::{IesFile, PhotometricType};

@@ -109,7 +109,7 @@ mod tests {
     use crate::model::{Light, LightType, Shaping};
     use crate::prepare::TemperatureMode;
     use crate::prepare::dome::RectTexture;
-    use crate::testkit::Rng;
+    use crate::synthetic::Rng;
 
     fn textured(l: &Light, w: usize, h: usize, rgb: Vec<[f32; 3]>, filter: Filter) -> Prepared {
         let mut p = Prepared::new(l, TemperatureMode::Spec).unwrap();

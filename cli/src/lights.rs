@@ -1,0 +1,82 @@
+//! `luxeval lights`: every light of a stage with its type, visibility, world matrix and every
+//! input, authored or the schema fallback.
+
+use std::path::Path;
+
+use luxeval::{Power, Reference, StageLight, TemperatureMode};
+
+use crate::exit::{CliResult, Failure};
+
+/// A light's total emitted power (DESIGN.md §3 "intensity" integrated over the sphere):
+/// `Ok(None)` for lights at infinity (distant, dome) or not evaluated; `Err` when the light
+/// cannot be prepared (a missing IES file, ...). The JSON records get the same from
+/// `luxeval::lights_json`.
+fn power(l: &StageLight) -> Result<Option<Power>, String> {
+    let Some(light) = &l.light else {
+        return Ok(None);
+    };
+    let r = Reference::new(light, TemperatureMode::default()).map_err(|e| e.to_string())?;
+    Ok(r.power())
+}
+
+pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
+    let scene = crate::open::load(path, time)?;
+    if json {
+        let runtime = |e: serde_json::Error| Failure::runtime(e.to_string());
+        let mut v = serde_json::to_value(&scene).map_err(runtime)?;
+        v["lights"] = luxeval::lights_json(&scene).map_err(runtime)?;
+        outln!("{}", serde_json::to_string_pretty(&v).map_err(runtime)?);
+        return Ok(());
+    }
+    outln!("{}", scene.file.display());
+    outln!(
+        "  upAxis {}, metersPerUnit {}, time {}",
+        scene.up_axis,
+        scene.meters_per_unit,
+        scene.time
+    );
+    for l in &scene.lights {
+        let status = match (&l.light, l.visible) {
+            (Some(_), true) => "evaluated",
+            (_, false) => "invisible: skipped",
+            (None, true) => "not evaluated",
+        };
+        outln!("\n{} ({}) [{}]", l.path, l.usd_type, status);
+        if !l.applied_schemas.is_empty() {
+            outln!("  apiSchemas: {}", l.applied_schemas.join(", "));
+        }
+        if let Some(w) = &l.warning {
+            outln!("  warning: {w}");
+        }
+        match power(l) {
+            Ok(Some(p)) => outln!(
+                "  power  {:.6} lm ({:.6} W at 683 lm/W; RGB flux ({:.6}, {:.6}, {:.6}))",
+                p.lumens,
+                p.watts,
+                p.rgb[0],
+                p.rgb[1],
+                p.rgb[2]
+            ),
+            Ok(None) => {}
+            Err(e) => outln!("  power  cannot be computed: {e}"),
+        }
+        for row in &l.world {
+            outln!(
+                "  world  {:>12.6} {:>12.6} {:>12.6} {:>12.6}",
+                row[0],
+                row[1],
+                row[2],
+                row[3]
+            );
+        }
+        for i in &l.inputs {
+            outln!(
+                "  {:<34} {}{}",
+                i.name,
+                i.value,
+                if i.authored { "" } else { "  (fallback)" }
+            );
+        }
+    }
+    Ok(())
+}

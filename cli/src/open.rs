@@ -1,0 +1,103 @@
+//! The one opening path of every scene command: load the stage, print its warnings, select and
+//! validate the lights, open the device, prepare the lights once.
+
+use luxeval::{Evaluator, Light, LuxError, PreparedScene, Stage};
+
+use crate::args::{DeviceArg, SceneArgs, ToleranceArg};
+use crate::exit::{CliResult, Failure, in_scene};
+
+/// The selected, visible, evaluable lights of the stage, validated (an invalid attribute is
+/// reported with the stage it comes from), their textures read with `--texture-filter`. Prints
+/// the stage's warnings.
+pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
+    let scene = load(&args.scene, args.time.time)?;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let mut lights = scene.evaluable(&args.lights)?;
+    for l in &mut lights {
+        l.validate().map_err(|e| in_scene(&args.scene, e))?;
+        if let Some(t) = &mut l.texture {
+            t.filter = args.texture_filter.into();
+        }
+    }
+    Ok(lights)
+}
+
+/// Loads the stage; an error about a light's attribute or transform is prefixed with the stage's
+/// path (file errors already name their file).
+pub fn load(path: &std::path::Path, time: Option<f64>) -> CliResult<Stage> {
+    Stage::load(path, time).map_err(|e| match e {
+        LuxError::InvalidAttribute { .. } | LuxError::InvalidTransform { .. } => in_scene(path, e),
+        e => e.into(),
+    })
+}
+
+/// The evaluator `device` asks for: the GPU (an error when there is none), the CPU, or by
+/// default the GPU with a fallback to the CPU reference and a warning.
+pub fn evaluator(device: Option<DeviceArg>, args: &SceneArgs) -> CliResult<Evaluator> {
+    let eval = match device {
+        Some(DeviceArg::Cpu) => Evaluator::cpu(),
+        Some(DeviceArg::Gpu) => Evaluator::gpu()?,
+        None => match Evaluator::gpu() {
+            Ok(e) => e,
+            Err(LuxError::NoAdapter { reason, .. }) => {
+                eprintln!("warning: no GPU adapter ({reason}); using the CPU reference");
+                Evaluator::cpu()
+            }
+            Err(e) => return Err(e.into()),
+        },
+    };
+    Ok(eval.with_temperature_mode(args.temperature_mode.into()))
+}
+
+/// Loads, selects and prepares the lights on the chosen device.
+pub fn prepare(
+    args: &SceneArgs,
+    device: Option<DeviceArg>,
+) -> CliResult<(Evaluator, PreparedScene)> {
+    prepare_with(args, device, None)
+}
+
+/// [`prepare`] for irradiance to a relative tolerance (`--tolerance`); checked before the stage
+/// is read, so that a bad value costs nothing.
+pub fn prepare_irradiance(
+    args: &SceneArgs,
+    device: Option<DeviceArg>,
+    tolerance: ToleranceArg,
+) -> CliResult<(Evaluator, PreparedScene)> {
+    prepare_with(args, device, Some(tolerance.tolerance))
+}
+
+fn prepare_with(
+    args: &SceneArgs,
+    device: Option<DeviceArg>,
+    tolerance: Option<f64>,
+) -> CliResult<(Evaluator, PreparedScene)> {
+    if let Some(rel) = tolerance {
+        // The range alone, before the stage is read (the device's own bound is checked below).
+        Evaluator::cpu()
+            .with_irradiance_tolerance(rel)
+            .map_err(|e| Failure::bad_input(format!("--{e}")))?;
+    }
+    let lights = lights(args)?;
+    if lights.is_empty() {
+        eprintln!(
+            "warning: {}: no light to evaluate; the output is all zeros",
+            args.scene.display()
+        );
+    }
+    let mut eval = evaluator(device, args)?;
+    if let Some(rel) = tolerance {
+        eval = eval
+            .with_irradiance_tolerance(rel)
+            .map_err(|e| Failure::bad_input(format!("--{e}")))?;
+    }
+    let scene = eval
+        .prepare(&lights)
+        .map_err(|e| in_scene(&args.scene, e))?;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
+    Ok((eval, scene))
+}

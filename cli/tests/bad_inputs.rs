@@ -1,0 +1,421 @@
+//! The bad-input corpus (`tests/data/bad/`, written by `tools/gen_bad_corpus.py`): one test per
+//! case runs the `luxeval` binary and checks the CLI contract (DESIGN.md §4, docs/INPUTS.md):
+//! the exit code; the file and the prim, attribute, row or line named in the message; no panic
+//! or abort; no output (not even a temporary) left behind by a failure; every input unchanged
+//! (hashed before and after); and no NaN or infinity in what a successful run writes.
+//!
+//! Each case runs in a fresh temporary directory: the corpus files it names (`{in}/NAME`) are
+//! copied to `{in}/` first, so a failing case can never damage the corpus; outputs go to
+//! `{out}/`. Adding a case (also for IES profiles and textures): put the file in the generator,
+//! then one line in the `cases!` table below.
+
+use crate::common;
+
+use std::collections::BTreeMap;
+use std::hash::{Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// One corpus case.
+#[derive(Default)]
+struct Case {
+    /// Arguments; `{in}` is the directory of copied inputs, `{out}` the output directory.
+    args: &'static [&'static str],
+    /// Expected exit code.
+    exit: i32,
+    /// Substrings the message on stderr must contain (placeholders expanded).
+    says: &'static [&'static str],
+    /// Extra environment.
+    env: &'static [(&'static str, &'static str)],
+    /// Prepares `{in}` after the copies (links, pipes, directories).
+    setup: Option<fn(&Path)>,
+    /// When set, a second run with these arguments writes `{out}/ref.npy`, which must equal the
+    /// case's `{out}/out.npy` (for inputs that must mean the same as a plain one).
+    same_as: &'static [&'static str],
+    /// The case's output must hold a non-zero value (a light that must not have been dropped).
+    lit: bool,
+    /// Limit the size of files the process may write (simulates a full disk: writes fail with
+    /// EFBIG; SIGXFSZ is ignored so that the write fails instead of killing the process).
+    fsize: Option<u64>,
+    /// Needs a GPU adapter (skipped with a note without one, failed under CI=true).
+    gpu: bool,
+}
+
+fn corpus() -> PathBuf {
+    crate::repo().join("tests/data/bad")
+}
+
+fn hash_file(p: &Path) -> u64 {
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    std::fs::read(p).unwrap().hash(&mut h);
+    h.finish()
+}
+
+/// Every entry under `dir` (not following links) with a hash of each regular file's bytes.
+fn snapshot(dir: &Path) -> BTreeMap<PathBuf, Option<u64>> {
+    let mut out = BTreeMap::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            let meta = std::fs::symlink_metadata(&p).unwrap();
+            if meta.is_dir() {
+                todo.push(p.clone());
+                out.insert(p, None);
+            } else if meta.is_file() {
+                out.insert(p.clone(), Some(hash_file(&p)));
+            } else {
+                out.insert(p, None);
+            }
+        }
+    }
+    out
+}
+
+fn expand(s: &str, input: &Path, out: &Path) -> String {
+    s.replace("{in}", &input.to_string_lossy())
+        .replace("{out}", &out.to_string_lossy())
+}
+
+fn command(args: &[String], env: &[(&str, &str)], fsize: Option<u64>) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_luxeval"));
+    c.args(args).env("RUST_BACKTRACE", "1");
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    if let Some(limit) = fsize {
+        use std::os::unix::process::CommandExt;
+        // SAFETY: only async-signal-safe calls between fork and exec.
+        unsafe {
+            c.pre_exec(move || {
+                libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+                let r = libc::rlimit {
+                    rlim_cur: limit,
+                    rlim_max: limit,
+                };
+                if libc::setrlimit(libc::RLIMIT_FSIZE, &r) != 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                Ok(())
+            });
+        }
+    }
+    c
+}
+
+/// Every float of an output the run wrote: `.npy` (float32) or `.exr`.
+fn output_values(p: &Path) -> Vec<f32> {
+    match p.extension().and_then(|e| e.to_str()) {
+        Some("npy") => {
+            let bytes = std::fs::read(p).unwrap();
+            let f = npyz::NpyFile::new(&bytes[..]).unwrap();
+            f.into_vec::<f32>().unwrap()
+        }
+        Some("exr") => luxeval_cli::io::exr::read_exr(p)
+            .unwrap()
+            .rgb
+            .into_iter()
+            .flatten()
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
+fn run(name: &str, case: &Case) {
+    if case.gpu && common::gpu().is_none() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let input = tmp.path().join("in");
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&input).unwrap();
+    std::fs::create_dir(&out).unwrap();
+    // Copy the corpus files the case names, and the files they compose with.
+    for a in case.args.iter().chain(case.same_as) {
+        if let Some(name) = a.strip_prefix("{in}/") {
+            let src = corpus().join(name);
+            if src.is_file() {
+                std::fs::copy(&src, input.join(name)).unwrap();
+            }
+        }
+    }
+    for companion in [
+        "reference_cycle_b.usda",
+        "sublayer_cycle_b.usda",
+        "big_layer.usda",
+        "ies_truncated.ies",
+    ] {
+        std::fs::copy(corpus().join(companion), input.join(companion)).unwrap();
+    }
+    if let Some(setup) = case.setup {
+        setup(&input);
+    }
+    let before = snapshot(&input);
+    let args: Vec<String> = case.args.iter().map(|a| expand(a, &input, &out)).collect();
+    let o = command(&args, case.env, case.fsize).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    let context = format!("case {name}: luxeval {}\nstderr:\n{stderr}", args.join(" "));
+    for crash in [
+        "panicked",
+        "overflowed its stack",
+        "fatal runtime error",
+        "RUST_BACKTRACE",
+    ] {
+        assert!(!stderr.contains(crash), "{context}");
+    }
+    assert_eq!(o.status.code(), Some(case.exit), "{context}");
+    for s in case.says {
+        let s = expand(s, &input, &out);
+        assert!(
+            stderr.contains(&s),
+            "expected {s:?} in the message; {context}"
+        );
+    }
+    assert_eq!(snapshot(&input), before, "the inputs changed; {context}");
+    let written = snapshot(&out);
+    if case.exit != 0 {
+        assert!(
+            written.is_empty(),
+            "a failed run left {written:?}; {context}"
+        );
+        return;
+    }
+    let mut any_lit = false;
+    for p in written.keys() {
+        let v = output_values(p);
+        assert!(
+            v.iter().all(|x| x.is_finite()),
+            "{} holds NaN or infinity; {context}",
+            p.display()
+        );
+        any_lit |= v.iter().any(|x| *x != 0.0);
+    }
+    assert!(!case.lit || any_lit, "the output is all zeros; {context}");
+    if !case.same_as.is_empty() {
+        let args: Vec<String> = case
+            .same_as
+            .iter()
+            .map(|a| expand(a, &input, &out))
+            .collect();
+        let r = command(&args, case.env, None).output().unwrap();
+        assert!(r.status.success(), "reference run failed; {context}");
+        assert_eq!(
+            std::fs::read(out.join("out.npy")).unwrap(),
+            std::fs::read(out.join("ref.npy")).unwrap(),
+            "not the same output as {:?}; {context}",
+            case.same_as
+        );
+    }
+}
+
+/// One `#[test]` per case.
+macro_rules! cases {
+    ($($name:ident: $case:expr;)*) => {
+        $(
+            #[test]
+            fn $name() {
+                run(stringify!($name), &$case);
+            }
+        )*
+        /// Every case's name, for the count below.
+        const CASES: &[&str] = &[$(stringify!($name)),*];
+    };
+}
+
+/// `emission` on the CPU with the given scene and directions.
+macro_rules! emission {
+    ($scene:expr, $dirs:expr) => {
+        &[
+            "emission",
+            $scene,
+            "--dirs",
+            $dirs,
+            "-o",
+            "{out}/out.npy",
+            "--device",
+            "cpu",
+        ]
+    };
+}
+
+fn mkdir_sub(d: &Path) {
+    std::fs::create_dir(d.join("sub")).unwrap();
+}
+fn symlink_dirs(d: &Path) {
+    std::os::unix::fs::symlink(d.join("dirs.npy"), d.join("link.npy")).unwrap();
+}
+fn hardlink_dirs(d: &Path) {
+    std::fs::hard_link(d.join("dirs.npy"), d.join("hard.npy")).unwrap();
+}
+fn fifo(d: &Path) {
+    let p = std::ffi::CString::new(d.join("pipe").to_str().unwrap()).unwrap();
+    // SAFETY: a valid C string.
+    assert_eq!(unsafe { libc::mkfifo(p.as_ptr(), 0o644) }, 0);
+}
+fn zero_dirs(d: &Path) {
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.npy")).unwrap();
+}
+fn zero_scene(d: &Path) {
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.usda")).unwrap();
+}
+fn zero_sublayer(d: &Path) {
+    std::os::unix::fs::symlink("/dev/zero", d.join("zero.usda")).unwrap();
+    std::fs::write(
+        d.join("sublayer_zero.usda"),
+        "#usda 1.0\n(\n    subLayers = [@zero.usda@]\n)\n",
+    )
+    .unwrap();
+}
+
+const NO_GPU: &[(&str, &str)] = &[
+    ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+    ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+];
+
+cases! {
+    // --- An output path that is one of the inputs, by any spelling, or not a file ---------------
+    output_is_dirs: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/dirs.npy", "--device", "cpu"], exit: 2, says: &["-o", "--dirs", "dirs.npy", "the same file"], ..Case::default() };
+    output_is_points: Case { args: &["radiance", "{in}/ok.usda", "--points", "{in}/points.npy", "--dirs", "{in}/dirs.npy", "-o", "{in}/points.npy", "--device", "cpu"], exit: 2, says: &["--points", "points.npy"], ..Case::default() };
+    output_is_radiance_dirs: Case { args: &["radiance", "{in}/ok.usda", "--points", "{in}/points.npy", "--dirs", "{in}/dirs.npy", "-o", "{in}/dirs.npy", "--device", "cpu"], exit: 2, says: &["--dirs", "dirs.npy"], ..Case::default() };
+    output_is_normals: Case { args: &["irradiance", "{in}/ok.usda", "--points", "{in}/points.npy", "--normals", "{in}/normals.npy", "-o", "{in}/normals.npy", "--device", "cpu"], exit: 2, says: &["--normals", "normals.npy"], ..Case::default() };
+    output_is_scene: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/ok.usda", "--device", "cpu"], exit: 2, says: &["SCENE", "ok.usda"], ..Case::default() };
+    output_is_input_through_dotdot: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/sub/../dirs.npy", "--device", "cpu"], exit: 2, says: &["sub/../dirs.npy", "--dirs"], setup: Some(mkdir_sub), ..Case::default() };
+    output_is_input_through_symlink: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/link.npy", "--device", "cpu"], exit: 2, says: &["link.npy", "--dirs"], setup: Some(symlink_dirs), ..Case::default() };
+    output_is_input_through_hard_link: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/hard.npy", "--device", "cpu"], exit: 2, says: &["hard.npy", "--dirs"], setup: Some(hardlink_dirs), ..Case::default() };
+    falloff_png_is_exr: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{out}/m.exr", "--png", "{out}/m.exr", "--device", "cpu"], exit: 2, says: &["--png", "-o", "m.exr"], ..Case::default() };
+    falloff_output_is_scene: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{in}/ok.usda", "--device", "cpu"], exit: 2, says: &["SCENE", "ok.usda"], ..Case::default() };
+    output_is_a_pipe: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/pipe", "--device", "cpu"], exit: 2, says: &["pipe", "not a regular file"], setup: Some(fifo), ..Case::default() };
+    output_is_a_directory: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/sub", "--device", "cpu"], exit: 2, says: &["sub", "not a regular file"], setup: Some(mkdir_sub), ..Case::default() };
+    output_in_missing_directory: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/no/such/dir/o.npy", "--device", "cpu"], exit: 2, says: &["{out}/no/such/dir/o.npy"], ..Case::default() };
+
+    // --- Composition: cycles, depth, arc chains, prim counts ------------------------------------
+    self_inherit: Case { args: &["lights", "{in}/self_inherit.usda"], exit: 2, says: &["self_inherit.usda", "</L>", "cycle", "inherits"], ..Case::default() };
+    class_inherits_itself: Case { args: &["lights", "{in}/class_inherits_itself.usda"], exit: 2, says: &["class_inherits_itself.usda", "</C>", "cycle"], ..Case::default() };
+    class_inherits_itself_usdc: Case { args: &["lights", "{in}/class_inherits_itself.usdc"], exit: 2, says: &["class_inherits_itself.usdc", "</C>", "cycle"], ..Case::default() };
+    inherit_ancestor: Case { args: &["lights", "{in}/inherit_ancestor.usda"], exit: 2, says: &["inherit_ancestor.usda", "</A/B>", "cycle"], ..Case::default() };
+    inherit_descendant: Case { args: &["lights", "{in}/inherit_descendant.usda"], exit: 2, says: &["inherit_descendant.usda", "</L/C>", "cycle"], ..Case::default() };
+    reference_self: Case { args: &["lights", "{in}/reference_self.usda"], exit: 2, says: &["reference_self.usda", "</L>", "references"], ..Case::default() };
+    specialize_self: Case { args: &["lights", "{in}/specialize_self.usda"], exit: 2, says: &["specialize_self.usda", "</L>", "specializes"], ..Case::default() };
+    reference_cycle_across_files: Case { args: &["lights", "{in}/reference_cycle_a.usda"], exit: 2, says: &["reference_cycle_a.usda", "reference_cycle_b.usda", "cycle"], ..Case::default() };
+    sublayer_cycle: Case { args: &["lights", "{in}/sublayer_cycle_a.usda"], exit: 2, says: &["sublayer_cycle_a.usda", "sublayer_cycle_b.usda", "sublayer cycle"], ..Case::default() };
+    namespace_10000_deep: Case { args: &["lights", "{in}/deep_10000.usda"], exit: 2, says: &["deep_10000.usda", "LUXEVAL_MAX_PRIM_DEPTH"], ..Case::default() };
+    namespace_1001_deep: Case { args: &["lights", "{in}/deep_1001.usda"], exit: 2, says: &["deep_1001.usda", "</p0>", "1001 levels", "LUXEVAL_MAX_PRIM_DEPTH"], ..Case::default() };
+    namespace_150_deep_is_legal: Case { args: emission!("{in}/deep_150.usda", "{in}/dirs.npy"), exit: 0, lit: true, ..Case::default() };
+    arc_chain_98_is_legal: Case { args: emission!("{in}/chain_98.usda", "{in}/dirs.npy"), exit: 0, lit: true, ..Case::default() };
+    arc_chain_99: Case { args: &["lights", "{in}/chain_99.usda"], exit: 2, says: &["chain_99.usda", "</R0>", "99 nested composition arcs", "98"], ..Case::default() };
+    arc_chain_150: Case { args: emission!("{in}/chain_150.usda", "{in}/dirs.npy"), exit: 2, says: &["chain_150.usda", "</R", "composition arcs"], ..Case::default() };
+    prim_explosion: Case { args: &["lights", "{in}/prim_explosion.usda"], exit: 2, says: &["prim_explosion.usda", "</L0>", "LUXEVAL_MAX_PRIMS"], ..Case::default() };
+    prim_limit_lowered: Case { args: &["lights", "{in}/prims_120.usda"], exit: 2, env: &[("LUXEVAL_MAX_PRIMS", "100")], says: &["prims_120.usda", "up to 111 prims", "</L0>", "LUXEVAL_MAX_PRIMS"], ..Case::default() };
+
+    // --- LightAPI on a prim that is not a light type: listed with a warning, not dropped --------
+    lightapi_on_xform: Case { args: emission!("{in}/lightapi_on_xform.usda", "{in}/dirs.npy"), exit: 0, says: &["warning", "/Rig", "LightAPI", "Xform"], ..Case::default() };
+    lightapi_on_unknown_type: Case { args: emission!("{in}/lightapi_on_unknown_type.usda", "{in}/dirs.npy"), exit: 0, says: &["warning", "/Fancy", "LightAPI", "FancyLight"], ..Case::default() };
+    lightapi_on_untyped_prim: Case { args: &["lights", "{in}/lightapi_on_untyped.usda"], exit: 0, ..Case::default() };
+
+    // --- Finite inputs whose values do not fit float32 ------------------------------------------
+    exposure_200: Case { args: emission!("{in}/exposure_200.usda", "{in}/dirs.npy"), exit: 2, says: &["exposure_200.usda", "/L", "inputs:exposure", "float32"], ..Case::default() };
+    intensity_1e39: Case { args: emission!("{in}/intensity_1e39.usda", "{in}/dirs.npy"), exit: 2, says: &["intensity_1e39.usda", "/L", "inputs:intensity", "float32"], ..Case::default() };
+    color_1e39: Case { args: emission!("{in}/color_1e39.usda", "{in}/dirs.npy"), exit: 2, says: &["color_1e39.usda", "inputs:color"], ..Case::default() };
+    normalize_tiny_light: Case { args: emission!("{in}/normalize_tiny.usda", "{in}/dirs.npy"), exit: 2, says: &["normalize_tiny.usda", "/L", "inputs:normalize", "float32"], ..Case::default() };
+    radius_1e19: Case { args: emission!("{in}/radius_1e19.usda", "{in}/dirs.npy"), exit: 2, says: &["radius_1e19.usda", "/L", "inputs:radius"], ..Case::default() };
+    translate_1e19: Case { args: emission!("{in}/translate_1e19.usda", "{in}/dirs.npy"), exit: 2, says: &["translate_1e19.usda", "/L", "world transform"], ..Case::default() };
+    sum_over_lights_overflows: Case { args: emission!("{in}/domes_sum_overflows.usda", "{in}/dirs.npy"), exit: 2, says: &["row 0", "overflows float32"], ..Case::default() };
+    point_light_irradiance_on_the_light: Case { args: &["irradiance", "{in}/point_light.usda", "--points", "{in}/point_on_light.npy", "--normals", "{in}/normal_down.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["row 0", "overflows float32"], ..Case::default() };
+    dirs_f64_huge_mean_their_direction: Case { args: emission!("{in}/ok.usda", "{in}/dirs_f64_huge.npy"), exit: 0, lit: true, same_as: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/ref.npy", "--device", "cpu"], ..Case::default() };
+    dirs_f32_subnormal_mean_their_direction: Case { args: emission!("{in}/ok.usda", "{in}/dirs_f32_subnormal.npy"), exit: 0, lit: true, same_as: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/ref.npy", "--device", "cpu"], ..Case::default() };
+    dirs_f32_huge_on_the_gpu: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs_f32_huge.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 0, lit: true, gpu: true, same_as: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/ref.npy", "--device", "gpu"], ..Case::default() };
+    dirs_f32_subnormal_on_the_gpu: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs_f32_subnormal.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 0, lit: true, gpu: true, same_as: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/ref.npy", "--device", "gpu"], ..Case::default() };
+    points_f64_beyond_float32: Case { args: &["radiance", "{in}/ok.usda", "--points", "{in}/points_f64_huge.npy", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["points_f64_huge.npy", "row 1", "float32"], ..Case::default() };
+
+    // --- Counts and sizes that overflow or exceed a limit; endless inputs -----------------------
+    npy_rows_times_size_wraps: Case { args: emission!("{in}/ok.usda", "{in}/npy_rows_wrap.npy"), exit: 2, says: &["npy_rows_wrap.npy", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
+    npy_rows_wrap_with_samples_unlimited: Case { args: emission!("{in}/ok.usda", "{in}/npy_rows_wrap.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "18446744073709551615")], says: &["npy_rows_wrap.npy", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
+    npy_more_rows_than_data: Case { args: emission!("{in}/ok.usda", "{in}/npy_more_rows_than_data.npy"), exit: 2, says: &["npy_more_rows_than_data.npy", "ends inside the data"], ..Case::default() };
+    npy_trailing_data: Case { args: emission!("{in}/ok.usda", "{in}/npy_trailing_data.npy"), exit: 2, says: &["npy_trailing_data.npy", "more data"], ..Case::default() };
+    npy_huge_header: Case { args: emission!("{in}/ok.usda", "{in}/npy_huge_header.npy"), exit: 2, says: &["npy_huge_header.npy", "header of"], ..Case::default() };
+    check_samples_1e12: Case { args: &["check", "{in}/ok.usda", "--samples", "1000000000000"], exit: 2, says: &["--samples", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
+    bench_samples_1e12: Case { args: &["bench", "--samples", "1000000000000"], exit: 2, says: &["--samples", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
+    bench_lights_1e12: Case { args: &["bench", "--lights", "1000000000000"], exit: 2, says: &["--lights", "LUXEVAL_MAX_PRIMS"], ..Case::default() };
+    bench_command_sets_device: Case { args: &["bench", "--no-startup", "--no-dome", "--command", "falloff {in}/ok.usda --device cpu"], exit: 2, says: &["--command", "--device"], ..Case::default() };
+    bench_command_empty: Case { args: &["bench", "--no-startup", "--no-dome", "--command", "  "], exit: 2, says: &["--command"], ..Case::default() };
+    bench_command_bad_scene: Case { args: &["bench", "--no-startup", "--no-dome", "--samples", "8", "--cpu-samples", "8", "--lights", "1", "--command", "emission {in}/missing.usda --dirs {in}/dirs.npy -o {out}/out.npy"], exit: 2, says: &["--command", "missing.usda"], ..Case::default() };
+    falloff_res_1e10_pixels: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "100000,100000", "-o", "{out}/m.exr", "--device", "cpu"], exit: 2, says: &["--res", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
+    dirs_link_to_dev_zero: Case { args: emission!("{in}/ok.usda", "{in}/zero.npy"), exit: 2, says: &["zero.npy"], setup: Some(zero_dirs), ..Case::default() };
+    scene_link_to_dev_zero: Case { args: emission!("{in}/zero.usda", "{in}/dirs.npy"), exit: 2, says: &["zero.usda", "not a regular file"], setup: Some(zero_scene), ..Case::default() };
+    sublayer_link_to_dev_zero: Case { args: &["lights", "{in}/sublayer_zero.usda"], exit: 2, says: &["zero.usda", "sublayer_zero.usda"], setup: Some(zero_sublayer), ..Case::default() };
+    npy_over_file_limit: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "100")], says: &["dirs.npy", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
+    scene_over_file_limit: Case { args: &["lights", "{in}/ok.usda"], exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "100")], says: &["ok.usda", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
+    referenced_layer_over_file_limit: Case { args: &["lights", "{in}/references_big_layer.usda"], exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "1000")], says: &["big_layer.usda", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
+    rows_over_sample_limit: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "3")], says: &["dirs.npy", "4 rows", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
+    per_light_rows_over_sample_limit: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu", "--per-light"], exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "7")], says: &["lights × rows", "8 rows"], ..Case::default() };
+    limit_variable_not_a_number: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "lots")], says: &["LUXEVAL_MAX_SAMPLES", "\"lots\""], ..Case::default() };
+
+    // --- Values of the wrong type, or NaN -------------------------------------------------------
+    color_int3: Case { args: emission!("{in}/color_int3.usda", "{in}/dirs.npy"), exit: 2, says: &["color_int3.usda", "/L", "inputs:color", "color3f"], ..Case::default() };
+    intensity_int: Case { args: emission!("{in}/intensity_int.usda", "{in}/dirs.npy"), exit: 2, says: &["intensity_int.usda", "/L", "inputs:intensity"], ..Case::default() };
+    intensity_string: Case { args: &["lights", "{in}/intensity_string.usda"], exit: 2, says: &["intensity_string.usda", "/L", "inputs:intensity"], ..Case::default() };
+    normalize_string: Case { args: emission!("{in}/normalize_string.usda", "{in}/dirs.npy"), exit: 2, says: &["normalize_string.usda", "/L", "inputs:normalize"], ..Case::default() };
+    start_time_code_nan: Case { args: emission!("{in}/start_time_nan.usda", "{in}/dirs.npy"), exit: 2, says: &["start_time_nan.usda", "startTimeCode"], ..Case::default() };
+    start_time_code_inf: Case { args: &["lights", "{in}/start_time_inf.usda"], exit: 2, says: &["start_time_inf.usda", "startTimeCode"], ..Case::default() };
+    intensity_nan: Case { args: emission!("{in}/intensity_nan.usda", "{in}/dirs.npy"), exit: 2, says: &["intensity_nan.usda", "/L", "inputs:intensity", "finite"], ..Case::default() };
+    intensity_nan_time_sample: Case { args: emission!("{in}/intensity_nan_sample.usda", "{in}/dirs.npy"), exit: 2, says: &["intensity_nan_sample.usda", "/L", "inputs:intensity"], ..Case::default() };
+    time_argument_nan: Case { args: &["lights", "{in}/ok.usda", "--time", "nan"], exit: 2, says: &["--time"], ..Case::default() };
+
+    // --- Messages name the file (and prim, attribute or row) ------------------------------------
+    zero_size_light_with_normalize: Case { args: emission!("{in}/zero_size_normalize.usda", "{in}/dirs.npy"), exit: 2, says: &["zero_size_normalize.usda", "/L", "inputs:normalize"], ..Case::default() };
+    negative_radius: Case { args: emission!("{in}/negative_radius.usda", "{in}/dirs.npy"), exit: 2, says: &["negative_radius.usda", "/L", "inputs:radius"], ..Case::default() };
+    singular_transform: Case { args: emission!("{in}/singular_scale.usda", "{in}/dirs.npy"), exit: 2, says: &["singular_scale.usda", "/L", "singular"], ..Case::default() };
+    dirs_row_nan: Case { args: emission!("{in}/ok.usda", "{in}/dirs_nan.npy"), exit: 2, says: &["dirs_nan.npy", "row 2", "not finite"], ..Case::default() };
+    dirs_row_zero: Case { args: emission!("{in}/ok.usda", "{in}/dirs_zero_row.npy"), exit: 2, says: &["dirs_zero_row.npy", "row 1", "zero"], ..Case::default() };
+    points_row_inf: Case { args: &["irradiance", "{in}/ok.usda", "--points", "{in}/points_inf.npy", "--normals", "{in}/normals.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["points_inf.npy", "row 0"], ..Case::default() };
+    normals_row_zero: Case { args: &["irradiance", "{in}/ok.usda", "--points", "{in}/points.npy", "--normals", "{in}/normals_zero.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["normals_zero.npy", "row 2"], ..Case::default() };
+    radiance_row_counts_differ: Case { args: &["radiance", "{in}/ok.usda", "--points", "{in}/points.npy", "--dirs", "{in}/dirs5.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["points.npy", "dirs5.npy", "4 rows", "5"], ..Case::default() };
+    irradiance_row_counts_differ: Case { args: &["irradiance", "{in}/ok.usda", "--points", "{in}/points.npy", "--normals", "{in}/dirs5.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["points.npy", "dirs5.npy"], ..Case::default() };
+
+    // --- Malformed files ------------------------------------------------------------------------
+    malformed_usda: Case { args: &["lights", "{in}/malformed.usda"], exit: 2, says: &["malformed.usda:"], ..Case::default() };
+    missing_reference: Case { args: &["lights", "{in}/missing_reference.usda"], exit: 2, says: &["does_not_exist.usda", "missing_reference.usda"], ..Case::default() };
+    empty_usda: Case { args: &["lights", "{in}/empty.usda"], exit: 2, says: &["empty.usda"], ..Case::default() };
+    not_usd: Case { args: &["lights", "{in}/not_usd.usda"], exit: 2, says: &["not_usd.usda"], ..Case::default() };
+    truncated_usdc: Case { args: &["lights", "{in}/truncated.usdc"], exit: 2, says: &["truncated.usdc"], ..Case::default() };
+    usdc_table_of_contents_far_away: Case { args: &["lights", "{in}/toc_offset.usdc"], exit: 2, says: &["toc_offset.usdc"], ..Case::default() };
+    corrupt_usdz: Case { args: &["lights", "{in}/corrupt.usdz"], exit: 2, says: &["corrupt.usdz"], ..Case::default() };
+    deflated_usdz: Case { args: &["lights", "{in}/deflated.usdz"], exit: 2, says: &["deflated.usdz"], ..Case::default() };
+    npy_int_dtype: Case { args: emission!("{in}/ok.usda", "{in}/npy_int.npy"), exit: 2, says: &["npy_int.npy", "float32 or float64"], ..Case::default() };
+    npy_object_dtype: Case { args: emission!("{in}/ok.usda", "{in}/npy_object.npy"), exit: 2, says: &["npy_object.npy", "float32 or float64"], ..Case::default() };
+    npy_three_dimensions: Case { args: emission!("{in}/ok.usda", "{in}/npy_3d.npy"), exit: 2, says: &["npy_3d.npy", "(N, 3)"], ..Case::default() };
+    npy_header_with_code: Case { args: emission!("{in}/ok.usda", "{in}/npy_header_code.npy"), exit: 2, says: &["npy_header_code.npy", "header"], ..Case::default() };
+    npy_not_numpy: Case { args: emission!("{in}/ok.usda", "{in}/npy_not_numpy.npy"), exit: 2, says: &["npy_not_numpy.npy", "not a .npy file"], ..Case::default() };
+    light_not_in_stage: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu", "--light", "/nope"], exit: 2, says: &["/nope", "ok.usda"], ..Case::default() };
+
+    // --- IES profiles (shaping:ies:file and `luxeval ies`) -------------------------------------
+    ies_profile_missing: Case { args: emission!("{in}/ies_missing_file.usda", "{in}/dirs.npy"), exit: 2, says: &["ies_missing_file.usda", "/L", "inputs:shaping:ies:file", "missing.ies"], ..Case::default() };
+    ies_profile_truncated_in_stage: Case { args: emission!("{in}/ies_truncated.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_truncated.ies:7", "candela"], ..Case::default() };
+    ies_without_tilt_line: Case { args: &["ies", "{in}/ies_no_tilt.ies"], exit: 2, says: &["ies_no_tilt.ies", "TILT="], ..Case::default() };
+    ies_count_not_integer: Case { args: &["ies", "{in}/ies_bad_count.ies"], exit: 2, says: &["ies_bad_count.ies:3", "integer", "3.5"], ..Case::default() };
+    ies_tilt_file_missing: Case { args: &["ies", "{in}/ies_tilt_missing.ies"], exit: 2, says: &["ies_tilt_missing.ies:2", "nothere.tilt"], ..Case::default() };
+    ies_truncated: Case { args: &["ies", "{in}/ies_truncated.ies", "--png", "{out}/p.png"], exit: 2, says: &["ies_truncated.ies:7", "missing value"], ..Case::default() };
+    ies_png_is_the_profile: Case { args: &["ies", "{in}/ies_bad_count.ies", "--png", "{in}/ies_bad_count.ies"], exit: 2, says: &["--png", "ies_bad_count.ies"], ..Case::default() };
+
+    // --- Runtime failures: exit 1 ---------------------------------------------------------------
+    disk_full_while_writing_npy: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 1, fsize: Some(100), says: &["writing", "out.npy"], ..Case::default() };
+    disk_full_while_writing_exr: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "64,64", "-o", "{out}/m.exr", "--png", "{out}/m.png", "--device", "cpu"], exit: 1, fsize: Some(1000), says: &["writing", "m.exr"], ..Case::default() };
+    no_adapter_with_device_gpu: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 1, env: NO_GPU, says: &["no GPU adapter"], ..Case::default() };
+    no_adapter_falls_back_to_the_cpu: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy"], exit: 0, env: NO_GPU, lit: true, says: &["warning: no GPU adapter", "CPU reference"], ..Case::default() };
+    gpu_device_lost: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 1, gpu: true, env: &[("LUXEVAL_TEST_FAULT", "device-lost")], says: &["GPU", "device was lost"], ..Case::default() };
+    check_without_adapter: Case { args: &["check", "{in}/ok.usda", "--samples", "10"], exit: 1, env: NO_GPU, says: &["GPU"], ..Case::default() };
+}
+
+/// The issue asks for at least 60 cases.
+#[test]
+fn the_corpus_has_at_least_60_cases_and_every_file_is_used() {
+    assert!(CASES.len() >= 60, "{} cases", CASES.len());
+    let src = std::fs::read_to_string(file!()).unwrap();
+    for e in std::fs::read_dir(corpus()).unwrap() {
+        let name = e.unwrap().file_name().into_string().unwrap();
+        assert!(
+            src.contains(&format!("{{in}}/{name}")) || src.contains(&format!("\"{name}\"")),
+            "tests/data/bad/{name} is used by no case"
+        );
+    }
+}
