@@ -10,6 +10,7 @@ use luxeval::{
     IesFile, IesFormat as Format, IesPlane as Plane, IesProfile as Profile, Lm63Version,
     PhotometricType, TiltSource,
 };
+use crate::plot::numbers::decimal;
 use crate::plot::{Canvas, polar};
 
 /// Integrated and rated flux may differ by this much before the report warns (a luminaire's
@@ -179,11 +180,7 @@ impl Report {
     }
 }
 
-/// A number with at most 4 significant decimals, without trailing zeros.
+/// A number with at most 4 decimals, none from 1000 up, without trailing zeros.
 pub fn trimmed(v: f64) -> String {
-    if v.abs() >= 1000.0 {
-        return format!("{v:.0}");
-    }
-    let s = format!("{v:.4}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
+    decimal(v, if v.abs() >= 1000.0 { 0 } else { 4 })
 }

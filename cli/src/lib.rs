@@ -23,7 +23,7 @@ mod check;
 mod exit;
 mod falloff;
 mod ies;
-mod ies_report;
+pub mod ies_report;
 mod info;
 pub mod io;
 mod lights;

@@ -406,11 +406,12 @@ cases! {
     check_without_adapter: Case { args: &["check", "{in}/ok.usda", "--samples", "10"], exit: 1, env: NO_GPU, says: &["GPU"], ..Case::default() };
 }
 
-/// The issue asks for at least 60 cases.
+/// The corpus covers at least 60 kinds of bad input, and no file of it is left unused.
 #[test]
 fn the_corpus_has_at_least_60_cases_and_every_file_is_used() {
     assert!(CASES.len() >= 60, "{} cases", CASES.len());
-    let src = std::fs::read_to_string(file!()).unwrap();
+    // file!() is relative to the workspace root; tests run in cli/.
+    let src = std::fs::read_to_string(crate::repo().join(file!())).unwrap();
     for e in std::fs::read_dir(corpus()).unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();
         assert!(

@@ -1,4 +1,4 @@
-//! The photometric reader on arbitrary bytes (`ies::parse_any`: LM-63 of every version and
+//! The photometric reader on arbitrary bytes (`parse_any`: LM-63 of every version and
 //! EULUMDAT, told apart by content) and everything a parsed file feeds: the prepared profile, its
 //! exact mean over the sphere, flux, tilt, the f64 lookup and the report `luxeval ies` prints.
 //! Invariants beyond "no panic, no hang, bounded memory": the mean lies in [0, peak]; every
@@ -6,7 +6,9 @@
 #![no_main]
 
 use glam::DVec3;
-use luxeval::ies;
+use luxeval::IesProfile;
+use luxeval::testkit::ies_parts::parse_any;
+use luxeval_cli::ies_report::Report;
 
 /// `TILT=<name>`: names starting with 'a' resolve to a small valid table, others are missing.
 fn resolver(name: &str) -> Result<Vec<u8>, String> {
@@ -31,10 +33,10 @@ const DIRS: [[f64; 3]; 10] = [
 ];
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
-    let Ok(file) = ies::parse_any(data, &resolver) else {
+    let Ok(file) = parse_any(data, &resolver) else {
         return;
     };
-    let Ok(p) = ies::Profile::new(&file) else {
+    let Ok(p) = IesProfile::new(&file) else {
         return;
     };
     let peak = p.peak().candela;
@@ -47,13 +49,13 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     for d in DIRS {
         let e = DVec3::from_array(d).normalize();
         for s in [0.0, 0.5, -2.0] {
-            let f = ies::ies_factor(&p, e, s);
+            let f = p.candela(e, s);
             assert!(
                 f.is_finite() && f >= 0.0 && f <= peak * (1.0 + 1e-12),
                 "factor {f}, peak {peak}"
             );
         }
     }
-    let report = ies::Report::new(std::path::Path::new("fuzz.ies"), &file, &p);
+    let report = Report::new(std::path::Path::new("fuzz.ies"), &file, &p);
     let _ = report.plot(&p);
 });

@@ -8,11 +8,11 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     std::fs::File::create(&path)
         .and_then(|mut f| f.write_all(data))
         .expect("scratch file");
-    let _ = luxeval::io::npy::read_vec3(&path);
-    if let Ok(p) = luxeval::io::npy::read_points(&path) {
+    let _ = luxeval_cli::io::npy::read_vec3(&path);
+    if let Ok(p) = luxeval_cli::io::npy::read_points(&path) {
         assert!(p.iter().flatten().all(|v| v.is_finite()));
     }
-    if let Ok(d) = luxeval::io::npy::read_directions(&path) {
+    if let Ok(d) = luxeval_cli::io::npy::read_directions(&path) {
         // Every direction read is finite and non-zero (float64 rows also unit length).
         for r in d {
             let n = (r[0] as f64).hypot(r[1] as f64).hypot(r[2] as f64);

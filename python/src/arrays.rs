@@ -7,23 +7,16 @@ use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::intern;
 use pyo3::prelude::*;
 
-use crate::errors;
+use luxeval::{RowKind, RowProblem};
 
-/// What a row of the array is, for the checks and the messages.
-#[derive(Clone, Copy, PartialEq, Eq)]
-pub enum Kind {
-    /// Any finite point.
-    Point,
-    /// A finite, non-zero direction (normalised by the library).
-    Direction,
-}
+use crate::errors;
 
 /// `obj` as a C-contiguous float32 (N, 3) array; `name` is the Python argument, used in errors.
 pub fn rows<'py>(
     py: Python<'py>,
     obj: &Bound<'py, PyAny>,
     name: &str,
-    kind: Kind,
+    kind: RowKind,
 ) -> PyResult<PyReadonlyArray2<'py, f32>> {
     let np = py.import(intern!(py, "numpy"))?;
     let arr = np
@@ -73,19 +66,20 @@ pub fn rows<'py>(
         .map_err(|e| errors::input(format!("{name}: {e}")))?;
     let ro = f32s.readonly();
     let data = as_vec3(&ro)?;
-    if let Some((i, why)) = py.detach(|| first_bad(data, kind)) {
-        let row = arr.get_item(i)?;
+    // The library's one rule for input rows (luxeval::RowKind), its message with the row's
+    // values as Python writes them.
+    if let Err(mut bad) = py.detach(|| kind.check_f32(0, data)) {
+        let row = arr.get_item(bad.row as usize)?;
         let finite: bool = np
             .call_method1(intern!(py, "isfinite"), (&row,))?
             .call_method0(intern!(py, "all"))?
             .extract()?;
-        let row_text = row.call_method0(intern!(py, "tolist"))?.str()?.to_string();
-        let reason = match why {
-            Bad::NotFinite if finite => format!("row {i} = {row_text} is outside float32's range"),
-            Bad::NotFinite => format!("row {i} = {row_text} is not finite"),
-            Bad::Zero => format!("row {i} = {row_text} is the zero vector, which has no direction"),
-        };
-        return Err(errors::input(format!("{name}: {reason}")));
+        if bad.problem == RowProblem::NotFinite && finite {
+            // Finite as given, infinite once rounded to float32.
+            bad.problem = RowProblem::OutsideFloat32;
+        }
+        bad.values = row.call_method0(intern!(py, "tolist"))?.str()?.to_string();
+        return Err(errors::input(format!("{name}: {bad}")));
     }
     Ok(ro)
 }
@@ -98,23 +92,6 @@ pub fn as_vec3<'a>(a: &'a PyReadonlyArray2<'_, f32>) -> PyResult<&'a [[f32; 3]]>
     let (rows, rest) = flat.as_chunks::<3>();
     debug_assert!(rest.is_empty());
     Ok(rows)
-}
-
-enum Bad {
-    NotFinite,
-    Zero,
-}
-
-fn first_bad(rows: &[[f32; 3]], kind: Kind) -> Option<(usize, Bad)> {
-    rows.iter().enumerate().find_map(|(i, r)| {
-        if r.iter().any(|c| !c.is_finite()) {
-            Some((i, Bad::NotFinite))
-        } else if kind == Kind::Direction && r.iter().all(|c| *c == 0.0) {
-            Some((i, Bad::Zero))
-        } else {
-            None
-        }
-    })
 }
 
 pub fn shape_str(shape: &[usize]) -> String {

@@ -6,8 +6,10 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use glam::DVec3;
-use luxeval::falloff::{self, Plane};
-use luxeval::{Accumulate, PreparedScene, Stage, TemperatureMode, TextureFilter, TimeRule};
+use luxeval::{
+    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, Stage, TemperatureMode, TextureFilter,
+    TimeRule,
+};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyMemoryError, PyUserWarning};
@@ -15,7 +17,7 @@ use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyString, PyTuple, PyType};
 
-use crate::arrays::{self, Kind};
+use crate::arrays;
 use crate::device::{self, Device};
 use crate::errors::{self, no_panic};
 
@@ -260,13 +262,13 @@ impl Stage {
         o: Options,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (a_name, a_kind, b_name) = match q {
-            Query::Emission => ("dirs", Kind::Direction, ""),
-            Query::Radiance => ("points", Kind::Point, "dirs"),
-            Query::Irradiance => ("points", Kind::Point, "normals"),
+            Query::Emission => ("dirs", RowKind::Directions, ""),
+            Query::Radiance => ("points", RowKind::Points, "dirs"),
+            Query::Irradiance => ("points", RowKind::Points, "normals"),
         };
         let a_arr = arrays::rows(py, a, a_name, a_kind)?;
         let b_arr: Option<PyReadonlyArray2<'py, f32>> = match b {
-            Some(b) => Some(arrays::rows(py, b, b_name, Kind::Direction)?),
+            Some(b) => Some(arrays::rows(py, b, b_name, RowKind::Directions)?),
             None => None,
         };
         let a_rows = arrays::as_vec3(&a_arr)?;
@@ -391,10 +393,10 @@ fn resolution(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
     let (w, h): (i64, i64) = res.extract().map_err(|_| bad())?;
     let w = u32::try_from(w).ok().filter(|w| *w >= 1).ok_or_else(bad)?;
     let h = u32::try_from(h).ok().filter(|h| *h >= 1).ok_or_else(bad)?;
-    if w as u64 * h as u64 > falloff::MAX_PIXELS {
+    if w as u64 * h as u64 > Plane::MAX_PIXELS {
         return Err(errors::input(format!(
             "res: {w}×{h} is more than {} pixels",
-            falloff::MAX_PIXELS
+            Plane::MAX_PIXELS
         )));
     }
     Ok((w, h))

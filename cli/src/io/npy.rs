@@ -783,7 +783,7 @@ mod streaming {
     /// Chunks of any size give the rows of the whole file, in every layout.
     #[test]
     fn chunks_of_any_size_read_the_whole_file() {
-        let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/npy");
+        let data = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/npy"));
         let want = read_vec3(&data.join("dirs_f32.npy")).unwrap();
         for f in [
             "dirs_f32.npy",
@@ -838,9 +838,7 @@ mod numpy_files {
     use super::*;
 
     fn data(name: &str) -> std::path::PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/npy")
-            .join(name)
+        Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/npy")).join(name)
     }
 
     /// Files written by NumPy (tools/gen_npy_fixtures.py): every accepted layout reads the same.

@@ -5,19 +5,12 @@
 
 use std::path::Path;
 
-use super::viridis::VIRIDIS;
-use luxeval::{FalloffMap as Map, FalloffPlane as Plane};
-use luxeval::{LuxError, Result};
-use super::font;
+use luxeval::{FalloffMap as Map, FalloffPlane as Plane, LuxError, Result};
 
-/// How values map to colours.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Scale {
-    /// log10: falloff maps span decades (default).
-    #[default]
-    Log,
-    Linear,
-}
+pub use super::numbers::Scale;
+use super::numbers::{decimal, label, ticks};
+use super::viridis::VIRIDIS;
+use super::{Canvas, INK, PAPER, font};
 
 /// Rendering options.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -30,12 +23,10 @@ pub struct Style {
     pub contours: bool,
 }
 
-/// An RGB8 image with what it shows.
+/// The picture with what it shows.
 #[derive(Clone, Debug)]
 pub struct Rendered {
-    pub width: u32,
-    pub height: u32,
-    pub rgb: Vec<u8>,
+    pub canvas: Canvas,
     /// The value range of the colour bar (lux).
     pub range: (f64, f64),
     /// The labelled values (and contour levels).
@@ -79,70 +70,6 @@ pub fn auto_range(values: &[f64], style: &Style) -> (f64, f64) {
     }
 }
 
-/// Tick values inside `range`: decades (plus 2 and 5 when few) on a log scale, 1-2-5 steps on a
-/// linear one.
-pub fn ticks(range: (f64, f64), scale: Scale) -> Vec<f64> {
-    let (lo, hi) = range;
-    if !(hi > lo) {
-        return vec![];
-    }
-    match scale {
-        Scale::Log => {
-            let lo = lo.max(f64::MIN_POSITIVE);
-            let (k0, k1) = (lo.log10().ceil() as i32, hi.log10().floor() as i32);
-            let decades: Vec<f64> = (k0..=k1).map(|k| 10f64.powi(k)).collect();
-            if decades.len() >= 3 {
-                return decades;
-            }
-            let mut t: Vec<f64> = (k0 - 1..=k1)
-                .flat_map(|k| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(k)))
-                .filter(|v| *v >= lo * (1.0 - 1e-12) && *v <= hi * (1.0 + 1e-12))
-                .collect();
-            t.dedup();
-            t
-        }
-        Scale::Linear => {
-            let raw = (hi - lo) / 5.0;
-            let mag = 10f64.powf(raw.log10().floor());
-            let step = [1.0, 2.0, 5.0, 10.0]
-                .iter()
-                .map(|m| m * mag)
-                .find(|s| *s >= raw)
-                .unwrap_or(10.0 * mag);
-            let first = (lo / step).ceil() as i64;
-            let last = (hi / step).floor() as i64;
-            (first..=last).map(|k| k as f64 * step).collect()
-        }
-    }
-}
-
-/// A compact label: plain decimals from 0.001 to 99999, otherwise `1e6`-style.
-pub fn label(v: f64) -> String {
-    if v == 0.0 {
-        return "0".into();
-    }
-    let a = v.abs();
-    if (1e-3..1e5).contains(&a) {
-        let s = format!("{v:.4}");
-        let s = s.trim_end_matches('0').trim_end_matches('.');
-        // Four decimals may still be too many significant digits for values ≥ 10.
-        let digits = (a.log10().floor() as i32 + 1).max(1) as usize;
-        if digits >= 4 {
-            format!("{v:.0}")
-        } else {
-            s.to_string()
-        }
-    } else {
-        let e = a.log10().floor() as i32;
-        let m = v / 10f64.powi(e);
-        if (m.abs() - 1.0).abs() < 1e-9 {
-            format!("{}1e{e}", if v < 0.0 { "-" } else { "" })
-        } else {
-            format!("{m:.1}e{e}")
-        }
-    }
-}
-
 fn position(v: f64, range: (f64, f64), scale: Scale) -> f64 {
     let (lo, hi) = range;
     let t = match scale {
@@ -163,43 +90,13 @@ fn colour(t: f64) -> [u8; 3] {
     VIRIDIS[(t * 255.0).round().clamp(0.0, 255.0) as usize]
 }
 
-struct Canvas {
-    w: u32,
-    h: u32,
-    px: Vec<u8>,
-}
-
-impl Canvas {
-    fn set(&mut self, x: i64, y: i64, c: [u8; 3]) {
-        if x >= 0 && y >= 0 && (x as u32) < self.w && (y as u32) < self.h {
-            let k = 3 * (y as usize * self.w as usize + x as usize);
-            self.px[k..k + 3].copy_from_slice(&c);
-        }
-    }
-    fn get(&self, x: u32, y: u32) -> [u8; 3] {
-        let k = 3 * (y as usize * self.w as usize + x as usize);
-        [self.px[k], self.px[k + 1], self.px[k + 2]]
-    }
-    fn text(&mut self, s: &str, x: i64, y: i64, c: [u8; 3]) {
-        let mut pts = Vec::new();
-        font::draw(s, x, y, FONT_SCALE, |px, py| pts.push((px, py)));
-        for (px, py) in pts {
-            self.set(px, py, c);
-        }
-    }
-}
-
-const INK: [u8; 3] = [20, 20, 20];
-const PAPER: [u8; 3] = [255, 255, 255];
-
 fn fmt_vec(v: glam::DVec3) -> String {
-    format!("({}, {}, {})", short(v.x), short(v.y), short(v.z))
-}
-
-fn short(x: f64) -> String {
-    let s = format!("{x:.3}");
-    let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
-    if s == "-0" { "0".into() } else { s }
+    format!(
+        "({}, {}, {})",
+        decimal(v.x, 3),
+        decimal(v.y, 3),
+        decimal(v.z, 3)
+    )
 }
 
 /// Renders `map` (sampled on `plane`) with `style`.
@@ -247,8 +144,8 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
     );
     let caption1 = format!(
         "{} x {} scene units",
-        short(plane.u.length()),
-        short(plane.v.length())
+        decimal(plane.u.length(), 3),
+        decimal(plane.v.length(), 3)
     );
     let caption2 = format!("normal {}", fmt_vec(plane.normal()));
     let caption_w = [&title, &caption1, &caption2]
@@ -260,13 +157,9 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
         (MARGIN + mw + BAR_GAP + BAR_WIDTH + 12 + label_w + MARGIN).max(caption_w + 2 * MARGIN);
     let top = MARGIN + 2 * (TEXT_H + 6) + 4;
     let height = top + mh + 10 + 2 * (TEXT_H + 6) + MARGIN;
-    let mut c = Canvas {
-        w: width,
-        h: height,
-        px: PAPER.repeat((width * height) as usize),
-    };
+    let mut c = Canvas::new(width, height, PAPER);
 
-    c.text(&title, MARGIN as i64, MARGIN as i64, INK);
+    c.text(&title, MARGIN as i64, MARGIN as i64, FONT_SCALE, INK);
     // The map.
     for j in 0..map.height {
         for i in 0..map.width {
@@ -343,16 +236,26 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
         for x in 0..4 {
             c.set((bx + BAR_WIDTH + 1 + x) as i64, y, INK);
         }
-        c.text(l, (bx + BAR_WIDTH + 12) as i64, y - TEXT_H as i64 / 2, INK);
+        c.text(
+            l,
+            (bx + BAR_WIDTH + 12) as i64,
+            y - TEXT_H as i64 / 2,
+            FONT_SCALE,
+            INK,
+        );
     }
-    c.text("lux", bx as i64, (MARGIN + TEXT_H + 6) as i64, INK);
+    c.text("lux", bx as i64, (MARGIN + TEXT_H + 6) as i64, FONT_SCALE, INK);
     let cy = top + mh + 10;
-    c.text(&caption1, MARGIN as i64, cy as i64, INK);
-    c.text(&caption2, MARGIN as i64, (cy + TEXT_H + 6) as i64, INK);
+    c.text(&caption1, MARGIN as i64, cy as i64, FONT_SCALE, INK);
+    c.text(
+        &caption2,
+        MARGIN as i64,
+        (cy + TEXT_H + 6) as i64,
+        FONT_SCALE,
+        INK,
+    );
     Ok(Rendered {
-        width,
-        height,
-        rgb: c.px,
+        canvas: c,
         range,
         ticks,
         zoom,
@@ -361,11 +264,8 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
 
 /// Writes a rendered image as an 8-bit sRGB PNG, atomically.
 pub fn write(path: &Path, r: &Rendered) -> Result<()> {
-    crate::plot::write_rgb_png(
+    r.canvas.write_png(
         path,
-        r.width,
-        r.height,
-        &r.rgb,
         &format!("irradiance colour bar {} to {} lux", r.range.0, r.range.1),
     )
 }
@@ -374,24 +274,6 @@ pub fn write(path: &Path, r: &Rendered) -> Result<()> {
 mod tests {
     use super::*;
     use glam::DVec3;
-
-    #[test]
-    fn ticks_and_labels() {
-        assert_eq!(
-            ticks((0.5, 2000.0), Scale::Log),
-            vec![1.0, 10.0, 100.0, 1000.0]
-        );
-        assert_eq!(ticks((0.3, 4.0), Scale::Log), vec![0.5, 1.0, 2.0]);
-        assert_eq!(
-            ticks((0.0, 1.0), Scale::Linear),
-            vec![0.0, 0.2, 0.4, 0.6000000000000001, 0.8, 1.0]
-        );
-        assert_eq!(label(0.25), "0.25");
-        assert_eq!(label(1000.0), "1000");
-        assert_eq!(label(1e6), "1e6");
-        assert_eq!(label(2.5e-5), "2.5e-5");
-        assert_eq!(label(12.5), "12.5");
-    }
 
     #[test]
     fn auto_range_spans_three_decades() {
@@ -433,8 +315,7 @@ mod tests {
                 MARGIN + i * r.zoom + r.zoom / 2,
                 MARGIN + 2 * (TEXT_H + 6) + 4 + j * r.zoom + r.zoom / 2,
             );
-            let k = 3 * (y * r.width + x) as usize;
-            [r.rgb[k], r.rgb[k + 1], r.rgb[k + 2]]
+            r.canvas.get(x, y)
         };
         assert_eq!(at(0, 0), [0, 0, 0]);
         assert_eq!(at(3, 1), VIRIDIS[255]);

@@ -4,6 +4,7 @@
 
 pub mod falloff;
 pub(crate) mod font;
+pub mod numbers;
 pub mod polar;
 mod viridis;
 
@@ -130,37 +131,9 @@ pub fn write_rgb_png(
     })
 }
 
-/// A "nice" step (1, 2 or 5 times a power of ten) for about `n` divisions of `[0, max]`.
-pub fn nice_step(max: f64, n: f64) -> f64 {
-    if !(max > 0.0) || !max.is_finite() {
-        return 1.0;
-    }
-    let raw = max / n;
-    let p = 10f64.powf(raw.log10().floor());
-    let f = raw / p;
-    let m = if f <= 1.0 {
-        1.0
-    } else if f <= 2.0 {
-        2.0
-    } else if f <= 5.0 {
-        5.0
-    } else {
-        10.0
-    };
-    m * p
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn nice_steps() {
-        assert_eq!(nice_step(100.0, 5.0), 20.0);
-        assert_eq!(nice_step(7.0, 4.0), 2.0);
-        assert_eq!(nice_step(0.03, 3.0), 0.01);
-        assert_eq!(nice_step(0.0, 3.0), 1.0);
-    }
 
     #[test]
     fn drawing_stays_inside_and_inks() {

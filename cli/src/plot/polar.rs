@@ -6,7 +6,8 @@
 
 use glam::DVec3;
 
-use super::{Canvas, GRID, INK, PAPER, nice_step};
+use super::numbers::{decimal, nice_step};
+use super::{Canvas, GRID, INK, PAPER};
 
 /// One curve: `(signed angle from nadir in degrees, candela)` in drawing order; positive angles
 /// are drawn on the right half, negative on the left.
@@ -86,7 +87,7 @@ pub fn render(title: &str, subtitle: &str, curves: &[Curve]) -> Canvas {
     // Ring values along the 90° line on the right, just above it; the unit after the last.
     for k in 1..=rings as usize {
         let v = step * k as f64;
-        let mut label = trim(v);
+        let mut label = decimal(v, 6);
         if k == rings as usize {
             label.push_str(" cd");
         }
@@ -120,13 +121,6 @@ pub fn render(title: &str, subtitle: &str, curves: &[Curve]) -> Canvas {
         x += 60.0 + Canvas::text_width(&curve.label, FONT) as f64 + 30.0;
     }
     c
-}
-
-/// A ring label without trailing zeros.
-fn trim(v: f64) -> String {
-    let s = format!("{v:.6}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    s.to_string()
 }
 
 #[cfg(test)]
