@@ -6,7 +6,7 @@
 
 // #import shared/record.wgsl
 // #import shared/shaping.wgsl
-// #import shared/dome.wgsl
+// #import shared/texture.wgsl
 
 // Emission along unit direction e (pointing away from the light; for a dome, toward the
 // environment).

@@ -1,5 +1,5 @@
 //! CPU (f64) vs GPU (f32, WGSL) conformance over randomised lights and samples covering every
-//! light type, transform kind and attribute (issue: foundation, item 6).
+//! light type, transform kind and attribute (DESIGN.md §5).
 //!
 //! Tolerance: relative error ≤ 1e-4 (luxeval::check::TOLERANCE); the excluded band around
 //! discontinuities is luxeval::check::BAND (1e-4 rad, or 1e-4 of the shape's size) — see

@@ -4,7 +4,7 @@
 //! a rotated transform; emission and radiance within a relative 1e-4 per channel. Irradiance:
 //! the GPU path gives the reference's value (see the last test).
 //!
-//! Excluded directions (documented divergence 1 of shaders/shared/dome.wgsl): with the nearest
+//! Excluded directions (documented divergence 1 of shaders/shared/texture.wgsl): with the nearest
 //! filter, those within 1e-3 px of a texel edge (f32 pixel coordinates carry ~W·2⁻²⁴ px of
 //! rounding and may pick the neighbour); with either filter, those within a relative 1e-4 of a
 //! cube-cross face edge (each face clamps to its own edge texels). Both counted and bounded.

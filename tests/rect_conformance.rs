@@ -4,7 +4,7 @@
 //! relative 1e-4 per channel (irradiance of a textured rect is the CPU reference's on both paths,
 //! `query::irradiance_on_host`).
 //!
-//! Excluded radiance samples (documented divergences 1 and 7 of shaders/shared/dome.wgsl): rays
+//! Excluded radiance samples (documented divergences 1 and 7 of shaders/shared/texture.wgsl): rays
 //! meeting the light's plane within a relative 1e-3 of the rect's edge (f32 may hit or miss),
 //! and with the nearest filter within 1e-3 px of a texel edge (f32 may pick the neighbour).
 //! Both counted and printed. Texel values are linear in [0.21, 1] (8-bit sRGB 128..255).

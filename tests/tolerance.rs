@@ -1,6 +1,6 @@
-//! `--tolerance` (issue 11): irradiance computed to a relative tolerance instead of the
+//! `--tolerance`: irradiance computed to a relative tolerance instead of the
 //! reference's 1e-9. The luxtest floor maps of the shaped rect and the spot sphere at frame 31
-//! (the scenes the issue compares with Cycles), computed by the CPU at tolerances 1e-3 and 1e-4,
+//! (the scenes BENCHMARKS.md compares with Cycles), computed by the CPU at tolerances 1e-3 and 1e-4,
 //! must lie within that tolerance of the 1e-9 reference at every pixel (relative to the pixel;
 //! a pixel that is 0 in one must be 0 in the other). The GPU, whose f32 rule is fixed, takes no
 //! tolerance below 1e-4 (its conformance bound).

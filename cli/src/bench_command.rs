@@ -1,5 +1,5 @@
 //! `luxeval bench --command "ARGS"`: whole-process figures of real commands, the ones a user
-//! waits for (issue 11: the quick start, an irradiance or falloff command's start-up, a falloff
+//! waits for (the quick start, an irradiance or falloff command's start-up, a falloff
 //! map against `--device cpu`, a streamed emission run's peak memory). The throughput rows time
 //! calls inside one process on a prepared scene; these time `luxeval ARGS --device gpu` and
 //! `luxeval ARGS --device cpu` as child processes of this binary, alternately, from spawn to

@@ -76,7 +76,7 @@ struct Params {
 @group(0) @binding(4) var<storage, read_write> out_rgb: array<f32>;
 // Every IES profile of the scene (shared/ies.wgsl reads it; layout in src/gpu/ies_atlas.rs).
 @group(0) @binding(5) var<storage, read> ies_atlas: array<f32>;
-// Every dome and rect texture of the scene (shared/dome.wgsl reads it; layout in src/gpu/dome_atlas.rs).
+// Every dome and rect texture of the scene (shared/texture.wgsl reads it; layout in src/gpu/texture_atlas.rs).
 @group(0) @binding(6) var<storage, read> tex_atlas: array<f32>;
 
 fn sample_index(gid: vec3<u32>) -> u32 {

@@ -1,5 +1,5 @@
 //! Texture files → linear RGB `f32` images (DESIGN.md §6 "RectLight texture", last bullet, and
-//! §6 D1 "Texel grid"). Ported from the staged crate `luxeval-dome` (`src/texture.rs`).
+//! §6 D1 "Texel grid")
 //!
 //! - OpenEXR (half, float or uint samples; scanline or tiled; every compression the `exr` crate
 //!   decodes, which since 1.74 includes DWAA/DWAB): linear as stored, read through the **data
@@ -14,9 +14,6 @@
 //! [`MAX_PIXELS`] is refused from its header, before any pixel buffer is allocated. The third-party
 //! decoders are additionally run under `catch_unwind`, so that a decoder bug reached by a corrupt
 //! file becomes [`TextureError::DecoderPanic`] instead of aborting the caller.
-
-// `load` and `Image::from_rgb` serve tests and the tools still to come (issue 9).
-#![allow(dead_code)]
 
 use std::io::Cursor;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -114,6 +111,7 @@ impl Image {
         changed
     }
 
+    #[cfg(test)]
     /// An image from raw linear texels (tests and generated data). `rgb.len()` must equal
     /// `width × height`, both non-zero.
     pub fn from_rgb(
@@ -139,6 +137,7 @@ impl Image {
     }
 }
 
+#[cfg(test)]
 /// Loads any supported texture file. OpenEXR is recognised by its magic number, everything else
 /// goes to the `image` decoders (PNG, JPEG, Radiance HDR, recognised from their content).
 /// Texels are then [`Image::sanitize`]d (negatives and NaN → 0).

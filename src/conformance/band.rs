@@ -14,7 +14,7 @@ use crate::cpu::shaping::off_axis_angle;
 use crate::model::LightType;
 use crate::model::TextureFilter;
 use crate::prepare::Prepared;
-use crate::prepare::dome::DomeFormat;
+use crate::prepare::texture::DomeFormat;
 use crate::prepare::ies::{HFold, PhotometricType, VFold};
 use crate::query::Reference;
 use crate::synthetic::samples::local_extent;
@@ -494,7 +494,7 @@ pub const TEXEL_BAND: f64 = 1e-3;
 /// A textured dome's comparison floor along world direction `w` (toward the environment):
 /// the largest channel of `base ⊙ texel` over the texels the lookup may read there (the 2 × 2
 /// bilinear footprint, or the nearest texel and its neighbours). Divergence 1 of
-/// shaders/shared/dome.wgsl: f32 pixel coordinates carry ~W·2⁻²⁴ px of rounding (plus the f32
+/// shaders/shared/texture.wgsl: f32 pixel coordinates carry ~W·2⁻²⁴ px of rounding (plus the f32
 /// direction's ~1e-7 rad), so the GPU's bilinear value differs from the reference by that
 /// fraction of a pixel times the footprint's contrast. On a high-dynamic-range map (a 100:1 step
 /// between neighbouring texels is common) that is far more than 1e-4 of a dark texel's value,
@@ -505,7 +505,7 @@ pub fn texture_floor(p: &Prepared, w: DVec3) -> f64 {
         return 0.0;
     };
     let (wd, hd) = (t.image.width, t.image.height);
-    let st = crate::cpu::dome::direction_to_st(t.format, t.frame.to_dome(w.normalize()));
+    let st = crate::cpu::texture::direction_to_st(t.format, t.frame.to_dome(w.normalize()));
     let around = |x: f64, n: usize| {
         let c = (x * n as f64 - 0.5).floor() as i64;
         [c - 1, c, c + 1, c + 2].map(|i| i.clamp(0, n as i64 - 1) as u32)
@@ -513,7 +513,7 @@ pub fn texture_floor(p: &Prepared, w: DVec3) -> f64 {
     let mut m = 0.0f64;
     for j in around(st.y, hd) {
         for i in around(st.x, wd) {
-            let v = crate::cpu::dome::tex_fetch(&t.image, i, j) * p.base;
+            let v = crate::cpu::texture::tex_fetch(&t.image, i, j) * p.base;
             m = m.max(v.abs().max_element());
         }
     }
@@ -521,7 +521,7 @@ pub fn texture_floor(p: &Prepared, w: DVec3) -> f64 {
 }
 
 /// Whether a textured dome has a discontinuity within `margin` of world direction `w` that f32
-/// may straddle (divergence 1 of shaders/shared/dome.wgsl): with the nearest filter, a texel
+/// may straddle (divergence 1 of shaders/shared/texture.wgsl): with the nearest filter, a texel
 /// edge within `margin` pixels; with either filter, a cube-cross face edge (the two largest
 /// |d| within a relative `margin`: each face clamps to its own edge texels). In f64, on the
 /// reference's dome direction. False for other lights.
@@ -541,6 +541,6 @@ pub fn near_texture_edge(p: &Prepared, w: DVec3, margin: f64) -> bool {
         return false;
     }
     let near_int = |x: f64| (x - x.round()).abs() < margin;
-    let st = crate::cpu::dome::direction_to_st(t.format, d);
+    let st = crate::cpu::texture::direction_to_st(t.format, d);
     near_int(st.x * t.image.width as f64) || near_int(st.y * t.image.height as f64)
 }

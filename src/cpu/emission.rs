@@ -7,7 +7,7 @@
 
 use glam::DVec3;
 
-use super::dome::{dome_factor, rect_mean};
+use super::texture::{dome_factor, rect_mean};
 use super::shaping::{off_axis_angle, shaping};
 use crate::model::LightType;
 use crate::prepare::Prepared;

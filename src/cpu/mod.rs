@@ -10,7 +10,7 @@
 //! Contract shared with the kernels: directions passed to the per-light functions are unit
 //! vectors; the batch entry points below normalise their inputs, as the kernels' entry points do.
 
-pub mod dome;
+pub mod texture;
 pub mod emission;
 pub mod ies;
 pub mod intensity;

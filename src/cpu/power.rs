@@ -25,7 +25,7 @@ pub fn flux(p: &Prepared) -> Option<DVec3> {
     }
     let Some(s) = &p.shaping else {
         // A textured rect emits its texture's mean (DESIGN.md §6 "RectLight texture").
-        return Some(p.base * super::dome::rect_mean(p) * (PI * world_area(&p.light)));
+        return Some(p.base * super::texture::rect_mean(p) * (PI * world_area(&p.light)));
     };
     let mut breaks = vec![0.0, FRAC_PI_2, PI];
     for t in [s.start, s.cone] {

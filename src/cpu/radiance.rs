@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use super::dome::rect_factor;
+use super::texture::rect_factor;
 use super::emission::{emission, surface_emission};
 use super::shapes::{cylinder_hit, disk_hit, plane_hit, rect_hit, sphere_hit};
 use crate::model::LightType;

@@ -1,4 +1,4 @@
-//! The persistent pipeline cache (issue 11 "start-up"): wgpu's `PipelineCache` (a Vulkan
+//! The persistent pipeline cache (start-up time): wgpu's `PipelineCache` (a Vulkan
 //! `VkPipelineCache`) kept in a file per adapter and driver under the user's cache directory, so
 //! that a later process skips the driver's compile where the driver caches.
 //!

@@ -2,8 +2,8 @@
 //! input/output/readback buffers kept between calls of the same size class ([`Scratch`]), and
 //! the batch cut into chunks that fit the device's binding and dispatch limits. The host's share
 //! of a call (mapping the inputs into the staging memory, copying the results out of the
-//! readback buffer) runs on every core: on a real GPU it is most of the call (issue 11 item 7,
-//! BENCHMARKS.md "A real GPU").
+//! readback buffer) runs on every core: on a real GPU it is most of the call (BENCHMARKS.md
+//! "A real GPU").
 
 use rayon::prelude::*;
 
@@ -13,7 +13,7 @@ use super::record::{Params, Record, WORKGROUP_SIZE};
 use super::shaders::Features;
 use super::{GpuContext, Kernel};
 
-/// A prepared scene's light records, IES atlas and dome texture atlas on the device.
+/// A prepared scene's light records, IES atlas and texture atlas on the device.
 pub(crate) struct GpuLights {
     pub(super) buffer: wgpu::Buffer,
     pub(super) ies_atlas: wgpu::Buffer,
@@ -78,13 +78,13 @@ pub(crate) struct Scratch {
 }
 
 impl GpuContext {
-    /// Uploads the records, the IES atlas and the dome texture atlas of a prepared scene (None
+    /// Uploads the records, the IES atlas and the texture atlas of a prepared scene (None
     /// when there are no lights).
     pub fn upload(
         &self,
         records: &[Record],
         ies_atlas: &[f32],
-        tex_atlas: &super::dome_atlas::Atlas,
+        tex_atlas: &super::texture_atlas::Atlas,
     ) -> Result<Option<GpuLights>> {
         if records.is_empty() {
             return Ok(None);
@@ -128,7 +128,7 @@ impl GpuContext {
             self.queue
                 .write_buffer(&ies_atlas_buffer, 0, bytemuck::cast_slice(ies_atlas));
         }
-        // One atlas per scene, reduced to fit the binding limit (dome_atlas::scene_atlas) where
+        // One atlas per scene, reduced to fit the binding limit (texture_atlas::scene_atlas) where
         // its textures allow; refused whole when it still does not fit.
         let tex_bytes = (tex_atlas.len() * 4) as u64;
         if tex_bytes > self.limits.max_storage_buffer_binding_size {
@@ -154,7 +154,7 @@ impl GpuContext {
             ));
         }
         let tex_atlas_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("dome texture atlas"),
+            label: Some("texture atlas"),
             size: tex_bytes.max(4),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,

@@ -5,7 +5,7 @@
 
 pub(crate) mod cache;
 pub(crate) mod dispatch;
-pub(crate) mod dome_atlas;
+pub(crate) mod texture_atlas;
 pub(crate) mod ies_atlas;
 pub(crate) mod record;
 pub(crate) mod resident;

@@ -38,10 +38,10 @@ pub const FLAG_AXIS_SINGULAR: u32 = 256;
 /// ShapingAPI carries an IES profile (`ies`: atlas base, angleScale, scale).
 pub const FLAG_IES: u32 = 512;
 /// A dome with a texture (`tex_inv`, `tex`: the dome frame and the atlas offset, see
-/// `gpu::dome_atlas` and `shaders/shared/dome.wgsl`).
+/// `gpu::texture_atlas` and `shaders/shared/texture.wgsl`).
 pub const FLAG_DOME_TEXTURE: u32 = 1024;
 /// A rect with a texture (`tex`: the atlas offset and filter; `tex_inv[0]`: the texture's mean
-/// colour, DESIGN.md §6 "RectLight texture"; see `shaders/shared/dome.wgsl`).
+/// colour, DESIGN.md §6 "RectLight texture"; see `shaders/shared/texture.wgsl`).
 pub const FLAG_RECT_TEXTURE: u32 = 2048;
 /// The irradiance kernel gives 0: the host adds the CPU reference's value
 /// (`prepare::Prepared::irradiance_on_host`).
@@ -154,7 +154,7 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 
 /// Rounds a prepared light's f64 constants to its GPU record; `ies_base` is where its IES
 /// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture
-/// starts in the scene's texture atlas (`gpu::dome_atlas`).
+/// starts in the scene's texture atlas (`gpu::texture_atlas`).
 pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Record {
     let m = p.to_local;
     // Local = M⁻¹·(x − o): row i is (row_i(M⁻¹), −row_i(M⁻¹)·o).

@@ -61,7 +61,7 @@ impl GpuContext {
     /// A light buffer for a scene with no lights: the kernels need a bound record array even
     /// when they evaluate none (summed mode still writes its zero rows).
     pub(crate) fn no_lights(&self) -> Result<GpuLights> {
-        let atlas = super::dome_atlas::Atlas::new();
+        let atlas = super::texture_atlas::Atlas::new();
         Ok(self
             .upload(&[Record::default()], &[], &atlas)?
             .expect("one record uploaded"))

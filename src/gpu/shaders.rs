@@ -2,7 +2,7 @@
 //! the composer inlines them once each, in dependency order, after a prelude of the constants
 //! shared with Rust: the record's kinds and flags ([`super::record::WGSL_CONSTANTS`]), the IES
 //! atlas codes ([`super::ies_atlas::wgsl_constants`]), the dome texture codes
-//! ([`super::dome_atlas::wgsl_constants`]) and the
+//! ([`super::texture_atlas::wgsl_constants`]) and the
 //! quadrature rules and tuning constants of [`crate::rules`]. No constant is retyped in WGSL.
 //!
 //! Optional parts of a kernel sit between `// #if NAME` and `// #endif` lines ([`Features`]);
@@ -16,7 +16,7 @@ use std::collections::HashSet;
 use std::sync::OnceLock;
 
 use super::record::WGSL_CONSTANTS;
-use super::{dome_atlas, ies_atlas};
+use super::{texture_atlas, ies_atlas};
 use crate::rules;
 
 /// Every WGSL source file, by its path under `shaders/`.
@@ -46,8 +46,8 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/ies.wgsl"),
     ),
     (
-        "shared/dome.wgsl",
-        include_str!("../../shaders/shared/dome.wgsl"),
+        "shared/texture.wgsl",
+        include_str!("../../shaders/shared/texture.wgsl"),
     ),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
@@ -129,7 +129,7 @@ impl Kernel {
 pub struct Features {
     /// `IES`: the IES profile lookup (shared/ies.wgsl), for scenes with a profile.
     pub ies: bool,
-    /// `TEXTURE`: the dome and rect texture lookups (shared/dome.wgsl), for scenes with one.
+    /// `TEXTURE`: the dome and rect texture lookups (shared/texture.wgsl), for scenes with one.
     pub texture: bool,
     /// `CHART`: the irradiance chart quadrature (irradiance/outer.wgsl), for the lights
     /// [`super::record::Record::features`] says need it.
@@ -142,8 +142,8 @@ impl Features {
     /// The names of `// #if` blocks, in the order of the fields.
     pub const NAMES: [&'static str; 4] = ["IES", "TEXTURE", "CHART", "LINE"];
 
-    /// Every part on.
-    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
+    /// Every part on (for the tests' naga checks).
+    #[cfg(any(test, feature = "testkit"))]
     pub const ALL: Features = Features {
         ies: true,
         texture: true,
@@ -174,7 +174,7 @@ impl Features {
     }
 
     /// Each combination of the parts `kernel`'s source has (tests/wgsl.rs validates each).
-    #[cfg_attr(not(feature = "testkit"), allow(dead_code))]
+    #[cfg(any(test, feature = "testkit"))]
     pub fn variants(kernel: Kernel) -> Vec<Features> {
         let used = Features::used_by(kernel);
         (0..1u32 << Features::NAMES.len())
@@ -241,7 +241,7 @@ fn source(path: &str) -> &'static str {
 /// The prelude of shared constants.
 pub fn prelude() -> String {
     let mut s = String::from(
-        "// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs, src/gpu/dome_atlas.rs and \
+        "// Generated from src/gpu/record.rs, src/gpu/ies_atlas.rs, src/gpu/texture_atlas.rs and \
          src/rules.rs.\n",
     );
     for (name, value) in WGSL_CONSTANTS
@@ -249,7 +249,7 @@ pub fn prelude() -> String {
         .copied()
         .chain(rules::wgsl_u32_constants())
         .chain(ies_atlas::wgsl_constants())
-        .chain(dome_atlas::wgsl_constants())
+        .chain(texture_atlas::wgsl_constants())
     {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
@@ -258,7 +258,7 @@ pub fn prelude() -> String {
     }
     for (name, values) in rules::wgsl_f32_arrays()
         .into_iter()
-        .chain(dome_atlas::wgsl_f32_arrays())
+        .chain(texture_atlas::wgsl_f32_arrays())
     {
         let items: Vec<String> = values.iter().map(|v| f32_literal(*v)).collect();
         s.push_str(&format!(

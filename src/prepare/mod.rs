@@ -7,7 +7,7 @@
 
 pub mod assets;
 pub mod blackbody;
-pub mod dome;
+pub mod texture;
 pub mod ies;
 pub mod ies_kinks;
 pub mod normalize;
@@ -98,10 +98,10 @@ pub struct Prepared {
     /// The IES profile of ShapingAPI, where authored (and the light shapeable).
     pub ies: Option<PreparedIes>,
     /// A dome's environment map, where `texture:file` is authored (DESIGN.md §6 D1–D6).
-    pub texture: Option<dome::PreparedTexture>,
+    pub texture: Option<texture::PreparedTexture>,
     /// A RectLight's image, where `texture:file` is authored (DESIGN.md §6 "RectLight
     /// texture"); kept apart from [`Prepared::texture`], which is a dome's.
-    pub rect_texture: Option<dome::RectTexture>,
+    pub rect_texture: Option<texture::RectTexture>,
 }
 
 impl Prepared {
@@ -245,7 +245,7 @@ fn prepare_texture(
     t: &Texture,
     linear: DMat3,
     cache: &mut AssetCache,
-) -> Result<dome::PreparedTexture> {
+) -> Result<texture::PreparedTexture> {
     if light.kind != LightType::Dome {
         return Err(LuxError::attr(
             &light.path,
@@ -263,14 +263,14 @@ fn prepare_texture(
     let image = cache
         .texture(&t.file)
         .map_err(|e| asset_err("inputs:texture:file", e))?;
-    let format = dome::resolve_format(t.format, &image)
+    let format = texture::resolve_format(t.format, &image)
         .map_err(|e| asset_err("inputs:texture:format", e.into()))?;
-    let frame = dome::DomeFrame::new(linear, dome::pole_offset(t.pole_axis, light.stage_up))
+    let frame = texture::DomeFrame::new(linear, texture::pole_offset(t.pole_axis, light.stage_up))
         .ok_or_else(|| LuxError::InvalidTransform {
             light: light.path.clone(),
             reason: "is singular, so the dome has no direction".into(),
         })?;
-    Ok(dome::PreparedTexture {
+    Ok(texture::PreparedTexture {
         image,
         format,
         frame,
@@ -285,11 +285,11 @@ fn prepare_rect_texture(
     light: &Light,
     t: &Texture,
     cache: &mut AssetCache,
-) -> Result<dome::RectTexture> {
+) -> Result<texture::RectTexture> {
     let image = cache.texture(&t.file).map_err(|source| {
         LuxError::asset(&light.path, "inputs:texture:file", &t.file.authored, source)
     })?;
-    Ok(dome::RectTexture::new(image, t.filter))
+    Ok(texture::RectTexture::new(image, t.filter))
 }
 
 /// The largest magnitude of a length (a position, a size, an entry of the world transform or

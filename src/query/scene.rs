@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
-use crate::gpu::{GpuLights, Input, Kernel, Scratch, dome_atlas, ies_atlas, record};
+use crate::gpu::{GpuLights, Input, Kernel, Scratch, texture_atlas, ies_atlas, record};
 use crate::model::Light;
 use crate::prepare::{self, Prepared, TemperatureMode};
 
@@ -61,7 +61,7 @@ impl PreparedScene {
                 let (atlas, bases) = ies_atlas::scene_atlas(&lights)
                     .map_err(|e| LuxError::input("IES profiles", e.to_string()))?;
                 let limit = g.device_limits().max_storage_buffer_binding_size;
-                let (tex_atlas, offsets, reduced) = dome_atlas::scene_atlas(&lights, limit)
+                let (tex_atlas, offsets, reduced) = texture_atlas::scene_atlas(&lights, limit)
                     .map_err(|e| LuxError::input("textures", e.to_string()))?;
                 for r in reduced {
                     warnings.push(format!(

@@ -412,16 +412,6 @@ fn convert(p: &usd::LightPrim, up: UpAxis) -> std::result::Result<(Light, Option
         "RectLight" | "DomeLight" | "DomeLight_1" => texture(&r, ty)?,
         _ => None,
     };
-    // Texture evaluation is being integrated (issue 9): a texture luxeval does not evaluate yet
-    // is reported and the light skipped, never evaluated as if untextured.
-    if let Some(t) = &texture
-        && !texture_is_evaluated(&kind, t)
-    {
-        return Err(format!(
-            "{path}: {ty} texture:file is not supported yet (@{}@)",
-            t.file.authored
-        ));
-    }
     let shaped = p.applied_schemas.iter().any(|s| s == "ShapingAPI");
     let inputs = LightInputs {
         intensity: r.float("inputs:intensity")?,
@@ -488,13 +478,6 @@ fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, String>
         })?);
     }
     Ok(Some(t))
-}
-
-/// Whether the queries evaluate this light's texture: dome and RectLight textures are evaluated
-/// by every query on both paths (the GPU path takes their irradiance from the CPU reference);
-/// a texture on any other type would stay listed as skipped, with the warning.
-fn texture_is_evaluated(kind: &LightType, _texture: &Texture) -> bool {
-    matches!(kind, LightType::Dome | LightType::Rect { .. })
 }
 
 #[cfg(test)]

@@ -31,14 +31,14 @@ use std::sync::{Arc, OnceLock};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::prepare::dome::Filter;
-use crate::prepare::dome::Image;
-use crate::prepare::dome::{DomeFormat, DomeFrame, FormatError};
+use crate::prepare::texture::Filter;
+use crate::prepare::texture::Image;
+use crate::prepare::texture::{DomeFormat, DomeFrame, FormatError};
 use pieces::{Domain, Geometry, HorizonCurve, Piece, PieceGrid, exact, tensor};
 use quadrature::gl;
 
 /// The irradiance tables of a prepared textured dome, built on first use and kept in the
-/// texture's [`crate::prepare::dome::PreparedTexture::irradiance`] slot (shared by clones of the
+/// texture's [`crate::prepare::texture::PreparedTexture::irradiance`] slot (shared by clones of the
 /// light). `None` for a light without a texture, or a cross whose size is not 3N × 4N (which
 /// preparation already refuses).
 pub fn tables(p: &crate::prepare::Prepared) -> Option<Arc<DomeIrradiance>> {
@@ -212,7 +212,7 @@ impl DomeIrradiance {
     /// The piece's texture scale for tolerances: its largest corner texel (summed channels) times
     /// its solid angle estimate.
     fn scale(&self, p: &Piece) -> f64 {
-        let t = |i, j| crate::cpu::dome::tex_fetch(&self.img, i, j);
+        let t = |i, j| crate::cpu::texture::tex_fetch(&self.img, i, j);
         let m = [
             t(p.ax.i0, p.ay.i0),
             t(p.ax.i1, p.ay.i0),
@@ -256,7 +256,7 @@ impl DomeIrradiance {
                         cx[a][1] * ry[b][1],
                         cx[a][2] * ry[b][0],
                     ) * k;
-                    let tex = crate::cpu::dome::tex_fetch(&self.img, i, j);
+                    let tex = crate::cpu::texture::tex_fetch(&self.img, i, j);
                     add(&mut v, &outer(tex, m));
                 }
                 v

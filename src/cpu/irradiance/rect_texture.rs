@@ -23,9 +23,9 @@
 use glam::{DVec2, DVec3};
 
 use super::chart::{Chart, Region};
-use crate::cpu::dome::sample_rect;
+use crate::cpu::texture::sample_rect;
 use crate::prepare::Prepared;
-use crate::prepare::dome::{Filter, Image, axis_pieces};
+use crate::prepare::texture::{Filter, Image, axis_pieces};
 
 /// A textured rect's texture as the chart quadrature reads it.
 pub struct ChartTexture<'a> {
@@ -64,7 +64,7 @@ pub fn chart_texture<'a>(p: &'a Prepared, chart: &Chart) -> Option<ChartTexture<
 }
 
 /// Where the reconstruction of an axis of `n` texels is not smooth, as fractions of the axis
-/// in (0, 1): the ends of `prepare::dome::axis_pieces` (clamped, so no wrap), interior only.
+/// in (0, 1): the ends of `prepare::texture::axis_pieces` (clamped, so no wrap), interior only.
 fn breaks(n: usize, filter: Filter) -> Vec<f64> {
     let nf = n as f64;
     let mut v: Vec<f64> = axis_pieces(n as u32, false, filter)
@@ -108,7 +108,7 @@ mod tests {
     use crate::cpu::shaping::shaping;
     use crate::model::{Light, LightType, Shaping};
     use crate::prepare::TemperatureMode;
-    use crate::prepare::dome::RectTexture;
+    use crate::prepare::texture::RectTexture;
     use crate::synthetic::Rng;
 
     fn textured(l: &Light, w: usize, h: usize, rgb: Vec<[f32; 3]>, filter: Filter) -> Prepared {
@@ -194,7 +194,7 @@ mod tests {
     }
 
     /// The bilinear reconstruction clamped at the borders, written here independently of
-    /// `cpu::dome::filter_block`: texel centres at (i + ½)/W.
+    /// `cpu::texture::filter_block`: texel centres at (i + ½)/W.
     fn bilinear(rgb: &[[f32; 3]], w: usize, h: usize, s: f64, t: f64) -> DVec3 {
         let tex = |i: f64, j: f64| {
             let i = i.clamp(0.0, (w - 1) as f64) as usize;

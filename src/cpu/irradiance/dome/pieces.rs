@@ -4,7 +4,7 @@
 //!
 //! A piece is a rectangle of the image sheet (pixel units) between texel-centre lines (bilinear)
 //! or texel edges (nearest), inside one cross face for `cubeMapVerticalCross`; on it the texture
-//! is `Σ wx(x)·wy(y)·T` with linear weights ([`crate::prepare::dome::AxisPiece`]). The map sheet → dome
+//! is `Σ wx(x)·wy(y)·T` with linear weights ([`crate::prepare::texture::AxisPiece`]). The map sheet → dome
 //! direction is smooth inside a piece (§6 D2–D5), with the dome solid angle per pixel area `J`:
 //! latlong `sin θ · (2π/W)(π/H)`; mirroredBall `4 · (2/W)(2/H)` (the mirror ball is equal-area);
 //! angular `π sin(πr)/r · (2/W)(2/H)`; cross `(2/N)² / |F + aR + bU|³` (gnomonic).
@@ -23,10 +23,10 @@
 use glam::{DVec2, DVec3};
 
 use super::quadrature::{adaptive, gl, sign_change_roots};
-use crate::cpu::dome;
-use crate::prepare::dome::Image;
-use crate::prepare::dome::{AxisPiece, Filter, axis_pieces};
-use crate::prepare::dome::{DomeFormat, ball_dir};
+use crate::cpu::texture;
+use crate::prepare::texture::Image;
+use crate::prepare::texture::{AxisPiece, Filter, axis_pieces};
+use crate::prepare::texture::{DomeFormat, ball_dir};
 
 const PI: f64 = std::f64::consts::PI;
 const TAU: f64 = std::f64::consts::TAU;
@@ -48,7 +48,7 @@ pub struct Geometry {
 pub struct PieceGrid {
     pub xs: Vec<AxisPiece>,
     pub ys: Vec<AxisPiece>,
-    /// Cross face (dome::cross_face numbering); 0 otherwise.
+    /// Cross face (texture::cross_face numbering); 0 otherwise.
     pub face: u32,
 }
 
@@ -131,7 +131,7 @@ impl Geometry {
                 let n = self.n as u32;
                 (0..6)
                     .map(|f| {
-                        let b = dome::cross_basis(f).3;
+                        let b = texture::cross_basis(f).3;
                         let shift = |p: AxisPiece, k: u32| {
                             let o = (k * n) as f64;
                             AxisPiece {
@@ -198,7 +198,7 @@ impl Geometry {
                 )
             }
             DomeFormat::Cross => {
-                let (f, r, u, blk) = dome::cross_basis(face);
+                let (f, r, u, blk) = texture::cross_basis(face);
                 let a = 2.0 * (x - blk.x * self.n) / self.n - 1.0;
                 let b = 1.0 - 2.0 * (y - blk.y * self.n) / self.n;
                 let v = f + a * r + b * u;
@@ -276,7 +276,7 @@ impl AxisPiece {
 pub fn texture_at(img: &Image, p: &Piece, x: f64, y: f64) -> DVec3 {
     let (wx0, wx1) = p.ax.weights(x);
     let (wy0, wy1) = p.ay.weights(y);
-    let t = |i: u32, j: u32| dome::tex_fetch(img, i, j);
+    let t = |i: u32, j: u32| texture::tex_fetch(img, i, j);
     let top = t(p.ax.i0, p.ay.i0) * wx0
         + if wx1 != 0.0 {
             t(p.ax.i1, p.ay.i0) * wx1
@@ -490,7 +490,7 @@ fn inner_roots(
         }
         DomeFormat::Cross => {
             // m·(F + aR + bU) = 0 is a line in the face's (a, b).
-            let (f, r, u, blk) = dome::cross_basis(face);
+            let (f, r, u, blk) = texture::cross_basis(face);
             let a = 2.0 * (x - blk.x * g.n) / g.n - 1.0;
             let mu = m.dot(u);
             if mu != 0.0 {
@@ -582,9 +582,9 @@ impl HorizonCurve {
     pub fn point(&self, g: f64) -> DVec2 {
         let d = g.cos() * self.e1 + g.sin() * self.e2;
         let st = if self.format == DomeFormat::MirroredBall {
-            dome::mirrored_ball_st(d)
+            texture::mirrored_ball_st(d)
         } else {
-            dome::angular_st(d)
+            texture::angular_st(d)
         };
         DVec2::new(2.0 * st.x - 1.0, 1.0 - 2.0 * st.y)
     }

@@ -1,6 +1,6 @@
 //! Every dome and rect texture of a scene packed into one flat `f32` storage buffer for
-//! `shaders/shared/dome.wgsl` (`tex_atlas`, binding 6). Ported from the staged crate
-//! `luxeval-dome` (`src/atlas.rs`), on the model of [`super::ies_atlas`]: one atlas per scene.
+//! `shaders/shared/texture.wgsl` (`tex_atlas`, binding 6), on the model of [`super::ies_atlas`]:
+//! one atlas per scene.
 //!
 //! Layout: textures one after another; a texture at offset `o` (f32 units, a multiple of 4) is
 //! `[width, height, format, 0]` as u32 bit patterns ([`HEADER_WORDS`] words), then
@@ -19,7 +19,7 @@
 use std::sync::Arc;
 
 use crate::prepare::Prepared;
-use crate::prepare::dome::{
+use crate::prepare::texture::{
     CROSS_FACES, FILTER_BILINEAR, FILTER_NEAREST, FORMAT_ANGULAR, FORMAT_CROSS, FORMAT_LATLONG,
     FORMAT_MIRRORED_BALL, FORMAT_RECT, Image,
 };
@@ -115,7 +115,7 @@ impl Atlas {
     }
 }
 
-/// The `u32` constants `dome.wgsl` uses, by name, for the generated WGSL prelude (DESIGN.md §1:
+/// The `u32` constants `texture.wgsl` uses, by name, for the generated WGSL prelude (DESIGN.md §1:
 /// shared constants are generated into the WGSL, never retyped).
 pub fn wgsl_constants() -> Vec<(&'static str, u32)> {
     vec![
@@ -134,7 +134,7 @@ pub fn wgsl_constants() -> Vec<(&'static str, u32)> {
 /// Floats per face of [`CROSS_FACES`] in the generated `CROSS_FACE_TABLE`: F, R, U, block.
 pub const CROSS_FACE_STRIDE: usize = 11;
 
-/// The f32 arrays `dome.wgsl` reads, for the generated prelude: §6 D5's cube-cross table
+/// The f32 arrays `texture.wgsl` reads, for the generated prelude: §6 D5's cube-cross table
 /// ([`CROSS_FACES`]) flattened face by face as (F, R, U, block column, block row).
 pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     let table = CROSS_FACES

@@ -1,22 +1,18 @@
-//! Dome and rect texture lookup on the CPU (f64). Twin of `shaders/shared/dome.wgsl` (which
-//! reads the texture atlas packed by `src/gpu/dome_atlas.rs`): the same functions
+//! Texture lookup on the CPU (f64): a dome's environment map and a rect's image. Twin of `shaders/shared/texture.wgsl` (which
+//! reads the texture atlas packed by `src/gpu/texture_atlas.rs`): the same functions
 //! with the same names in the same order, one per step (world direction → dome direction →
 //! format coordinates → filtered texel). The codes and the cube-cross table come from
-//! [`crate::prepare::dome`], which both backends read.
+//! [`crate::prepare::texture`], which both backends read.
 //!
 //! Every formula is DESIGN.md §6 "Dome lights" D1–D5 and "RectLight texture"; the comments cite
 //! the paragraph. Directions are unit vectors; `(s, t)` are image coordinates in `[0, 1]`
 //! (s to the right, t down); pixel coordinates are `px = s·W`, `py = t·H` (§6 D1).
 
-// The rect lookups and the helpers the irradiance port will use (issue 9) are exercised by the
-// tests below until their callers land.
-#![allow(dead_code)]
-
 use glam::{DMat3, DVec2, DVec3, DVec4};
 
 use crate::prepare::Prepared;
-use crate::prepare::dome::{DomeFormat, Filter, Image, cross_face_basis};
-use crate::prepare::dome::{
+use crate::prepare::texture::{DomeFormat, Filter, Image, cross_face_basis};
+use crate::prepare::texture::{
     FILTER_NEAREST, FORMAT_ANGULAR, FORMAT_LATLONG, FORMAT_MIRRORED_BALL, FORMAT_RECT,
 };
 
@@ -113,7 +109,7 @@ pub fn cross_face(d: DVec3) -> u32 {
 }
 
 /// §6 D5's table: (F, R, U) of face `f` and its block (column, row) in the cross
-/// ([`crate::prepare::dome::CROSS_FACES`]).
+/// ([`crate::prepare::texture::CROSS_FACES`]).
 pub fn cross_basis(f: u32) -> (DVec3, DVec3, DVec3, DVec2) {
     cross_face_basis(f)
 }
@@ -230,7 +226,7 @@ pub fn dome_factor(p: &Prepared, e: DVec3) -> DVec3 {
 }
 
 /// A rect light's texture factor for `emission` (§6 "RectLight texture"): the exact area mean
-/// of the filtered reconstruction (`prepare::dome::area_mean`), 1 without a texture.
+/// of the filtered reconstruction (`prepare::texture::area_mean`), 1 without a texture.
 pub fn rect_mean(p: &Prepared) -> DVec3 {
     match &p.rect_texture {
         Some(t) => t.mean(),
@@ -256,8 +252,9 @@ pub fn rect_factor(p: &Prepared, hit: DVec2) -> DVec3 {
     }
 }
 
+#[cfg(test)]
 /// The filtered dome texel along dome direction `d` (§6 D1–D5). `format` must come from
-/// [`crate::prepare::dome::resolve_format`] (which checks the cross's 3N × 4N shape).
+/// [`crate::prepare::texture::resolve_format`] (which checks the cross's 3N × 4N shape).
 pub fn sample_dome(img: &Image, format: DomeFormat, d: DVec3, filter: Filter) -> DVec3 {
     dome_texel(img, tex_info(img, format.code()), d, filter.code())
 }
@@ -277,7 +274,7 @@ pub fn sample_rect(img: &Image, st: DVec2, filter: Filter) -> DVec3 {
 }
 
 /// Dome direction → `(s, t)` of the format (for the cross the sheet's `(s, t)`, i.e. the block
-/// offset applied); the inverse is [`crate::prepare::dome::st_to_direction`].
+/// offset applied); the inverse is [`crate::prepare::texture::st_to_direction`].
 pub fn direction_to_st(format: DomeFormat, d: DVec3) -> DVec2 {
     match format {
         DomeFormat::LatLong => latlong_st(d),
@@ -297,7 +294,7 @@ mod tests {
     use crate::model::{Asset, Light, PoleAxis, Texture, TextureFormat, UpAxis};
     use crate::prepare::TemperatureMode;
     use crate::prepare::assets::AssetCache;
-    use crate::prepare::dome::{DomeFrame, pole_offset, st_to_direction};
+    use crate::prepare::texture::{DomeFrame, pole_offset, st_to_direction};
     use crate::synthetic::Rng;
 
     const CHART: &str = concat!(
@@ -393,7 +390,7 @@ mod tests {
         // automatic: the chart is 2:1, so latlong.
         assert_eq!(
             p.texture.as_ref().unwrap().format,
-            crate::prepare::dome::DomeFormat::LatLong
+            crate::prepare::texture::DomeFormat::LatLong
         );
         let e = crate::cpu::emission::emission(&p, DVec3::X);
         assert_eq!(colour_name(e / 6.0), "green");

@@ -1,13 +1,9 @@
-//! Dome textures as both backends use them (DESIGN.md §6 D1–D6, "RectLight texture"): which
-//! format a file is (`automatic`), the dome's frame (poleAxis offset `P` composed with the world
-//! 3×3 `A`), the codes and the cube-cross table the lookups share, the inverse maps (image
-//! coordinates → direction, for tests and irradiance) and the reconstruction's pieces. Ported
-//! from the staged crate `luxeval-dome` (`src/mapping.rs`, `src/filter.rs`); the per-lookup
-//! forward maps are the CPU twin of `dome.wgsl`, `src/cpu/dome.rs`, which reads this module.
-
-// The inverse maps, pieces and rect helpers serve the irradiance and rect steps of issue 9 still
-// to land; tests exercise them meanwhile.
-#![allow(dead_code)]
+//! Textures as both backends use them, a dome's environment map and a rect's image (DESIGN.md
+//! §6 D1–D6, "RectLight texture"): which format a file is (`automatic`), the dome's frame
+//! (poleAxis offset `P` composed with the world 3×3 `A`), the codes and the cube-cross table the
+//! lookups share, the inverse maps (image coordinates → direction, for tests and irradiance) and
+//! the reconstruction's pieces. The per-lookup forward maps are the CPU twin of `texture.wgsl`,
+//! `src/cpu/texture.rs`, which reads this module.
 
 use std::sync::Arc;
 
@@ -95,6 +91,7 @@ pub enum DomeFormat {
 }
 
 impl DomeFormat {
+    #[cfg(test)]
     pub const ALL: [DomeFormat; 4] = [
         DomeFormat::LatLong,
         DomeFormat::MirroredBall,
@@ -196,6 +193,7 @@ impl DomeFrame {
         })
     }
 
+    #[cfg(test)]
     pub fn identity() -> DomeFrame {
         DomeFrame {
             a_eff: DMat3::IDENTITY,
@@ -204,12 +202,13 @@ impl DomeFrame {
         }
     }
 
-    /// World direction → dome direction (§6 D1; `dome_direction` of `src/cpu/dome.rs`).
+    /// World direction → dome direction (§6 D1; `dome_direction` of `src/cpu/texture.rs`).
     pub fn to_dome(self, w: DVec3) -> DVec3 {
         (self.inv * w).normalize()
     }
 
     /// Dome direction → world direction (unit).
+    #[cfg(test)]
     pub fn to_world(self, d: DVec3) -> DVec3 {
         (self.a_eff * d).normalize()
     }
@@ -222,6 +221,7 @@ impl DomeFrame {
 
     /// World solid angle per dome solid angle at dome direction `d` (§6 D1):
     /// `|det A| / |A_eff d|³`.
+    #[cfg(test)]
     pub fn jacobian(&self, d: DVec3) -> f64 {
         let l = (self.a_eff * d).length();
         self.det_abs / (l * l * l)
@@ -293,7 +293,8 @@ pub fn cross_face_basis(f: u32) -> (DVec3, DVec3, DVec3, DVec2) {
     )
 }
 
-/// `(s, t)` → dome direction, the inverse of the forward maps (`src/cpu/dome.rs`). `None`
+#[cfg(test)]
+/// `(s, t)` → dome direction, the inverse of the forward maps (`src/cpu/texture.rs`). `None`
 /// outside the format's domain (outside the disk for mirroredBall/angular, outside the six faces
 /// for the cross).
 pub fn st_to_direction(format: DomeFormat, st: DVec2) -> Option<DVec3> {
@@ -321,6 +322,7 @@ pub fn st_to_direction(format: DomeFormat, st: DVec2) -> Option<DVec3> {
     }
 }
 
+#[cfg(test)]
 /// Inverse of §6 D2: `φ = 2π(0.5 − s)`, `θ = πt`, `d = (sin θ sin φ, cos θ, sin θ cos φ)`.
 pub fn latlong_dir(s: f64, t: f64) -> DVec3 {
     let phi = std::f64::consts::TAU * (0.5 - s);
@@ -336,6 +338,7 @@ pub fn ball_dir(a: f64, b: f64) -> DVec3 {
     DVec3::new(a * q, b * q, 1.0 - 2.0 * r2)
 }
 
+#[cfg(test)]
 /// §6 D4: `d = (a·sin(πr)/r, b·sin(πr)/r, cos πr)` (sin(πr)/r → π at the centre).
 pub fn angular_dir(a: f64, b: f64) -> DVec3 {
     let r = (a * a + b * b).sqrt().min(1.0);
@@ -348,23 +351,20 @@ pub fn angular_dir(a: f64, b: f64) -> DVec3 {
     DVec3::new(a * k, b * k, pr.cos())
 }
 
+#[cfg(test)]
 /// §6 D5: `d = normalize(F + a·R + b·U)` on face `f`.
 pub fn cross_dir(f: u32, a: f64, b: f64) -> DVec3 {
     let (fw, r, u, _) = cross_face_basis(f);
     (fw + a * r + b * u).normalize()
 }
 
+#[cfg(test)]
 /// The face stored in block (column, row) of the vertical cross, if any.
 pub fn face_at_block(col: u32, row: u32) -> Option<u32> {
     (0..6).find(|&f| {
         let b = CROSS_FACES[f as usize].3;
         b[0] as u32 == col && b[1] as u32 == row
     })
-}
-
-/// Inverse of §6 "RectLight texture"'s `(s, t)`: `(s, t)` → local `(x, y)` on a `w × h` rect.
-pub fn rect_xy(st: DVec2, w: f64, h: f64) -> DVec2 {
-    DVec2::new((0.5 - st.x) * w, (0.5 - st.y) * h)
 }
 
 /// One piece of a 1-D reconstruction on an axis of `n` texels (pixel units): on `[x0, x1]` the

@@ -1,18 +1,18 @@
-// Twin of src/cpu/dome.rs
+// Twin of src/cpu/texture.rs
 //
-// Dome and rect texture lookup on the GPU: the same functions with the same names in the same
-// order as the Rust twin, which carries the DESIGN.md §6 D1–D5 and "RectLight texture"
-// citations for every formula. Ported from the staged crate luxeval-dome.
+// Texture lookup on the GPU, a dome's environment map and a rect's image: the same functions with
+// the same names in the same order as the Rust twin, which carries the DESIGN.md §6 D1–D5 and
+// "RectLight texture" citations for every formula.
 //
 // Texels live in one flat storage buffer, `tex_atlas: array<f32>` (declared in
-// shared/record.wgsl at @group(0) @binding(6)), packed by src/gpu/dome_atlas.rs: a texture at
+// shared/record.wgsl at @group(0) @binding(6)), packed by src/gpu/texture_atlas.rs: a texture at
 // offset `o` (in f32 units, a multiple of 4) is a TEX_HEADER_WORDS-word header — width, height,
 // format code, 0 (u32 bit patterns) — followed by width × height RGB triplets, row-major, row 0
 // at the top: texel (i, j) is at o + 4 + 3·(j·width + i). A light record carries its texture's
 // offset and filter in `tex`, and A_eff⁻¹ in `tex_inv0..2` (FLAG_DOME_TEXTURE); a textured rect
 // (FLAG_RECT_TEXTURE) its offset and filter in `tex` and its mean colour in `tex_inv0.rgb`. The FORMAT_*,
 // FILTER_* codes and §6 D5's cube-cross table (CROSS_FACE_TABLE) are generated from Rust
-// (gpu::dome_atlas::wgsl_constants, wgsl_f32_arrays).
+// (gpu::texture_atlas::wgsl_constants, wgsl_f32_arrays).
 //
 // Deliberate f32 divergences from the f64 twin, and why:
 // 1. Everything is f32. Pixel coordinates s·W carry about W·2⁻²⁴ px of rounding (5e-4 px at
