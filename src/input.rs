@@ -140,7 +140,10 @@ mod tests {
         let e = RowKind::Points
             .f32_from_f64(5, &[[0.0; 3], [1e300, 0.0, 0.0]])
             .unwrap_err();
-        assert_eq!(e.to_string(), "row 6 = [1e300, 0.0, 0.0] is outside float32's range");
+        assert_eq!(
+            e.to_string(),
+            "row 6 = [1e300, 0.0, 0.0] is outside float32's range"
+        );
     }
 
     #[test]

@@ -90,38 +90,65 @@ pub fn gk15_unit() -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     )
 }
 
-/// n-point Gauss–Legendre nodes and weights on [0, 1] (ascending nodes).
-pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+/// The n-point Gauss–Legendre rule on [−1, 1], (nodes ascending, weights): the one builder of
+/// luxeval's Gauss–Legendre rules. Nodes by Newton's iteration on Pₙ from Tricomi's initial
+/// guess, converged to rounding; weights `2 / ((1 − x²) Pₙ'(x)²)` (Abramowitz & Stegun 25.4.29);
+/// symmetric by construction, the middle node of an odd rule exactly 0.
+pub fn gauss_legendre_pm1(n: usize) -> (Vec<f64>, Vec<f64>) {
+    if n == 0 {
+        return (vec![], vec![]);
+    }
     let mut x = vec![0.0; n];
     let mut w = vec![0.0; n];
     for i in 0..n.div_ceil(2) {
-        // Initial guess for the i-th largest root of Pₙ on [−1, 1].
+        // Tricomi's initial guess for the i-th largest root, then Newton on Pₙ.
         let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
         let mut dp = 1.0;
         for _ in 0..100 {
-            let (mut p0, mut p1) = (1.0, z);
-            for k in 2..=n {
-                let p2 = ((2 * k - 1) as f64 * z * p1 - (k - 1) as f64 * p0) / k as f64;
-                p0 = p1;
-                p1 = p2;
-            }
-            let p = if n == 1 { z } else { p1 };
-            let pm1 = if n == 1 { 1.0 } else { p0 };
-            dp = n as f64 * (z * p - pm1) / (z * z - 1.0);
-            let dz = p / dp;
+            let (p, d) = legendre(n, z);
+            dp = d;
+            let dz = p / d;
             z -= dz;
             if dz.abs() < 1e-16 {
                 break;
             }
         }
+        let (_, d) = legendre(n, z);
+        dp = if d.is_finite() { d } else { dp };
         let wi = 2.0 / ((1.0 - z * z) * dp * dp);
-        // Map [−1, 1] → [0, 1].
-        x[n - 1 - i] = 0.5 * (1.0 + z);
-        x[i] = 0.5 * (1.0 - z);
-        w[n - 1 - i] = 0.5 * wi;
-        w[i] = 0.5 * wi;
+        x[i] = -z;
+        x[n - 1 - i] = z;
+        w[i] = wi;
+        w[n - 1 - i] = wi;
+    }
+    if n % 2 == 1 {
+        x[n / 2] = 0.0;
     }
     (x, w)
+}
+
+/// (Pₙ(z), Pₙ'(z)) by the three-term recurrence (A&S 22.7.10) and 22.8.5 for the derivative.
+fn legendre(n: usize, z: f64) -> (f64, f64) {
+    let (mut p0, mut p1) = (1.0, z);
+    for k in 2..=n {
+        let kf = k as f64;
+        let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
+        p0 = p1;
+        p1 = p2;
+    }
+    let p = if n == 0 { 1.0 } else { p1 };
+    let pm1 = if n == 0 { 0.0 } else { p0 };
+    (p, n as f64 * (z * p - pm1) / (z * z - 1.0))
+}
+
+/// n-point Gauss–Legendre nodes and weights on [0, 1] (ascending nodes): [`gauss_legendre_pm1`]
+/// mapped by `x ↦ (1 + x)/2`, weights halved.
+pub fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let (x, w) = gauss_legendre_pm1(n);
+    (
+        x.iter().map(|x| 0.5 * (1.0 + x)).collect(),
+        w.iter().map(|w| 0.5 * w).collect(),
+    )
 }
 
 // ---------------------------------------------------------------------------------------------

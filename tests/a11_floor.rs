@@ -15,8 +15,8 @@ use crate::common;
 use std::path::Path;
 
 use glam::DVec3;
-use luxeval::testkit::check::{self, BAND, TOLERANCE};
 use luxeval::FalloffPlane as Plane;
+use luxeval::testkit::check::{self, BAND, TOLERANCE};
 use luxeval::{Accumulate, Reference, Stage, TemperatureMode};
 
 fn dvec(v: [f32; 3]) -> DVec3 {

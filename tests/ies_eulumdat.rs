@@ -3,8 +3,8 @@
 use crate::ies_common;
 
 use ies_common::*;
-use luxeval::IesFormat as Format;
 use luxeval::IesErrorKind as K;
+use luxeval::IesFormat as Format;
 use luxeval::IesProfile as Profile;
 use luxeval::testkit::ies_parts::ies_factor;
 
@@ -191,20 +191,12 @@ fn content_detection_ignores_the_extension() {
         ("a.ldt", &ldt, Format::Eulumdat),
         ("a.ies", &ldt, Format::Eulumdat),
         ("a.txt", &ldt, Format::Eulumdat),
-        (
-            "b.ldt",
-            &lm63,
-            Format::Lm63(luxeval::Lm63Version::V2002),
-        ),
+        ("b.ldt", &lm63, Format::Lm63(luxeval::Lm63Version::V2002)),
         ("b", &lm63, Format::Lm63(luxeval::Lm63Version::V2002)),
     ] {
         let path = dir.join(name);
         std::fs::write(&path, text).unwrap();
-        assert_eq!(
-            luxeval::read_ies(&path).unwrap().format,
-            want,
-            "{name}"
-        );
+        assert_eq!(luxeval::read_ies(&path).unwrap().format, want, "{name}");
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -9,8 +9,7 @@ use luxeval::testkit::ies_parts::ies_factor;
 
 fn load(name: &str) -> Profile {
     let path = format!("{}/tests/data/luxtest/{name}", env!("CARGO_MANIFEST_DIR"));
-    let file =
-        luxeval::read_ies(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let file = luxeval::read_ies(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
     Profile::new(&file).unwrap()
 }
 

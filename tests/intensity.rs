@@ -207,7 +207,8 @@ fn ies_flux_is_the_profiles() {
         "/tests/data/luxtest/test_vstripes_hquadrants_nonuniform.ies"
     ))
     .unwrap();
-    let file = luxeval::testkit::ies_parts::parse_any(text.as_bytes(), &|_| Err(String::new())).unwrap();
+    let file =
+        luxeval::testkit::ies_parts::parse_any(text.as_bytes(), &|_| Err(String::new())).unwrap();
     let exact = luxeval::IesProfile::new(&file).unwrap().flux_lm();
     let flux = r(&with(&text)).flux().unwrap().x;
     assert!(rel(flux, exact) < 1e-6, "{flux} vs {exact}");

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use luxeval::Stage;
 use crate::common::fuzz_file;
+use luxeval::Stage;
 
 #[test]
 fn corrupted_usda_never_panics() {

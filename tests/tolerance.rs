@@ -35,9 +35,7 @@ fn map(eval: &Evaluator, scene: &str, frame: f64) -> Vec<[f32; 3]> {
         .evaluable(&[])
         .unwrap();
     let prepared = eval.prepare(&lights).unwrap();
-    prepared.falloff(&floor(), |_, _| {})
-        .unwrap()
-        .rgb
+    prepared.falloff(&floor(), |_, _| {}).unwrap().rgb
 }
 
 /// The largest relative error of `got` against `want` over every pixel and channel; a pixel

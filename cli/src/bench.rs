@@ -6,8 +6,8 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 
-use luxeval::{Rng, synthetic_lights};
 use luxeval::{Accumulate, Evaluator};
+use luxeval::{Rng, synthetic_lights};
 
 use crate::exit::{CliResult, Failure};
 

@@ -6,12 +6,12 @@ use std::path::Path;
 
 use serde::Serialize;
 
+use crate::plot::numbers::decimal;
+use crate::plot::{Canvas, polar};
 use luxeval::{
     IesFile, IesFormat as Format, IesPlane as Plane, IesProfile as Profile, Lm63Version,
     PhotometricType, TiltSource,
 };
-use crate::plot::numbers::decimal;
-use crate::plot::{Canvas, polar};
 
 /// Integrated and rated flux may differ by this much before the report warns (a luminaire's
 /// light output ratio is normally ≤ 1, relative photometry scales by it; a larger mismatch is a

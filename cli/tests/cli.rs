@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use luxeval::Stage;
-use luxeval_cli::io::npy;
 use luxeval::{Accumulate, Evaluator};
+use luxeval_cli::io::npy;
 
 fn luxeval(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_luxeval"))

@@ -8,8 +8,8 @@ use crate::common;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use luxeval_cli::io::npy;
 use luxeval::{Accumulate, Evaluator, Stage};
+use luxeval_cli::io::npy;
 
 fn luxeval(args: &[&str], chunk: Option<&str>) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_luxeval"));

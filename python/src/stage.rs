@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use glam::DVec3;
 use luxeval::{
-    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, Stage, TemperatureMode, TextureFilter,
-    TimeRule,
+    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, Stage, TemperatureMode,
+    TextureFilter, TimeRule,
 };
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};

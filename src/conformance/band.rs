@@ -14,8 +14,8 @@ use crate::cpu::shaping::off_axis_angle;
 use crate::model::LightType;
 use crate::model::TextureFilter;
 use crate::prepare::Prepared;
-use crate::prepare::texture::DomeFormat;
 use crate::prepare::ies::{HFold, PhotometricType, VFold};
+use crate::prepare::texture::DomeFormat;
 use crate::query::Reference;
 use crate::synthetic::samples::local_extent;
 
@@ -44,7 +44,7 @@ pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
     let mut m = f64::INFINITY;
     match p.light.kind {
         LightType::Distant { .. } => {
-            let tm = p.distant_half_angle;
+            let tm = p.distant_half_angle();
             m = m.min((off_axis_angle(p.axis, e) - tm).abs());
         }
         LightType::Rect { .. } | LightType::Disk { .. } => {
@@ -386,7 +386,7 @@ pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
         LightType::Dome => return f64::INFINITY,
         LightType::Distant { .. } => {
             let band = IRRADIANCE_SLIVER_FACTOR * 2.0 * F32_ROUNDING;
-            let top = n.dot(-p.axis).clamp(-1.0, 1.0).asin() + p.distant_half_angle;
+            let top = n.dot(-p.axis).clamp(-1.0, 1.0).asin() + p.distant_half_angle();
             return scale(top, band);
         }
         LightType::Sphere {
@@ -501,7 +501,7 @@ pub const TEXEL_BAND: f64 = 1e-3;
 /// but always far below 1e-4 of the footprint's largest texel: errors are measured against that.
 /// 0 for other lights.
 pub fn texture_floor(p: &Prepared, w: DVec3) -> f64 {
-    let (LightType::Dome, Some(t)) = (&p.light.kind, &p.texture) else {
+    let (LightType::Dome, Some(t)) = (&p.light.kind, p.dome_texture()) else {
         return 0.0;
     };
     let (wd, hd) = (t.image.width, t.image.height);
@@ -526,7 +526,7 @@ pub fn texture_floor(p: &Prepared, w: DVec3) -> f64 {
 /// |d| within a relative `margin`: each face clamps to its own edge texels). In f64, on the
 /// reference's dome direction. False for other lights.
 pub fn near_texture_edge(p: &Prepared, w: DVec3, margin: f64) -> bool {
-    let (LightType::Dome, Some(t)) = (&p.light.kind, &p.texture) else {
+    let (LightType::Dome, Some(t)) = (&p.light.kind, p.dome_texture()) else {
         return false;
     };
     let d = t.frame.to_dome(w.normalize());

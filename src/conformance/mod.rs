@@ -272,7 +272,12 @@ pub fn check_with(
 /// (CPU value, margin, GPU value, input a, input b, error floor).
 type SampleEval = (DVec3, f64, [f32; 3], [f32; 3], Option<[f32; 3]>, f64);
 
-fn compare(r: &Reference, query: CheckedQuery, n: usize, f: impl Fn(usize) -> SampleEval) -> QueryReport {
+fn compare(
+    r: &Reference,
+    query: CheckedQuery,
+    n: usize,
+    f: impl Fn(usize) -> SampleEval,
+) -> QueryReport {
     let mut report = QueryReport {
         light: r.light().path.clone(),
         light_type: r.light().kind.usd_type(),

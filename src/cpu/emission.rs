@@ -7,8 +7,8 @@
 
 use glam::DVec3;
 
-use super::texture::{dome_factor, rect_mean};
 use super::shaping::{off_axis_angle, shaping};
+use super::texture::{dome_factor, rect_mean};
 use crate::model::LightType;
 use crate::prepare::Prepared;
 
@@ -21,7 +21,7 @@ pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
         LightType::Distant { .. } => {
             // A delta light (θmax = 0) has emission 0 (DESIGN.md §2 "Edge cases"); a finite
             // cone's boundary is inclusive. Distant lights are never shaped.
-            let theta_max = p.distant_half_angle;
+            let theta_max = p.distant_half_angle();
             if theta_max > 0.0 && off_axis_angle(p.axis, e) <= theta_max {
                 base
             } else {

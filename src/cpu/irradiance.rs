@@ -64,14 +64,14 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
     let e = match p.light.kind {
         // A textured dome's irradiance is the exact integral of its filtered texture (DESIGN.md
         // §6 "Dome and texture irradiance: what 'exact' means"), see dome.rs.
-        LightType::Dome if p.texture.is_some() => match dome::tables(p) {
+        LightType::Dome if p.dome_texture().is_some() => match dome::tables(p) {
             Some(t) => p.base * t.irradiance(n),
             None => DVec3::NAN,
         },
         LightType::Dome => p.base * PI,
         LightType::Distant { .. } => {
             let c = -p.axis;
-            let theta_max = p.distant_half_angle;
+            let theta_max = p.distant_half_angle();
             let sg = n.dot(c);
             if theta_max == 0.0 {
                 p.base * sg.max(0.0)
@@ -94,7 +94,7 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
             let xl = p.to_local * (x - p.origin);
             if !(xl.z < 0.0) {
                 DVec3::ZERO
-            } else if p.shaping.is_none() && p.rect_texture.is_none() {
+            } else if p.shaping.is_none() && p.rect_texture().is_none() {
                 p.base * rect_lambert(p, x, n, width / 2.0, height / 2.0)
             } else {
                 let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);

@@ -10,7 +10,6 @@
 //! Contract shared with the kernels: directions passed to the per-light functions are unit
 //! vectors; the batch entry points below normalise their inputs, as the kernels' entry points do.
 
-pub mod texture;
 pub mod emission;
 pub mod ies;
 pub mod intensity;
@@ -21,6 +20,7 @@ pub mod radiance;
 pub mod roots;
 pub mod shapes;
 pub mod shaping;
+pub mod texture;
 
 use std::collections::HashMap;
 
@@ -106,7 +106,7 @@ pub fn irradiance_batch(
     let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
         .iter()
         .map(|l| {
-            (matches!(l.light.kind, LightType::Dome) && l.texture.is_some())
+            (matches!(l.light.kind, LightType::Dome) && l.dome_texture().is_some())
                 .then(|| dome_by_normal(l, normals))
         })
         .collect();

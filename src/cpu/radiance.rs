@@ -8,9 +8,9 @@
 
 use glam::DVec3;
 
-use super::texture::rect_factor;
 use super::emission::{emission, surface_emission};
 use super::shapes::{cylinder_hit, disk_hit, plane_hit, rect_hit, sphere_hit};
+use super::texture::rect_factor;
 use crate::model::LightType;
 use crate::prepare::Prepared;
 
@@ -21,7 +21,7 @@ pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
         // which is ω itself.
         emission(p, w)
     } else if hits_emitting_surface(p, x, w) {
-        if p.rect_texture.is_some() {
+        if p.rect_texture().is_some() {
             // DESIGN.md §6 "RectLight texture": L(−ω) ⊙ tex(s, t) at the hit point, not the
             // texture's mean that emission carries.
             let xl = p.to_local * (x - p.origin);

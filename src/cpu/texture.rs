@@ -213,7 +213,7 @@ pub fn rect_texel(img: &Image, info: TexInfo, x: f64, y: f64, w: f64, h: f64, fi
 /// The texture factor of a prepared dome along the world direction `e` toward the environment
 /// (DESIGN.md §3 emission, §6 D1): 1 without a texture.
 pub fn dome_factor(p: &Prepared, e: DVec3) -> DVec3 {
-    match &p.texture {
+    match p.dome_texture() {
         Some(t) => dome_lookup(
             &t.image,
             tex_info(&t.image, t.format.code()),
@@ -228,7 +228,7 @@ pub fn dome_factor(p: &Prepared, e: DVec3) -> DVec3 {
 /// A rect light's texture factor for `emission` (§6 "RectLight texture"): the exact area mean
 /// of the filtered reconstruction (`prepare::texture::area_mean`), 1 without a texture.
 pub fn rect_mean(p: &Prepared) -> DVec3 {
-    match &p.rect_texture {
+    match p.rect_texture() {
         Some(t) => t.mean(),
         None => DVec3::ONE,
     }
@@ -238,7 +238,7 @@ pub fn rect_mean(p: &Prepared) -> DVec3 {
 /// light's plane (§6 "RectLight texture": `radiance(x, ω) = L(−ω) ⊙ tex(s, t)` at the hit), 1
 /// without a texture.
 pub fn rect_factor(p: &Prepared, hit: DVec2) -> DVec3 {
-    match (&p.rect_texture, &p.light.kind) {
+    match (p.rect_texture(), &p.light.kind) {
         (Some(t), crate::model::LightType::Rect { width, height }) => rect_texel(
             &t.image,
             tex_info(&t.image, FORMAT_RECT),
@@ -389,7 +389,7 @@ mod tests {
         let p = prep(&l).unwrap();
         // automatic: the chart is 2:1, so latlong.
         assert_eq!(
-            p.texture.as_ref().unwrap().format,
+            p.dome_texture().unwrap().format,
             crate::prepare::texture::DomeFormat::LatLong
         );
         let e = crate::cpu::emission::emission(&p, DVec3::X);
@@ -536,7 +536,7 @@ mod tests {
             &mut cache,
         )
         .unwrap();
-        let (ta, tb) = (a.texture.unwrap(), b.texture.unwrap());
+        let (ta, tb) = (a.dome_texture().unwrap(), b.dome_texture().unwrap());
         assert!(std::sync::Arc::ptr_eq(&ta.image, &tb.image));
     }
 

@@ -5,11 +5,11 @@
 
 pub(crate) mod cache;
 pub(crate) mod dispatch;
-pub(crate) mod texture_atlas;
 pub(crate) mod ies_atlas;
 pub(crate) mod record;
 pub(crate) mod resident;
 pub(crate) mod shaders;
+pub(crate) mod texture_atlas;
 
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};

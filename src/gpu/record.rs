@@ -209,7 +209,7 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
         r.flags |= FLAG_IES;
         r.ies = [base as f32, ies.angle_scale as f32, ies.scale as f32, 0.0];
     }
-    if let (Some(t), Some(offset)) = (&p.texture, tex_offset) {
+    if let (Some(t), Some(offset)) = (p.dome_texture(), tex_offset) {
         r.flags |= FLAG_DOME_TEXTURE;
         let inv = t.frame.inv;
         r.tex_inv = [
@@ -219,7 +219,7 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
         ];
         r.tex = [offset, t.filter.code(), 0, 0];
     }
-    if let (Some(t), Some(offset)) = (&p.rect_texture, tex_offset) {
+    if let (Some(t), Some(offset)) = (p.rect_texture(), tex_offset) {
         r.flags |= FLAG_RECT_TEXTURE;
         r.tex_inv[0] = v4(t.mean(), 0.0);
         r.tex = [offset, t.filter().code(), 0, 0];
@@ -229,7 +229,7 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
     }
     let (kind, size) = match p.light.kind {
         LightType::Distant { .. } => {
-            r.axis[3] = p.distant_half_angle as f32;
+            r.axis[3] = p.distant_half_angle() as f32;
             (KIND_DISTANT, [0.0; 4])
         }
         LightType::Sphere {

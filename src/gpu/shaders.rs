@@ -16,7 +16,7 @@ use std::collections::HashSet;
 use std::sync::OnceLock;
 
 use super::record::WGSL_CONSTANTS;
-use super::{texture_atlas, ies_atlas};
+use super::{ies_atlas, texture_atlas};
 use crate::rules;
 
 /// Every WGSL source file, by its path under `shaders/`.

@@ -172,7 +172,7 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
     let mut which = Vec::with_capacity(lights.len());
     for p in lights {
         // A dome's texture with its format's code; a rect's with FORMAT_RECT.
-        let (image, code) = match (&p.texture, &p.rect_texture) {
+        let (image, code) = match (p.dome_texture(), p.rect_texture()) {
             (Some(t), _) => (&t.image, t.format.code()),
             (None, Some(t)) => (&t.image, FORMAT_RECT),
             (None, None) => {

@@ -7,11 +7,11 @@
 
 pub mod assets;
 pub mod blackbody;
-pub mod texture;
 pub mod ies;
 pub mod ies_kinks;
 pub mod normalize;
 pub mod profile;
+pub mod texture;
 
 use std::sync::Arc;
 
@@ -93,46 +93,88 @@ pub struct Prepared {
     pub shaping: Option<ShapingConsts>,
     /// Where the shaping factor is not smooth (for the irradiance quadrature).
     pub profile: Profile,
-    /// A distant light's θmax (half its angular diameter, radians); 0 for other types.
-    pub distant_half_angle: f64,
     /// The IES profile of ShapingAPI, where authored (and the light shapeable).
     pub ies: Option<PreparedIes>,
-    /// A dome's environment map, where `texture:file` is authored (DESIGN.md §6 D1–D6).
-    pub texture: Option<texture::PreparedTexture>,
-    /// A RectLight's image, where `texture:file` is authored (DESIGN.md §6 "RectLight
-    /// texture"); kept apart from [`Prepared::texture`], which is a dome's.
-    pub rect_texture: Option<texture::RectTexture>,
+    /// What only this kind of light carries.
+    pub kind: KindData,
+    /// Where the GPU path takes this light's irradiance from, decided once here (see
+    /// [`IrradiancePath`]).
+    pub irradiance_path: IrradiancePath,
 }
 
-impl Prepared {
-    /// Whether the GPU path takes this light's irradiance from the CPU reference, until the f32
-    /// quadrature can match it (the record's `FLAG_HOST_IRRADIANCE`, which the irradiance kernel
-    /// answers with 0, and the host's sum in `query::PreparedScene::irradiance` both read this):
-    /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as the
-    ///   reference's line integrals do, and misses lit features narrower than its nodes (measured: up
-    ///   to 100 % on receivers that see a thin lit band of a striped profile).
+/// What one kind of light carries beyond the shared frame, base radiance and shaping of
+/// [`Prepared`] (pbrt-v4 gives each light its class; here each kind its variant). The shape's
+/// own sizes stay in the model's [`LightType`].
+#[derive(Clone, Debug)]
+pub enum KindData {
+    /// Sphere, disk and cylinder lights: nothing beyond their size and frame.
+    Shape,
+    /// A RectLight, with its image where `texture:file` is authored (DESIGN.md §6 "RectLight
+    /// texture").
+    Rect {
+        texture: Option<texture::RectTexture>,
+    },
+    /// A DistantLight: θmax, half its angular diameter in radians (0: a delta light).
+    Distant { half_angle: f64 },
+    /// A DomeLight, with its environment map where `texture:file` is authored (DESIGN.md §6
+    /// D1–D6).
+    Dome {
+        texture: Option<texture::PreparedTexture>,
+    },
+}
+
+/// Where the GPU path takes a light's irradiance from: the one decision, made per light when it
+/// is prepared, that the record's `FLAG_HOST_IRRADIANCE` (answered with 0 by the irradiance
+/// kernel), the host's sum in `query::PreparedScene::irradiance`, the GPU-resident refusal and
+/// the conformance check all read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IrradiancePath {
+    /// The f32 quadrature on the device.
+    Device,
+    /// The CPU reference, until the f32 quadrature can match it; the reason is a phrase ("it is
+    /// IES-shaped"):
+    /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as
+    ///   the reference's line integrals do, and misses lit features narrower than its nodes
+    ///   (measured: up to 100 % on receivers that see a thin lit band of a striped profile).
     /// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
-    ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a dome's
-    ///   irradiance depends on the normal only, so the reference evaluates it once per distinct
-    ///   normal (one for a whole falloff map).
+    ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a
+    ///   dome's irradiance depends on the normal only, so the reference evaluates it once per
+    ///   distinct normal (one for a whole falloff map).
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
-    pub fn irradiance_on_host(&self) -> bool {
-        self.host_irradiance_reason().is_some()
+    Host(&'static str),
+}
+
+impl Prepared {
+    /// A distant light's θmax (half its angular diameter, radians); 0 for other types.
+    pub fn distant_half_angle(&self) -> f64 {
+        match self.kind {
+            KindData::Distant { half_angle } => half_angle,
+            _ => 0.0,
+        }
     }
 
-    /// Why [`Prepared::irradiance_on_host`] holds, as a phrase ("it is IES-shaped"), if it does.
-    pub fn host_irradiance_reason(&self) -> Option<&'static str> {
-        if self.ies.is_some() {
-            Some("it is IES-shaped")
-        } else if matches!(self.light.kind, LightType::Dome) && self.texture.is_some() {
-            Some("it is a textured dome")
-        } else if self.rect_texture.is_some() {
-            Some("it is a textured rect")
-        } else {
-            None
+    /// A dome's environment map, where authored.
+    pub fn dome_texture(&self) -> Option<&texture::PreparedTexture> {
+        match &self.kind {
+            KindData::Dome { texture } => texture.as_ref(),
+            _ => None,
         }
+    }
+
+    /// A RectLight's image, where authored.
+    pub fn rect_texture(&self) -> Option<&texture::RectTexture> {
+        match &self.kind {
+            KindData::Rect { texture } => texture.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// Whether the GPU path takes this light's irradiance from the CPU reference
+    /// ([`Prepared::irradiance_path`]).
+    pub fn irradiance_on_host(&self) -> bool {
+        matches!(self.irradiance_path, IrradiancePath::Host(_))
     }
 
     /// Validates `light` and computes its constants for `mode`.
@@ -181,10 +223,6 @@ impl Prepared {
             .filter(|_| evaluated.kind.is_shapeable())
             .map(ShapingConsts::new);
         let profile = Profile::new(shaping.as_ref(), axis);
-        let distant_half_angle = match evaluated.kind {
-            LightType::Distant { angle } => normalize::distant_half_angle(angle),
-            _ => 0.0,
-        };
         let ies = match evaluated.shaping.as_ref().and_then(|s| s.ies.as_ref()) {
             Some(i) if evaluated.kind.is_shapeable() => {
                 let profile = cache.ies(&i.file).map_err(|source| {
@@ -209,16 +247,45 @@ impl Prepared {
             }
             _ => None,
         };
-        let (texture, rect_texture) = match (&light.texture, &light.kind) {
-            (None, _) => (None, None),
-            (Some(t), LightType::Rect { .. }) => {
-                (None, Some(prepare_rect_texture(light, t, cache)?))
+        let kind = match evaluated.kind {
+            LightType::Distant { angle } => KindData::Distant {
+                half_angle: normalize::distant_half_angle(angle),
+            },
+            LightType::Rect { .. } => KindData::Rect {
+                texture: match &light.texture {
+                    Some(t) => Some(prepare_rect_texture(light, t, cache)?),
+                    None => None,
+                },
+            },
+            LightType::Dome => KindData::Dome {
+                texture: match &light.texture {
+                    Some(t) => Some(prepare_texture(light, t, linear, cache)?),
+                    None => None,
+                },
+            },
+            _ => {
+                if let Some(t) = &light.texture {
+                    // A texture on any other type is refused rather than evaluated as if
+                    // untextured.
+                    prepare_texture(light, t, linear, cache)?;
+                }
+                KindData::Shape
             }
-            (Some(t), _) => (Some(prepare_texture(light, t, linear, cache)?), None),
+        };
+        let irradiance_path = if ies.is_some() {
+            IrradiancePath::Host("it is IES-shaped")
+        } else {
+            match &kind {
+                KindData::Dome { texture: Some(_) } => {
+                    IrradiancePath::Host("it is a textured dome")
+                }
+                KindData::Rect { texture: Some(_) } => {
+                    IrradiancePath::Host("it is a textured rect")
+                }
+                _ => IrradiancePath::Device,
+            }
         };
         Ok(Prepared {
-            texture,
-            rect_texture,
             base,
             size_factor,
             origin: light.origin(),
@@ -230,8 +297,9 @@ impl Prepared {
             similarity: similarity_scale(linear),
             shaping,
             profile,
-            distant_half_angle,
             ies,
+            kind,
+            irradiance_path,
             light: evaluated,
         })
     }

@@ -11,8 +11,8 @@ mod scene;
 use std::sync::Arc;
 
 use crate::error::{LuxError, Result};
-use crate::input::RowKind;
 use crate::gpu::{AdapterSummary, CacheStatus, DeviceLimits, GpuContext, Startup};
+use crate::input::RowKind;
 use crate::model::Light;
 use crate::prepare::TemperatureMode;
 #[cfg(feature = "usd")]

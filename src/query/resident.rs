@@ -8,6 +8,7 @@ use super::{Accumulate, Backend, Evaluator, PreparedScene};
 use crate::error::{LuxError, Result};
 use crate::gpu::resident::Operand;
 use crate::gpu::{GpuContext, Kernel};
+use crate::prepare::IrradiancePath;
 
 impl Evaluator {
     /// An evaluator on the caller's device (a renderer's own `wgpu::Device` and `wgpu::Queue`,
@@ -164,11 +165,10 @@ impl PreparedScene {
         count: u32,
         acc: Accumulate,
     ) -> Result<()> {
-        if let Some((p, reason)) = self
-            .lights
-            .iter()
-            .find_map(|p| Some((p, p.host_irradiance_reason()?)))
-        {
+        if let Some((p, reason)) = self.lights.iter().find_map(|p| match p.irradiance_path {
+            IrradiancePath::Host(reason) => Some((p, reason)),
+            IrradiancePath::Device => None,
+        }) {
             return Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),
                 query: "irradiance".into(),

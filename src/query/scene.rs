@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
-use crate::gpu::{GpuLights, Input, Kernel, Scratch, texture_atlas, ies_atlas, record};
+use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, record, texture_atlas};
 use crate::model::Light;
 use crate::prepare::{self, Prepared, TemperatureMode};
 
@@ -107,9 +107,9 @@ impl PreparedScene {
         self.lights.is_empty()
     }
 
-    /// The size (width, height) of light `k`'s texture as loaded, if it has one.
+    /// The size (width, height) of light `k`'s dome texture as loaded, if it has one.
     pub fn texture_size(&self, k: usize) -> Option<(u32, u32)> {
-        let t = self.lights.get(k)?.texture.as_ref()?;
+        let t = self.lights.get(k)?.dome_texture()?;
         Some((t.image.width as u32, t.image.height as u32))
     }
 

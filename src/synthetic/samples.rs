@@ -34,7 +34,7 @@ pub fn emission_samples(r: &Reference, n: usize, rng: &mut Rng) -> Vec<[f32; 3]>
             } else {
                 match (&p.light.kind, &p.light.shaping) {
                     (LightType::Distant { .. }, _) => {
-                        rng.cone(p.axis, (2.0 * p.distant_half_angle).max(1e-3))
+                        rng.cone(p.axis, (2.0 * p.distant_half_angle()).max(1e-3))
                     }
                     (_, Some(s)) => rng.cone(
                         p.axis,
@@ -66,7 +66,10 @@ pub fn radiance_samples(r: &Reference, n: usize, rng: &mut Rng) -> (Vec<[f32; 3]
                     rng.range(-10.0, 10.0),
                     rng.range(-10.0, 10.0),
                 );
-                (x, rng.cone(-p.axis, (2.0 * p.distant_half_angle).max(1e-3)))
+                (
+                    x,
+                    rng.cone(-p.axis, (2.0 * p.distant_half_angle()).max(1e-3)),
+                )
             }
             LightType::Dome => (
                 DVec3::new(

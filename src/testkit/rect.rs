@@ -31,7 +31,7 @@ pub fn near_rect_discontinuity(
     margin: f64,
 ) -> Result<Vec<bool>> {
     let p = Prepared::new(light, TemperatureMode::Spec)?;
-    let (LightType::Rect { width, height }, Some(t)) = (&p.light.kind, &p.rect_texture) else {
+    let (LightType::Rect { width, height }, Some(t)) = (&p.light.kind, p.rect_texture()) else {
         return Ok(vec![false; points.len()]);
     };
     let (iw, ih) = (t.image.width as f64, t.image.height as f64);

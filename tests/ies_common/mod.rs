@@ -99,7 +99,8 @@ pub fn no_tilt(name: &str) -> Result<Vec<u8>, String> {
 }
 
 pub fn parse(text: &str) -> IesFile {
-    luxeval::testkit::ies_parts::parse_any(text.as_bytes(), &no_tilt).unwrap_or_else(|e| panic!("{e}\n{text}"))
+    luxeval::testkit::ies_parts::parse_any(text.as_bytes(), &no_tilt)
+        .unwrap_or_else(|e| panic!("{e}\n{text}"))
 }
 
 pub fn parse_err(text: &str) -> luxeval::IesError {

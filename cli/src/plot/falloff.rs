@@ -244,7 +244,13 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
             INK,
         );
     }
-    c.text("lux", bx as i64, (MARGIN + TEXT_H + 6) as i64, FONT_SCALE, INK);
+    c.text(
+        "lux",
+        bx as i64,
+        (MARGIN + TEXT_H + 6) as i64,
+        FONT_SCALE,
+        INK,
+    );
     let cy = top + mh + 10;
     c.text(&caption1, MARGIN as i64, cy as i64, FONT_SCALE, INK);
     c.text(

@@ -10,8 +10,8 @@ mod viridis;
 
 use std::path::Path;
 
-use luxeval::Result;
 use crate::io::write_atomic;
+use luxeval::Result;
 
 /// An RGB8 raster, row-major from the top.
 #[derive(Clone, Debug, PartialEq)]

@@ -117,7 +117,10 @@ mod tests {
 
     #[test]
     fn more_ticks_and_labels() {
-        assert_eq!(ticks((0.0, 10.0), Scale::Linear), [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        assert_eq!(
+            ticks((0.0, 10.0), Scale::Linear),
+            [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+        );
         assert_eq!(ticks((0.5, 500.0), Scale::Log), [1.0, 10.0, 100.0]);
         assert_eq!(ticks((3.0, 30.0), Scale::Log), [5.0, 10.0, 20.0]);
         assert_eq!(label(1234.6), "1235");

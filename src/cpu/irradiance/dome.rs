@@ -42,7 +42,7 @@ use quadrature::gl;
 /// light). `None` for a light without a texture, or a cross whose size is not 3N × 4N (which
 /// preparation already refuses).
 pub fn tables(p: &crate::prepare::Prepared) -> Option<Arc<DomeIrradiance>> {
-    let t = p.texture.as_ref()?;
+    let t = p.dome_texture()?;
     let slot = t.irradiance.get_or_init(|| {
         match DomeIrradiance::new(t.image.clone(), t.format, t.filter, t.frame) {
             Ok(d) => Arc::new(d) as Arc<dyn std::any::Any + Send + Sync>,

@@ -48,7 +48,7 @@ impl ChartTexture<'_> {
 
 /// The texture of `p` when it is a textured rect integrated over its square chart.
 pub fn chart_texture<'a>(p: &'a Prepared, chart: &Chart) -> Option<ChartTexture<'a>> {
-    let t = p.rect_texture.as_ref()?;
+    let t = p.rect_texture()?;
     if !matches!(chart.region, Region::Square) {
         return None;
     }
@@ -85,7 +85,7 @@ pub fn texel_xs(p: &Prepared, chart: &Chart) -> Vec<f64> {
 /// The chart Y of the texture's horizontal break lines (textured rect on its square chart;
 /// empty otherwise).
 pub fn texel_ys(p: &Prepared, chart: &Chart) -> Vec<f64> {
-    match (&p.rect_texture, &chart.region) {
+    match (p.rect_texture(), &chart.region) {
         (Some(t), Region::Square) => breaks(t.image.height, t.filter())
             .into_iter()
             .map(|t| 1.0 - 2.0 * t)
@@ -114,7 +114,9 @@ mod tests {
     fn textured(l: &Light, w: usize, h: usize, rgb: Vec<[f32; 3]>, filter: Filter) -> Prepared {
         let mut p = Prepared::new(l, TemperatureMode::Spec).unwrap();
         let img = Image::from_rgb(w, h, rgb, "test.exr").unwrap();
-        p.rect_texture = Some(RectTexture::new(Arc::new(img), filter));
+        p.kind = crate::prepare::KindData::Rect {
+            texture: Some(RectTexture::new(Arc::new(img), filter)),
+        };
         p
     }
 

@@ -1,68 +1,23 @@
 //! Quadrature and root finding for the exact dome irradiance (f64).
 //!
-//! - Gauss–Legendre rules of any order, nodes by Newton's iteration on P_n (converged to
-//!   rounding), weights `2 / ((1 − x²) P_n'(x)²)`.
+//! - Gauss–Legendre rules of every order up to [`MAX_ORDER`], built once by
+//!   [`crate::rules::gauss_legendre_pm1`] (luxeval's one builder) and kept.
 //! - Adaptive bisection on top of an n-point rule: an interval is accepted when the rule on it
 //!   and the sum of the rule on its two halves agree to the tolerance (the halves' sum is kept).
 //! - Roots: sign changes on a sample grid, refined by the Illinois variant of regula falsi.
 
 use std::sync::OnceLock;
 
+use crate::rules::gauss_legendre_pm1;
+
 /// The largest rule cached.
 pub const MAX_ORDER: usize = 48;
 
-/// An n-point Gauss–Legendre rule on [−1, 1]: (nodes, weights).
+/// The n-point Gauss–Legendre rule on [−1, 1]: (nodes, weights), n clamped to 1..=[`MAX_ORDER`].
 pub fn gauss_legendre(n: usize) -> &'static (Vec<f64>, Vec<f64>) {
     static RULES: OnceLock<Vec<(Vec<f64>, Vec<f64>)>> = OnceLock::new();
-    let rules = RULES.get_or_init(|| (0..=MAX_ORDER).map(build_rule).collect());
+    let rules = RULES.get_or_init(|| (0..=MAX_ORDER).map(gauss_legendre_pm1).collect());
     &rules[n.clamp(1, MAX_ORDER)]
-}
-
-fn build_rule(n: usize) -> (Vec<f64>, Vec<f64>) {
-    if n == 0 {
-        return (vec![], vec![]);
-    }
-    let mut x = vec![0.0; n];
-    let mut w = vec![0.0; n];
-    for i in 0..n.div_ceil(2) {
-        // Tricomi's initial guess, then Newton on P_n.
-        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-        let mut dp = 1.0;
-        for _ in 0..100 {
-            let (p, d) = legendre(n, z);
-            dp = d;
-            let dz = p / d;
-            z -= dz;
-            if dz.abs() < 1e-16 {
-                break;
-            }
-        }
-        let (_, d) = legendre(n, z);
-        dp = if d.is_finite() { d } else { dp };
-        let wi = 2.0 / ((1.0 - z * z) * dp * dp);
-        x[i] = -z;
-        x[n - 1 - i] = z;
-        w[i] = wi;
-        w[n - 1 - i] = wi;
-    }
-    if n % 2 == 1 {
-        x[n / 2] = 0.0;
-    }
-    (x, w)
-}
-
-/// (P_n(z), P_n'(z)) by the three-term recurrence.
-fn legendre(n: usize, z: f64) -> (f64, f64) {
-    let (mut p0, mut p1) = (1.0, z);
-    for k in 2..=n {
-        let kf = k as f64;
-        let p2 = ((2.0 * kf - 1.0) * z * p1 - (kf - 1.0) * p0) / kf;
-        p0 = p1;
-        p1 = p2;
-    }
-    let p = if n == 0 { 1.0 } else { p1 };
-    let pm1 = if n == 0 { 0.0 } else { p0 };
-    (p, n as f64 * (z * p - pm1) / (z * z - 1.0))
 }
 
 /// `∫_a^b f` by the n-point rule, for vector-valued `f` (K components).
