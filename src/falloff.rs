@@ -32,7 +32,7 @@ impl FalloffPlane {
     /// The most pixels one map may have (memory for points, normals and results stays < 4 GiB).
     pub const MAX_PIXELS: u64 = MAX_PIXELS;
 
-    /// Validates the plane: finite vectors, u and v not parallel, 1 ≤ pixels ≤ [`MAX_PIXELS`].
+    /// Validates the plane: finite vectors, u and v not parallel, 1 ≤ pixels ≤ [`FalloffPlane::MAX_PIXELS`].
     pub fn new(origin: DVec3, u: DVec3, v: DVec3, width: u32, height: u32) -> Result<Self> {
         for (name, x) in [("--origin", origin), ("--u", u), ("--v", v)] {
             if !x.is_finite() {

@@ -63,7 +63,7 @@ pub(crate) mod usd;
 struct ReadmeDoctests;
 
 pub use assets::ies::eulumdat::{EulumdatInfo, LampSet};
-pub use assets::ies::lm63::{Format as IesFormat, Lm63Version, Tilt, TiltSource};
+pub use assets::ies::lm63::{Format as IesFormat, Lm63Version, Tilt as IesTilt, TiltSource};
 pub use assets::ies::{IesError, IesErrorKind, IesFile, PhotometricType, read_file as read_ies};
 pub use assets::texture::{FormatError as TextureFormatError, TextureError};
 pub use conformance::{
@@ -82,7 +82,8 @@ pub use model::{
 };
 pub use prepare::TemperatureMode;
 pub use prepare::ies::{
-    FluxCheck, Peak as IesPeak, Plane as IesPlane, Profile as IesProfile, Spread as IesSpread,
+    FluxCheck, HFold as IesHFold, Peak as IesPeak, Plane as IesPlane, Profile as IesProfile,
+    Spread as IesSpread, VFold as IesVFold,
 };
 #[cfg(feature = "usd")]
 pub use query::lights_json;

@@ -152,8 +152,11 @@ impl Samples {
     }
 }
 
-/// Compares `eval` (a GPU) with the f64 reference on [`Samples::per_query`]`(samples)` per
-/// light.
+/// Compares `eval` (a GPU) with the f64 reference of each light (`lights`, in order) on
+/// `samples` emission directions (also used for intensity) and radiance rays and `samples/4`
+/// (rounded up) irradiance receivers per light, drawn from `seed`: the comparison `luxeval
+/// check` prints. Tolerance [`TOLERANCE`] (relative), samples within [`BAND`] of a
+/// discontinuity counted but not compared (DESIGN.md §5).
 pub fn check(
     eval: &Evaluator,
     lights: &[Reference],

@@ -31,7 +31,6 @@ pub mod ies_parts {
     pub use crate::assets::ies::eulumdat::parse_eulumdat;
     pub use crate::assets::ies::lm63::{TypeCCoverage, type_c_coverage};
     pub use crate::assets::ies::{parse_any, parse_lm63};
-    pub use crate::prepare::ies::{HFold, VFold};
 
     pub mod lookup {
         pub use crate::cpu::ies::{

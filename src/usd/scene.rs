@@ -85,8 +85,9 @@ impl Stage {
     /// resolves its lights at `time`; without one, at the stage's `startTimeCode` when authored,
     /// else at USD's EarliestTime (DESIGN.md §2).
     ///
-    /// The stage is read on a thread of its own with a large stack (see [`STACK_BYTES`]), so
-    /// that a legal deep stage does not overflow the caller's stack.
+    /// The stage is read on a thread of its own with a large stack (512 MiB reserved, touched
+    /// only as deep as the stage goes), so that a legal deep stage does not overflow the
+    /// caller's stack.
     pub fn load(path: &Path, time: Option<f64>) -> Result<Stage> {
         check_time(time)?;
         on_large_stack(path, || UsdStage::open(path)?.read(time))
