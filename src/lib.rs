@@ -65,7 +65,9 @@ struct ReadmeDoctests;
 pub use assets::ies::eulumdat::{EulumdatInfo, LampSet};
 pub use assets::ies::lm63::{Format as IesFormat, Lm63Version, Tilt as IesTilt, TiltSource};
 pub use assets::ies::{IesError, IesErrorKind, IesFile, PhotometricType, read_file as read_ies};
-pub use assets::texture::{FormatError as TextureFormatError, TextureError};
+pub use assets::texture::{
+    FormatError as TextureFormatError, MAX_PIXELS as MAX_TEXTURE_PIXELS, TextureError,
+};
 pub use conformance::{
     BAND as CHECK_BAND, CONE_BAND as CHECK_CONE_BAND, CheckReport, CheckedQuery, QueryReport,
     TOLERANCE as CHECK_TOLERANCE, WorstSample, check as check_against_reference,

@@ -5,8 +5,8 @@ use glam::{DVec3, Vec3};
 use ies_common::*;
 use luxeval::testkit::ies_parts::ies_factor;
 use luxeval::testkit::ies_parts::lookup::{fold_h_type_c, fold_mirror, photometric_angles};
-use luxeval::{IesHFold as HFold, IesVFold as VFold};
 use luxeval::testkit::ies_replay::{AtlasError, HEADER_LEN, pack_atlas, replay_ies_factor};
+use luxeval::{IesHFold as HFold, IesVFold as VFold};
 use luxeval::{IesProfile as Profile, PhotometricType};
 
 /// The layout of atlas.rs, checked field by field on two small profiles.

@@ -77,6 +77,14 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .filter(|&v| (1..=65536).contains(&v))
     };
     match (p(w), p(h)) {
+        // A texture luxeval would refuse to load is not written in the first place.
+        (Some(w), Some(h)) if u64::from(w) * u64::from(h) > luxeval::MAX_TEXTURE_PIXELS => {
+            Err(format!(
+                "{s:?}: {} pixels, over the {} a texture may have",
+                u64::from(w) * u64::from(h),
+                luxeval::MAX_TEXTURE_PIXELS
+            ))
+        }
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err(format!(
             "{s:?}: width and height must be integers from 1 to 65536"

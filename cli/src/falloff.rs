@@ -50,7 +50,7 @@ pub struct FalloffArgs {
     scale: ScaleArg,
     /// Colour bar range of the PNG in lux, LOW,HIGH. Default: the map's maximum and three
     /// decades below it (log) or 0 (linear).
-    #[arg(long, value_name = "LOW,HIGH", value_parser = parse_range)]
+    #[arg(long, value_name = "LOW,HIGH", value_parser = parse_range, allow_hyphen_values = true)]
     range: Option<(f64, f64)>,
     /// Draw isolux contours on the PNG at the colour bar's tick values.
     #[arg(long)]
@@ -70,6 +70,9 @@ pub fn run(a: &FalloffArgs) -> CliResult {
     crate::io::check_outputs(&outputs, &[("SCENE", &a.scene.scene)])?;
     luxeval::Limits::from_env()?.check_samples("--res", u64::from(a.res.0) * u64::from(a.res.1))?;
     let plane = Plane::new(a.origin.into(), a.u.into(), a.v.into(), a.res.0, a.res.1)?;
+    if a.png.is_some() {
+        png::check_size(a.res.0, a.res.1)?;
+    }
     let style = png::Style {
         scale: match a.scale {
             ScaleArg::Log => png::Scale::Log,

@@ -159,8 +159,22 @@ fn write_stdout(args: std::fmt::Arguments) {
     }
 }
 
+/// Switches off Mesa's Vulkan device-select layer where it would print "error: XDG_RUNTIME_DIR is
+/// invalid or not set" (a headless machine: render-farm nodes, CI runners, containers), unless
+/// the user set `NODEVICE_SELECT` themselves: the layer only orders devices for a display, which
+/// luxeval never presents to, and its lines read as luxeval's errors.
+fn quiet_device_select() {
+    let runtime_dir_ok =
+        std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir());
+    if std::env::var_os("NODEVICE_SELECT").is_none() && !runtime_dir_ok {
+        // SAFETY: the first thing `main` does, before any thread is started.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
+}
+
 /// The whole command line: parses the arguments, runs the command, reports a failure once.
 pub fn main() -> ExitCode {
+    quiet_device_select();
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     match run(cli) {

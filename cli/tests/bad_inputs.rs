@@ -121,6 +121,54 @@ fn output_values(p: &Path) -> Vec<f32> {
     }
 }
 
+/// Longer than any case takes on the slowest machine the tests run on: a case that is still
+/// running then hangs (a blocked open, an endless read) and is killed and failed.
+const HANG: std::time::Duration = std::time::Duration::from_secs(300);
+
+/// Runs `c` to completion like `Command::output`, but kills it and fails the test when it runs
+/// longer than `limit` (so a hang fails the case instead of the whole test run).
+fn output_within(
+    mut c: Command,
+    limit: std::time::Duration,
+    args: &[String],
+) -> std::process::Output {
+    use std::io::Read;
+    use std::process::Stdio;
+    let mut child = c
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = child.stdout.take().unwrap();
+    let mut stderr = child.stderr.take().unwrap();
+    let out = std::thread::spawn(move || {
+        let mut b = Vec::new();
+        stdout.read_to_end(&mut b).map(|_| b)
+    });
+    let err = std::thread::spawn(move || {
+        let mut b = Vec::new();
+        stderr.read_to_end(&mut b).map(|_| b)
+    });
+    let start = std::time::Instant::now();
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if start.elapsed() > limit {
+            child.kill().unwrap();
+            child.wait().unwrap();
+            panic!("luxeval {} ran over {limit:?}: a hang", args.join(" "));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    std::process::Output {
+        status,
+        stdout: out.join().unwrap().unwrap(),
+        stderr: err.join().unwrap().unwrap(),
+    }
+}
+
 fn run(name: &str, case: &Case) {
     if case.gpu && common::gpu().is_none() {
         return;
@@ -152,7 +200,7 @@ fn run(name: &str, case: &Case) {
     }
     let before = snapshot(&input);
     let args: Vec<String> = case.args.iter().map(|a| expand(a, &input, &out)).collect();
-    let o = command(&args, case.env, case.fsize).output().unwrap();
+    let o = output_within(command(&args, case.env, case.fsize), HANG, &args);
     let stderr = String::from_utf8_lossy(&o.stderr);
     let context = format!("case {name}: luxeval {}\nstderr:\n{stderr}", args.join(" "));
     for crash in [
@@ -252,6 +300,35 @@ fn fifo(d: &Path) {
     // SAFETY: a valid C string.
     assert_eq!(unsafe { libc::mkfifo(p.as_ptr(), 0o644) }, 0);
 }
+fn mkfifo(p: &Path) {
+    let p = std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+    // SAFETY: a valid C string.
+    assert_eq!(unsafe { libc::mkfifo(p.as_ptr(), 0o644) }, 0);
+}
+fn fifo_ies(d: &Path) {
+    mkfifo(&d.join("missing.ies"));
+}
+fn zero_ies(d: &Path) {
+    std::os::unix::fs::symlink("/dev/zero", d.join("missing.ies")).unwrap();
+}
+fn fifo_tilt(d: &Path) {
+    mkfifo(&d.join("nothere.tilt"));
+}
+/// A dome whose texture is `sky.exr`, made by `make`.
+fn dome_with(d: &Path, make: fn(&Path)) {
+    std::fs::write(
+        d.join("dome_sky.usda"),
+        "#usda 1.0\ndef DomeLight \"D\"\n{\n    asset inputs:texture:file = @sky.exr@\n}\n",
+    )
+    .unwrap();
+    make(&d.join("sky.exr"));
+}
+fn fifo_texture(d: &Path) {
+    dome_with(d, mkfifo);
+}
+fn zero_texture(d: &Path) {
+    dome_with(d, |p| std::os::unix::fs::symlink("/dev/zero", p).unwrap());
+}
 fn zero_dirs(d: &Path) {
     std::os::unix::fs::symlink("/dev/zero", d.join("zero.npy")).unwrap();
 }
@@ -340,6 +417,10 @@ cases! {
     bench_command_empty: Case { args: &["bench", "--no-startup", "--no-dome", "--command", "  "], exit: 2, says: &["--command"], ..Case::default() };
     bench_command_bad_scene: Case { args: &["bench", "--no-startup", "--no-dome", "--samples", "8", "--cpu-samples", "8", "--lights", "1", "--command", "emission {in}/missing.usda --dirs {in}/dirs.npy -o {out}/out.npy"], exit: 2, says: &["--command", "missing.usda"], ..Case::default() };
     falloff_res_1e10_pixels: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "100000,100000", "-o", "{out}/m.exr", "--device", "cpu"], exit: 2, says: &["--res", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
+    falloff_png_too_elongated: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "33818560,1", "-o", "{out}/m.exr", "--png", "{out}/m.png", "--device", "cpu"], exit: 2, says: &["--png", "33818560×1", "pixels"], ..Case::default() };
+    falloff_png_subnormal_linear_range: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "8,8", "-o", "{out}/m.exr", "--png", "{out}/m.png", "--scale", "linear", "--range", "0,1e-323", "--device", "cpu"], exit: 0, ..Case::default() };
+    falloff_png_negative_low_on_a_linear_scale: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "8,8", "-o", "{out}/m.exr", "--png", "{out}/m.png", "--scale", "linear", "--range", "-1,10", "--device", "cpu"], exit: 0, lit: true, ..Case::default() };
+    bench_dome_size_over_the_texture_limit: Case { args: &["bench", "--dome-size", "65536x65536", "--samples", "16", "--no-startup"], exit: 2, says: &["--dome-size", "65536x65536", "pixels"], ..Case::default() };
     dirs_link_to_dev_zero: Case { args: emission!("{in}/ok.usda", "{in}/zero.npy"), exit: 2, says: &["zero.npy"], setup: Some(zero_dirs), ..Case::default() };
     scene_link_to_dev_zero: Case { args: emission!("{in}/zero.usda", "{in}/dirs.npy"), exit: 2, says: &["zero.usda", "not a regular file"], setup: Some(zero_scene), ..Case::default() };
     sublayer_link_to_dev_zero: Case { args: &["lights", "{in}/sublayer_zero.usda"], exit: 2, says: &["zero.usda", "sublayer_zero.usda"], setup: Some(zero_sublayer), ..Case::default() };
@@ -395,6 +476,13 @@ cases! {
     ies_count_not_integer: Case { args: &["ies", "{in}/ies_bad_count.ies"], exit: 2, says: &["ies_bad_count.ies:3", "integer", "3.5"], ..Case::default() };
     ies_tilt_file_missing: Case { args: &["ies", "{in}/ies_tilt_missing.ies"], exit: 2, says: &["ies_tilt_missing.ies:2", "nothere.tilt"], ..Case::default() };
     ies_truncated: Case { args: &["ies", "{in}/ies_truncated.ies", "--png", "{out}/p.png"], exit: 2, says: &["ies_truncated.ies:7", "missing value"], ..Case::default() };
+    // Assets are opened only when they are regular files (no blocked open on a FIFO, no read of
+    // a device), by the one asset-opening function.
+    ies_profile_is_a_fifo: Case { args: emission!("{in}/ies_missing_file.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "missing.ies", "not a regular file"], setup: Some(fifo_ies), ..Case::default() };
+    ies_profile_is_dev_zero: Case { args: emission!("{in}/ies_missing_file.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "missing.ies", "not a regular file"], setup: Some(zero_ies), ..Case::default() };
+    tilt_file_is_a_fifo: Case { args: &["ies", "{in}/ies_tilt_missing.ies"], exit: 2, says: &["ies_tilt_missing.ies:2", "nothere.tilt", "not a regular file"], setup: Some(fifo_tilt), ..Case::default() };
+    dome_texture_is_a_fifo: Case { args: emission!("{in}/dome_sky.usda", "{in}/dirs.npy"), exit: 2, says: &["/D", "inputs:texture:file", "sky.exr", "not a regular file"], setup: Some(fifo_texture), ..Case::default() };
+    dome_texture_is_dev_zero: Case { args: emission!("{in}/dome_sky.usda", "{in}/dirs.npy"), exit: 2, says: &["/D", "inputs:texture:file", "sky.exr", "not a regular file"], setup: Some(zero_texture), ..Case::default() };
     ies_png_is_the_profile: Case { args: &["ies", "{in}/ies_bad_count.ies", "--png", "{in}/ies_bad_count.ies"], exit: 2, says: &["--png", "ies_bad_count.ies"], ..Case::default() };
 
     // --- Runtime failures: exit 1 ---------------------------------------------------------------

@@ -690,3 +690,21 @@ fn blender_studio_maps_decode_and_evaluate() {
         "{e:?}"
     );
 }
+
+/// On a headless machine (no `XDG_RUNTIME_DIR`: render-farm nodes, CI runners, containers)
+/// Mesa's Vulkan device-select layer prints "error: XDG_RUNTIME_DIR is invalid or not set"
+/// while devices are enumerated; a successful command prints only luxeval's own output.
+#[test]
+fn a_headless_machine_hears_only_luxeval() {
+    for args in [&["info"][..], &["info", "--json"]] {
+        let o = Command::new(env!("CARGO_BIN_EXE_luxeval"))
+            .args(args)
+            .env_remove("XDG_RUNTIME_DIR")
+            .env_remove("NODEVICE_SELECT")
+            .output()
+            .unwrap();
+        let err = stderr(&o);
+        assert!(o.status.success(), "{err}");
+        assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+    }
+}

@@ -191,3 +191,14 @@ def test_without_a_gpu_auto_falls_back_and_gpu_raises(tmp_path):
     assert p.returncode == 0, p.stdout + p.stderr
     assert "warning: no GPU adapter" in p.stdout and "using the CPU reference" in p.stdout
     assert 'DeviceError: no GPU adapter found' in p.stdout and 'device="cpu"' in p.stdout
+
+
+def test_a_headless_machine_hears_only_luxeval():
+    """Without XDG_RUNTIME_DIR (render-farm nodes, CI runners, containers) Mesa's device-select
+    layer prints "error: XDG_RUNTIME_DIR is invalid or not set" when devices are enumerated;
+    importing luxeval and asking for a device prints nothing."""
+    env = {k: v for k, v in os.environ.items() if k not in ("XDG_RUNTIME_DIR", "NODEVICE_SELECT")}
+    code = "import luxeval; luxeval.device_name('auto')"
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert "XDG_RUNTIME_DIR" not in p.stderr, p.stderr

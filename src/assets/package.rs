@@ -43,19 +43,37 @@ fn split_package(path: &str) -> Option<(&str, &str)> {
     Some((&inner[..open], &inner[open + 1..]))
 }
 
-/// A file's bytes, refusing one larger than [`MAX_ASSET_BYTES`].
+/// A file's bytes: the one way luxeval opens an asset file (IES profiles, their TILT files,
+/// textures, `.usdz` packages holding them). The path (after symbolic links) must be a regular
+/// file of at most [`MAX_ASSET_BYTES`], both checked from its metadata before it is opened, so
+/// that a FIFO without a writer cannot block the open and a device (`/dev/zero`) is refused
+/// before a byte is read; the read itself stops past the limit too (a file that grows while it
+/// is read).
 pub fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
-    let file = std::fs::File::open(path)?;
-    if file.metadata()?.is_dir() {
+    let meta = std::fs::metadata(path)?;
+    if meta.is_dir() {
         return Err(Error::new(ErrorKind::IsADirectory, "is a directory"));
     }
+    if !meta.is_file() {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            "is not a regular file (a FIFO, socket or device), so it is not read",
+        ));
+    }
+    let too_large = || {
+        Error::new(
+            ErrorKind::InvalidData,
+            format!("larger than the {MAX_ASSET_BYTES}-byte limit on assets"),
+        )
+    };
+    if meta.len() > MAX_ASSET_BYTES {
+        return Err(too_large());
+    }
+    let file = std::fs::File::open(path)?;
     let mut bytes = Vec::new();
     file.take(MAX_ASSET_BYTES + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > MAX_ASSET_BYTES {
-        return Err(Error::new(
-            ErrorKind::InvalidData,
-            format!("larger than the {MAX_ASSET_BYTES}-byte limit on assets"),
-        ));
+        return Err(too_large());
     }
     Ok(bytes)
 }

@@ -43,6 +43,39 @@ const TEXT_H: u32 = font::HEIGHT * FONT_SCALE;
 /// Maps smaller than this (largest side) are enlarged by an integer factor for legibility.
 const MIN_DISPLAY: u32 = 384;
 
+/// The most pixels a falloff PNG may have (3 bytes each while it is drawn: 768 MiB).
+pub const MAX_PNG_PIXELS: u64 = 1 << 28;
+
+/// Room around the map for the title, colour bar, labels and captions, at most (pixels).
+const FRAME_W: u64 = 800;
+const FRAME_H: u64 = 200;
+
+/// The integer enlargement of a `width × height` map (small maps are drawn larger).
+fn zoom(width: u32, height: u32) -> u32 {
+    let side = width.max(height).max(1);
+    MIN_DISPLAY
+        .div_ceil(side)
+        .min((4 * MIN_DISPLAY / side).max(1))
+        .max(1)
+}
+
+/// Refuses a PNG for a `width × height` map that would have more than [`MAX_PNG_PIXELS`]
+/// (a very elongated map: the colour bar and captions add a frame to both sides), before the
+/// map is evaluated.
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    let z = u64::from(zoom(width, height));
+    let pixels = (u64::from(width) * z + FRAME_W) * (u64::from(height) * z + FRAME_H);
+    if pixels > MAX_PNG_PIXELS {
+        return Err(LuxError::input(
+            "--png",
+            format!(
+                "a {width}×{height} map draws a picture of about {pixels} pixels, over the {MAX_PNG_PIXELS} a falloff PNG may have; write the EXR alone, or a less elongated --res"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// The colour bar range for `values` under `style`.
 pub fn auto_range(values: &[f64], style: &Style) -> (f64, f64) {
     if let Some(r) = style.range {
@@ -122,11 +155,7 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
     let range = auto_range(&values, style);
     let ticks = ticks(range, style.scale);
     let labels: Vec<String> = ticks.iter().map(|t| label(*t)).collect();
-    let side = map.width.max(map.height);
-    let zoom = MIN_DISPLAY
-        .div_ceil(side)
-        .min((4 * MIN_DISPLAY / side).max(1))
-        .max(1);
+    let zoom = zoom(map.width, map.height);
     let (mw, mh) = (map.width * zoom, map.height * zoom);
     let label_w = labels
         .iter()
@@ -157,6 +186,13 @@ pub fn render(map: &Map, plane: &Plane, style: &Style) -> Result<Rendered> {
         (MARGIN + mw + BAR_GAP + BAR_WIDTH + 12 + label_w + MARGIN).max(caption_w + 2 * MARGIN);
     let top = MARGIN + 2 * (TEXT_H + 6) + 4;
     let height = top + mh + 10 + 2 * (TEXT_H + 6) + MARGIN;
+    if u64::from(width) * u64::from(height) > MAX_PNG_PIXELS {
+        check_size(map.width, map.height)?;
+        return Err(LuxError::input(
+            "--png",
+            format!("{width}×{height} pixels is over the {MAX_PNG_PIXELS} a falloff PNG may have"),
+        ));
+    }
     let mut c = Canvas::new(width, height, PAPER);
 
     c.text(&title, MARGIN as i64, MARGIN as i64, FONT_SCALE, INK);

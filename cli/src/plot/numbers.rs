@@ -31,11 +31,16 @@ pub fn nice_step(span: f64, n: f64) -> f64 {
     m * p
 }
 
+/// The most ticks [`ticks`] returns (a linear range holds about five; a log range one per decade
+/// of at most 308 + 324).
+const MAX_TICKS: usize = 700;
+
 /// Tick values inside `range`: decades (plus 2 and 5 when few) on a log scale, 1-2-5 steps (about
-/// five) on a linear one.
+/// five) on a linear one. A range too narrow for its 1-2-5 step to be a normal float (`0,1e-323`)
+/// is ticked at its two ends; never more than [`MAX_TICKS`] values.
 pub fn ticks(range: (f64, f64), scale: Scale) -> Vec<f64> {
     let (lo, hi) = range;
-    if !(hi > lo) {
+    if !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
         return vec![];
     }
     match scale {
@@ -55,9 +60,14 @@ pub fn ticks(range: (f64, f64), scale: Scale) -> Vec<f64> {
         }
         Scale::Linear => {
             let step = nice_step(hi - lo, 5.0);
-            let first = (lo / step).ceil() as i64;
-            let last = (hi / step).floor() as i64;
-            (first..=last).map(|k| k as f64 * step).collect()
+            let (first, last) = ((lo / step).ceil(), (hi / step).floor());
+            // The step of a subnormal span rounds to 0 or loses its digits: the ends instead.
+            if !step.is_normal() || !(last - first < MAX_TICKS as f64) || !(first <= last) {
+                return vec![lo, hi];
+            }
+            (first as i64..=last as i64)
+                .map(|k| k as f64 * step)
+                .collect()
         }
     }
 }
@@ -145,6 +155,19 @@ mod tests {
         assert_eq!(label(1e6), "1e6");
         assert_eq!(label(2.5e-5), "2.5e-5");
         assert_eq!(label(12.5), "12.5");
+    }
+
+    /// A valid but subnormal range is ticked at its ends (it once made ~9e18 ticks).
+    #[test]
+    fn ranges_too_narrow_for_a_step_are_ticked_at_their_ends() {
+        assert_eq!(ticks((0.0, 1e-323), Scale::Linear), [0.0, 1e-323]);
+        let narrow = ticks((1.0, 1.0 + 1e-15), Scale::Linear);
+        assert!(
+            narrow.iter().all(|t| (1.0..=1.0 + 1e-15).contains(t)),
+            "{narrow:?}"
+        );
+        assert!(ticks((f64::MIN_POSITIVE, f64::MAX), Scale::Log).len() <= MAX_TICKS);
+        assert!(ticks((-1.0, 10.0), Scale::Linear).contains(&0.0));
     }
 
     #[test]
