@@ -225,4 +225,12 @@ for name, profile in [("ies_missing_file.usda", "missing.ies"), ("ies_truncated.
     text(name, '\ndef SphereLight "L" (\n    prepend apiSchemas = ["ShapingAPI"]\n)\n{\n'
          f"    asset inputs:shaping:ies:file = @{profile}@\n}}\n")
 
+# A valid profile whose candela values do not fit float32 (1e39), used with and without
+# ies:normalize: both paths refuse it, naming the light, the attribute and the file.
+with open(os.path.join(OUT, "ies_huge.ies"), "w") as f:
+    f.write(IES_HEAD + "TILT=NONE\n" + IES_BODY.replace("100 50 0", "1e39 5e38 0"))
+for name, extra in [("ies_huge.usda", ""), ("ies_huge_normalized.usda", "    bool inputs:shaping:ies:normalize = 1\n")]:
+    text(name, '\ndef SphereLight "L" (\n    prepend apiSchemas = ["ShapingAPI"]\n)\n{\n'
+         f"    asset inputs:shaping:ies:file = @ies_huge.ies@\n{extra}}}\n")
+
 print(len(os.listdir(OUT)), "files in", os.path.normpath(OUT))

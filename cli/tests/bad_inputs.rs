@@ -192,6 +192,7 @@ fn run(name: &str, case: &Case) {
         "sublayer_cycle_b.usda",
         "big_layer.usda",
         "ies_truncated.ies",
+        "ies_huge.ies",
     ] {
         std::fs::copy(corpus().join(companion), input.join(companion)).unwrap();
     }
@@ -483,6 +484,11 @@ cases! {
     tilt_file_is_a_fifo: Case { args: &["ies", "{in}/ies_tilt_missing.ies"], exit: 2, says: &["ies_tilt_missing.ies:2", "nothere.tilt", "not a regular file"], setup: Some(fifo_tilt), ..Case::default() };
     dome_texture_is_a_fifo: Case { args: emission!("{in}/dome_sky.usda", "{in}/dirs.npy"), exit: 2, says: &["/D", "inputs:texture:file", "sky.exr", "not a regular file"], setup: Some(fifo_texture), ..Case::default() };
     dome_texture_is_dev_zero: Case { args: emission!("{in}/dome_sky.usda", "{in}/dirs.npy"), exit: 2, says: &["/D", "inputs:texture:file", "sky.exr", "not a regular file"], setup: Some(zero_texture), ..Case::default() };
+    // One refusal path for both devices: the same lights refused, naming the light, the
+    // attribute and the file (the GPU once said "profile 0"; the CPU evaluated the normalized one).
+    ies_candela_beyond_float32: Case { args: emission!("{in}/ies_huge.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_huge.ies", "1e39", "float32"], ..Case::default() };
+    ies_candela_beyond_float32_normalized: Case { args: emission!("{in}/ies_huge_normalized.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_huge.ies", "1e39", "float32"], ..Case::default() };
+    ies_candela_beyond_float32_on_the_gpu: Case { args: &["emission", "{in}/ies_huge_normalized.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_huge.ies", "1e39", "float32"], gpu: true, ..Case::default() };
     ies_png_is_the_profile: Case { args: &["ies", "{in}/ies_bad_count.ies", "--png", "{in}/ies_bad_count.ies"], exit: 2, says: &["--png", "ies_bad_count.ies"], ..Case::default() };
 
     // --- Runtime failures: exit 1 ---------------------------------------------------------------

@@ -33,8 +33,10 @@ pub const MAX_LEN: usize = 1 << 24;
 /// after 65,535 iterations in total, and irradiance looks a profile up thousands of times):
 /// enough for any grid of up to 2^16 + 1 angles, which the packer enforces.
 pub const SEARCH_STEPS: u32 = 16;
-/// The longest angle grid the shader's search covers.
-pub const MAX_ANGLES: usize = (1 << SEARCH_STEPS) + 1;
+/// The longest angle grid the shader's search covers (prepare refuses longer ones for both
+/// paths, naming the light and the file).
+pub const MAX_ANGLES: usize = crate::prepare::ies::MAX_ANGLES;
+const _: () = assert!(MAX_ANGLES == (1 << SEARCH_STEPS) + 1);
 
 /// Packed profiles: `data` is the `ies_atlas` buffer, `bases[k]` the header of profile k.
 #[derive(Clone, Debug, PartialEq)]

@@ -51,6 +51,33 @@ impl VFold {
     }
 }
 
+/// The longest angle grid (on either axis) a profile may have: the GPU's lookup is a binary
+/// search written out as 16 halving steps (no loop: lavapipe stops an invocation's loops after
+/// 65,535 iterations in total), which covers up to 2^16 + 1 angles. Both paths refuse longer
+/// grids, so that they accept the same lights.
+pub const MAX_ANGLES: usize = (1 << 16) + 1;
+
+/// Why a profile cannot be evaluated by both paths alike: a grid longer than [`MAX_ANGLES`],
+/// or a candela value (multipliers applied) that float32 cannot hold (the GPU keeps the
+/// profile in float32; the CPU would evaluate it, and then disagree). `ies:normalize` does not
+/// help: it divides at evaluation, after the value is stored.
+pub fn check_evaluable(p: &Profile) -> Result<(), String> {
+    for (axis, n) in [("horizontal", p.h.len()), ("vertical", p.v.len())] {
+        if n > MAX_ANGLES {
+            return Err(format!(
+                "the profile has {n} {axis} angles, more than the {MAX_ANGLES} a lookup covers"
+            ));
+        }
+    }
+    if let Some(c) = p.candela.iter().find(|c| !((**c as f32).is_finite())) {
+        return Err(format!(
+            "the profile's candela value {c:e} (multipliers applied) does not fit float32 (largest {:e}), which the GPU evaluates in",
+            f32::MAX
+        ));
+    }
+    Ok(())
+}
+
 /// A profile ready for lookup and normalisation.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Profile {

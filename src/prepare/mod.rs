@@ -233,6 +233,16 @@ impl Prepared {
                         source,
                     )
                 })?;
+                // The one refusal of a profile both paths cannot evaluate alike (the GPU holds
+                // candela values in float32 and looks grids up with a bounded search).
+                if let Err(reason) = ies::check_evaluable(&profile) {
+                    return Err(LuxError::attr(
+                        &light.path,
+                        "inputs:shaping:ies:file",
+                        format!("@{}@", i.file.authored),
+                        reason,
+                    ));
+                }
                 let scale = if i.normalize {
                     profile.inverse_mean()
                 } else {
