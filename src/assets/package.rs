@@ -36,6 +36,15 @@ pub fn sibling(resolved: &str, name: &str) -> String {
     }
 }
 
+/// The file on disk that holds the asset at `resolved`: the path itself, or the outermost
+/// package of a package member (`/abs/a.usdz[b.usdz[c.ies]]` → `/abs/a.usdz`).
+pub fn file_of(resolved: &str) -> &Path {
+    match split_package(resolved) {
+        Some((package, _)) => Path::new(package),
+        None => Path::new(resolved),
+    }
+}
+
 /// `pkg.usdz[inner]` → (`pkg.usdz`, `inner`), the inner part possibly a nested package path.
 fn split_package(path: &str) -> Option<(&str, &str)> {
     let inner = path.strip_suffix(']')?;

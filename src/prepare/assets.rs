@@ -1,7 +1,9 @@
 //! Loading the files lights reference, once per prepared scene: a profile referenced by several
 //! lights is read, parsed and packed once.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use super::ies::Profile;
@@ -11,11 +13,15 @@ use crate::assets::texture::{self, Image};
 use crate::error::AssetError;
 use crate::model::Asset;
 
-/// Profiles already loaded, by resolved path (or by address for in-memory contents).
+/// Profiles and textures already loaded, by resolved path (or by address for in-memory
+/// contents), with the files each one read.
 #[derive(Default)]
 pub struct AssetCache {
     profiles: HashMap<String, Arc<Profile>>,
     textures: HashMap<String, Arc<Image>>,
+    /// The files on disk each asset read (itself or its package; a profile's TILT file too):
+    /// what a command must never write over (DESIGN.md §4).
+    files: HashMap<String, Vec<PathBuf>>,
 }
 
 /// The cache key of `asset`: its resolved path, or the address of contents given in memory.
@@ -28,6 +34,14 @@ fn key(asset: &Asset) -> Result<String, AssetError> {
 }
 
 impl AssetCache {
+    /// The files on disk `asset` was read from, once loaded (none for contents in memory).
+    pub fn files(&self, asset: &Asset) -> Vec<PathBuf> {
+        key(asset)
+            .ok()
+            .and_then(|k| self.files.get(&k).cloned())
+            .unwrap_or_default()
+    }
+
     /// The texture in `asset` (OpenEXR, PNG, JPEG or Radiance HDR, detected by content; also
     /// inside a `.usdz` package), decoded to linear RGB once per file.
     pub fn texture(&mut self, asset: &Asset) -> Result<Arc<Image>, AssetError> {
@@ -43,6 +57,8 @@ impl AssetCache {
                     path: r.clone(),
                     source,
                 })?;
+                self.files
+                    .insert(key.clone(), vec![package::file_of(r).to_path_buf()]);
                 texture::decode(&bytes, &name)?
             }
             (None, None) => return Err(AssetError::Unresolved),
@@ -72,11 +88,22 @@ impl AssetCache {
             (None, None) => return Err(AssetError::Unresolved),
         };
         let here = asset.display().to_string();
+        let read = RefCell::new(
+            asset
+                .resolved
+                .iter()
+                .filter(|_| asset.bytes.is_none())
+                .map(|r| package::file_of(r).to_path_buf())
+                .collect::<Vec<_>>(),
+        );
         let resolver = |name: &str| -> Result<Vec<u8>, String> {
             match &asset.resolved {
                 Some(r) => {
                     let path = package::sibling(r, name);
-                    package::read(&path).map_err(|e| format!("{path}: {e}"))
+                    let bytes = package::read(&path).map_err(|e| format!("{path}: {e}"))?;
+                    read.borrow_mut()
+                        .push(package::file_of(&path).to_path_buf());
+                    Ok(bytes)
                 }
                 None => Err(format!(
                     "TILT={name}: {here} was given in memory, so no file beside it can be read"
@@ -90,6 +117,7 @@ impl AssetCache {
                 e
             })?;
         let profile = Arc::new(profile);
+        self.files.insert(key.clone(), read.take());
         self.profiles.insert(key, profile.clone());
         Ok(profile)
     }

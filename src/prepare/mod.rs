@@ -100,6 +100,9 @@ pub struct Prepared {
     /// Where the GPU path takes this light's irradiance from, decided once here (see
     /// [`IrradiancePath`]).
     pub irradiance_path: IrradiancePath,
+    /// The files on disk its assets were read from (IES profile, TILT file, texture, or the
+    /// package holding them), so that no output is written over one of them.
+    pub files_read: Vec<std::path::PathBuf>,
 }
 
 /// What one kind of light carries beyond the shared frame, base radiance and shaping of
@@ -295,7 +298,17 @@ impl Prepared {
                 _ => IrradiancePath::Device,
             }
         };
+        let mut files_read = Vec::new();
+        if let Some(i) = evaluated.shaping.as_ref().and_then(|s| s.ies.as_ref())
+            && ies.is_some()
+        {
+            files_read.extend(cache.files(&i.file));
+        }
+        if let Some(t) = &light.texture {
+            files_read.extend(cache.files(&t.file));
+        }
         Ok(Prepared {
+            files_read,
             base,
             size_factor,
             origin: light.origin(),

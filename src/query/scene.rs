@@ -113,6 +113,19 @@ impl PreparedScene {
         Some((t.image.width as u32, t.image.height as u32))
     }
 
+    /// Every file on disk the lights' assets were read from (IES profiles, TILT files, textures,
+    /// the packages holding them), each once, in the order first read: what a caller writing
+    /// outputs must not write over (DESIGN.md §4).
+    pub fn files_read(&self) -> Vec<&std::path::Path> {
+        let mut out: Vec<&std::path::Path> = Vec::new();
+        for f in self.lights.iter().flat_map(|p| &p.files_read) {
+            if !out.contains(&f.as_path()) {
+                out.push(f);
+            }
+        }
+        out
+    }
+
     /// The lights as evaluated, in order (a ShapingAPI whose factor is 1 everywhere is dropped).
     pub fn lights(&self) -> impl Iterator<Item = &Light> {
         self.lights.iter().map(|p| &p.light)
