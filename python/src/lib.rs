@@ -12,7 +12,9 @@
 //! `ValueError`), a device or run-time failure `DeviceError` (a `RuntimeError`); a panic inside
 //! the library is turned into a `DeviceError` that says it is a bug, never a `PanicException`.
 
+mod args;
 mod arrays;
+mod chunks;
 mod device;
 mod errors;
 mod stage;

@@ -5,64 +5,22 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-use glam::DVec3;
 use luxeval::{
-    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, Stage, TemperatureMode,
+    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, Stage as ReadStage, TemperatureMode,
     TextureFilter, TimeRule,
 };
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
-use pyo3::exceptions::{PyMemoryError, PyUserWarning};
+use pyo3::exceptions::PyUserWarning;
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyString, PyTuple, PyType};
 
+use crate::args::{Options, parse_lights, resolution, vec3};
 use crate::arrays;
-use crate::device::{self, Device};
+use crate::chunks::{Chunks, zeros};
+use crate::device;
 use crate::errors::{self, no_panic};
-
-/// How many rows each call into the library evaluates. Between two calls the GIL is taken back
-/// and Ctrl-C is checked, so a call should take about [`Chunks::TARGET_S`] whatever the device
-/// and the query cost (irradiance on the CPU reference costs ~10 000 times what emission on a
-/// GPU does): the first chunk is small, and each next one is sized from the last one's time.
-/// Sizes are powers of two, so that the GPU's buffers (kept per power-of-two size class) are
-/// reused from chunk to chunk once the size settles.
-struct Chunks {
-    rows: usize,
-    max: usize,
-}
-
-impl Chunks {
-    const TARGET_S: f64 = 0.25;
-    /// At most this many light-samples (rows × lights) per call: bounds the chunk's memory.
-    const MAX_SAMPLES: usize = 1 << 22;
-
-    fn new(first: usize, lights: usize) -> Chunks {
-        let max = (Self::MAX_SAMPLES / lights.max(1)).max(1);
-        Chunks {
-            rows: first.min(max).max(1),
-            max,
-        }
-    }
-
-    /// After a chunk of `rows` rows took `secs`: the size of the next one, within 4× of it.
-    fn update(&mut self, rows: usize, secs: f64) {
-        let rows = rows.max(1);
-        let ideal = if secs > 0.0 {
-            rows as f64 * Self::TARGET_S / secs
-        } else {
-            f64::INFINITY
-        };
-        let ideal = ideal.clamp((rows / 4).max(1) as f64, rows.saturating_mul(4) as f64);
-        self.rows = if ideal >= self.max as f64 {
-            self.max
-        } else {
-            // The power of two at or below the ideal size.
-            let ideal = ideal as usize;
-            1usize << (usize::BITS - 1 - ideal.leading_zeros())
-        };
-    }
-}
 
 /// A USD stage (``.usda``, ``.usdc``, ``.usdz``) and its lights, read once at one time.
 ///
@@ -89,7 +47,7 @@ pub struct Stage {
     absolute: PathBuf,
     /// The `time` argument (`None`: the stage's default rule).
     requested_time: Option<f64>,
-    scene: Stage,
+    scene: ReadStage,
     /// `scene.lights` as `luxeval lights --json` writes them.
     lights_json: String,
     prepared: Mutex<HashMap<Key, Arc<PreparedScene>>>,
@@ -103,85 +61,6 @@ struct Key {
     gpu: bool,
     mode: TemperatureMode,
     filter: TextureFilter,
-}
-
-/// The options every query takes.
-struct Options {
-    select: Vec<String>,
-    device: Device,
-    mode: TemperatureMode,
-    filter: TextureFilter,
-    /// Irradiance's relative tolerance (`luxeval irradiance --tolerance`); not part of the
-    /// prepared scene, which takes it per call.
-    tolerance: Option<f64>,
-}
-
-impl Options {
-    fn parse(
-        lights: Option<&Bound<'_, PyAny>>,
-        device: &str,
-        mode: &str,
-        filter: &str,
-    ) -> PyResult<Options> {
-        Ok(Options {
-            select: parse_lights(lights)?,
-            device: Device::parse(device)?,
-            mode: device::parse_mode(mode)?,
-            filter: device::parse_filter(filter)?,
-            tolerance: None,
-        })
-    }
-
-    /// With irradiance's tolerance, its range checked now (the GPU's bound per call).
-    fn with_tolerance(mut self, rel: f64) -> PyResult<Options> {
-        luxeval::Evaluator::cpu()
-            .with_irradiance_tolerance(rel)
-            .map_err(|e| errors::lux(e, None))?;
-        self.tolerance = Some(rel);
-        Ok(self)
-    }
-
-    fn irradiance(
-        &self,
-        scene: &PreparedScene,
-        points: &[[f32; 3]],
-        normals: &[[f32; 3]],
-        acc: Accumulate,
-    ) -> luxeval::Result<Vec<[f32; 3]>> {
-        match self.tolerance {
-            Some(rel) => scene.irradiance_with_tolerance(points, normals, acc, rel),
-            None => scene.irradiance(points, normals, acc),
-        }
-    }
-}
-
-/// `None`: every light; a str: that prim path; an iterable of str: those prim paths.
-fn parse_lights(lights: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
-    let Some(obj) = lights else {
-        return Ok(Vec::new());
-    };
-    if obj.is_none() {
-        return Ok(Vec::new());
-    }
-    if obj.is_instance_of::<PyString>() {
-        return Ok(vec![obj.extract::<String>()?]);
-    }
-    let bad = || {
-        errors::input(format!(
-            "lights: expected None, a prim path or a list of prim paths, got {}",
-            obj.repr().map(|r| r.to_string()).unwrap_or_default()
-        ))
-    };
-    let mut out = Vec::new();
-    for item in obj.try_iter().map_err(|_| bad())? {
-        out.push(item?.extract::<String>().map_err(|_| bad())?);
-    }
-    if out.is_empty() {
-        return Err(errors::input(
-            "lights: an empty list selects no light; pass None for every light",
-        ));
-    }
-    Ok(out)
 }
 
 /// `Stage(path, time)`'s arguments, as pickling records them.
@@ -336,72 +215,6 @@ impl Stage {
     }
 }
 
-/// A zeroed f32 buffer of `len` values (`None`: more than `usize` can count), or `MemoryError`
-/// rather than an abort when it cannot be allocated.
-fn zeros(len: Option<usize>) -> PyResult<Vec<f32>> {
-    let too_big =
-        |what: String| PyMemoryError::new_err(format!("cannot allocate the result: {what}"));
-    let len = len.ok_or_else(|| too_big("more values than memory can address".into()))?;
-    let mut v = Vec::new();
-    v.try_reserve_exact(len).map_err(|_| {
-        too_big(format!(
-            "{len} float32 values ({} bytes)",
-            len.saturating_mul(4)
-        ))
-    })?;
-    v.resize(len, 0.0);
-    Ok(v)
-}
-
-/// A 3-vector argument of `falloff`: three finite numbers.
-fn vec3(py: Python<'_>, obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DVec3> {
-    let np = py.import(intern!(py, "numpy"))?;
-    let arr = np
-        .call_method1(intern!(py, "asarray"), (obj, np.getattr("float64")?))
-        .map_err(|e| {
-            errors::input(format!(
-                "{name}: expected three numbers X, Y, Z: {}",
-                e.value(py)
-            ))
-        })?;
-    let shape: Vec<usize> = arr.getattr(intern!(py, "shape"))?.extract()?;
-    if shape != [3] {
-        return Err(errors::input(format!(
-            "{name}: shape {}; expected three numbers X, Y, Z",
-            arrays::shape_str(&shape)
-        )));
-    }
-    let list = arr.call_method0(intern!(py, "tolist"))?;
-    let v: [f64; 3] = list.extract()?;
-    if v.iter().any(|c| !c.is_finite()) {
-        return Err(errors::input(format!(
-            "{name}: {} is not finite",
-            list.str()?
-        )));
-    }
-    Ok(DVec3::from_array(v))
-}
-
-/// `res`: (width, height) in pixels.
-fn resolution(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
-    let bad = || {
-        errors::input(format!(
-            "res: expected (width, height), two integers ≥ 1, got {}",
-            res.repr().map(|r| r.to_string()).unwrap_or_default()
-        ))
-    };
-    let (w, h): (i64, i64) = res.extract().map_err(|_| bad())?;
-    let w = u32::try_from(w).ok().filter(|w| *w >= 1).ok_or_else(bad)?;
-    let h = u32::try_from(h).ok().filter(|h| *h >= 1).ok_or_else(bad)?;
-    if w as u64 * h as u64 > Plane::MAX_PIXELS {
-        return Err(errors::input(format!(
-            "res: {w}×{h} is more than {} pixels",
-            Plane::MAX_PIXELS
-        )));
-    }
-    Ok((w, h))
-}
-
 #[pymethods]
 impl Stage {
     #[new]
@@ -413,8 +226,9 @@ impl Stage {
             )));
         }
         let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
-        let scene =
-            py.detach(|| no_panic(|| Stage::load(&path, time).map_err(|e| errors::lux(e, None))))?;
+        let scene = py.detach(|| {
+            no_panic(|| ReadStage::load(&path, time).map_err(|e| errors::lux(e, None)))
+        })?;
         let lights_json = luxeval::lights_json(&scene)
             .map(|v| v.to_string())
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;

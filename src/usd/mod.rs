@@ -5,7 +5,8 @@
 //! references, payloads all loaded, variant selections, inherits, specializes, instancing) and
 //! returns plain data: stage metadata, and for every light prim its type, applied schemas,
 //! visibility, world matrix and every attribute of [`crate::model::schema::attrs_for`] resolved
-//! at one time. [`scene`] decides what each light means to luxeval.
+//! at one time. [`scene`] decides what each light means to luxeval (each prim converted by
+//! [`light`]).
 //!
 //! Value resolution and transforms are openusd's, checked against Pixar's usd-core in
 //! `tests/usd_fixtures.rs`, except where openusd 0.8 gives other numbers than usd-core; there
@@ -21,6 +22,8 @@
 
 mod arcs;
 mod diagnostics;
+mod light;
+mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;
 mod values;

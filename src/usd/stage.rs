@@ -6,8 +6,9 @@ use std::path::{Path, PathBuf};
 use openusd::usd::{self as ousd, PrimPredicate, TimeCode};
 use openusd_schemas::geom::{XformCache, Xformable, XformableExt};
 
-use super::arcs::{LimitedResolver, preflight};
+use super::arcs::preflight;
 use super::diagnostics::{check_composition, open_error, stage_error};
+use super::resolver::LimitedResolver;
 use super::values::{convert, reject_spline, value_at, visible_at};
 use super::xform::{needs_own_xform, world_as_usd_core, xform_error};
 use crate::error::{LuxError, Result};

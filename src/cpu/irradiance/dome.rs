@@ -22,9 +22,11 @@
 //! grow like `(1 + κ)^k`), and the adaptive routine for disk-rim pieces and pieces with
 //! `δ(1 + κ) > 0.5`. Crossed pieces: adaptive outer integral to 1e-12 of the piece's scale.
 
+pub mod horizon;
 pub mod pieces;
 pub mod quadrature;
 pub mod sh;
+mod tables;
 
 use std::sync::{Arc, OnceLock};
 
@@ -34,8 +36,9 @@ use rayon::prelude::*;
 use crate::prepare::texture::Filter;
 use crate::prepare::texture::Image;
 use crate::prepare::texture::{DomeFormat, DomeFrame, FormatError};
-use pieces::{Domain, Geometry, HorizonCurve, Piece, PieceGrid, exact, tensor};
+use pieces::{Domain, Geometry, Piece, PieceGrid, exact, tensor};
 use quadrature::gl;
+use tables::Tables;
 
 /// The irradiance tables of a prepared textured dome, built on first use and kept in the
 /// texture's [`crate::prepare::texture::PreparedTexture::irradiance`] slot (shared by clones of the
@@ -52,8 +55,6 @@ pub fn tables(p: &crate::prepare::Prepared) -> Option<Arc<DomeIrradiance>> {
     slot.clone().downcast::<DomeIrradiance>().ok()
 }
 
-/// Pieces per table entry at most (the tile size grows beyond it).
-const MAX_TILES: usize = 1 << 20;
 /// Relative tolerance of the adaptive integrals (per piece).
 const REL_TOL: f64 = 1e-12;
 
@@ -71,62 +72,6 @@ pub struct DomeIrradiance {
     tables: OnceLock<Tables>,
     /// The 9-coefficient fast path, projected on first use.
     sh9: OnceLock<sh::IrradianceSh>,
-}
-
-struct Tile {
-    grid: usize,
-    ix: (usize, usize),
-    iy: (usize, usize),
-    v: [f64; 9],
-    /// Cap centre and angular radius; radius = ∞ forces a descent.
-    centre: DVec3,
-    radius: f64,
-}
-
-struct Tables {
-    tiles: Vec<Tile>,
-    single: bool,
-    /// Separable latlong factors per axis piece: columns (a ∈ {0,1}) × (sin φ, 1, cos φ),
-    /// rows (b ∈ {0,1}) × (sin²θ, sinθ cosθ).
-    cols: Vec<[[f64; 3]; 2]>,
-    rows: Vec<[[f64; 2]; 2]>,
-}
-
-/// Where a cap lies with respect to the lit hemisphere `m̂·d > 0`.
-#[derive(PartialEq)]
-enum Side {
-    Lit,
-    Dark,
-    Crossed,
-}
-
-fn side(mhat: DVec3, centre: DVec3, radius: f64) -> Side {
-    if radius >= 0.5 * std::f64::consts::PI {
-        return Side::Crossed;
-    }
-    let (s, r) = (mhat.dot(centre), radius.sin() + 1e-12);
-    if s > r {
-        Side::Lit
-    } else if s < -r {
-        Side::Dark
-    } else {
-        Side::Crossed
-    }
-}
-
-/// `tex ⊗ v`, channel-major: a moment's RGB × xyz entries.
-fn outer(tex: DVec3, v: DVec3) -> [f64; 9] {
-    [
-        tex.x * v.x,
-        tex.x * v.y,
-        tex.x * v.z,
-        tex.y * v.x,
-        tex.y * v.y,
-        tex.y * v.z,
-        tex.z * v.x,
-        tex.z * v.y,
-        tex.z * v.z,
-    ]
 }
 
 fn add<const K: usize>(acc: &mut [f64; K], v: &[f64; K]) {
@@ -228,43 +173,6 @@ impl DomeIrradiance {
         m * (j.max(1e-3 * 16.0 / (self.geom.w * self.geom.h))) * area * self.weight(d) + 1e-300
     }
 
-    /// `V = ∫_piece L d w dd` (RGB × xyz, channel-major).
-    fn moment(&self, t: &Tables, grid: usize, ix: usize, iy: usize) -> [f64; 9] {
-        let p = self.piece(grid, ix, iy);
-        let dom = self.geom.domain(&p);
-        if dom == Domain::Outside {
-            return [0.0; 9];
-        }
-        let mut f = |d: DVec3, tex: DVec3, j: f64| outer(tex, d * (self.weight(d) * j));
-        let cap = self.geom.cap(&p);
-        match (cap, self.conformal) {
-            (Some(_), Some(w)) if self.format == DomeFormat::LatLong => {
-                let (cx, ry) = (&t.cols[ix], &t.rows[iy]);
-                let k = w
-                    * (2.0 * std::f64::consts::PI / self.geom.w)
-                    * (std::f64::consts::PI / self.geom.h);
-                let corners = [
-                    (p.ax.i0, p.ay.i0, 0, 0),
-                    (p.ax.i1, p.ay.i0, 1, 0),
-                    (p.ax.i0, p.ay.i1, 0, 1),
-                    (p.ax.i1, p.ay.i1, 1, 1),
-                ];
-                let mut v = [0.0; 9];
-                for (i, j, a, b) in corners {
-                    let m = DVec3::new(
-                        cx[a][0] * ry[b][0],
-                        cx[a][1] * ry[b][1],
-                        cx[a][2] * ry[b][0],
-                    ) * k;
-                    let tex = crate::cpu::texture::tex_fetch(&self.img, i, j);
-                    add(&mut v, &outer(tex, m));
-                }
-                v
-            }
-            _ => self.whole_piece(&p, dom, 0, &mut f),
-        }
-    }
-
     /// `∫ f(d, tex, J)` over a whole piece (no horizon): one tensor Gauss–Legendre rule of
     /// order `order(δ) + extra` where the piece lies inside the image's domain and is small for
     /// the frame (`δ(1 + κ) ≤ 0.5`, see the module docs), else the adaptive [`exact`].
@@ -292,192 +200,6 @@ impl DomeIrradiance {
         }
     }
 
-    fn tables(&self) -> &Tables {
-        self.tables.get_or_init(|| self.build())
-    }
-
-    fn build(&self) -> Tables {
-        let count: usize = self.grids.iter().map(|g| g.xs.len() * g.ys.len()).sum();
-        let tsize = ((count as f64 / MAX_TILES as f64).sqrt().ceil() as usize).max(1);
-        let axis_rule = |a: f64, b: f64, f: &dyn Fn(f64) -> [f64; 3]| gl::<3>(16, a, b, f);
-        let (mut cols, mut rows) = (vec![], vec![]);
-        if self.format == DomeFormat::LatLong {
-            let (w, h) = (self.geom.w, self.geom.h);
-            let phi = |x: f64| std::f64::consts::PI - 2.0 * std::f64::consts::PI * x / w;
-            cols = self.grids[0]
-                .xs
-                .iter()
-                .map(|p| {
-                    [0, 1].map(|a| {
-                        axis_rule(p.x0, p.x1, &|x| {
-                            let wt = if a == 0 {
-                                p.weights(x).0
-                            } else {
-                                p.weights(x).1
-                            };
-                            [wt * phi(x).sin(), wt, wt * phi(x).cos()]
-                        })
-                    })
-                })
-                .collect();
-            rows = self.grids[0]
-                .ys
-                .iter()
-                .map(|p| {
-                    [0, 1].map(|b| {
-                        let v = axis_rule(p.x0, p.x1, &|y| {
-                            let wt = if b == 0 {
-                                p.weights(y).0
-                            } else {
-                                p.weights(y).1
-                            };
-                            let (s, c) = (std::f64::consts::PI * y / h).sin_cos();
-                            [wt * s * s, wt * s * c, 0.0]
-                        });
-                        [v[0], v[1]]
-                    })
-                })
-                .collect();
-        }
-        let mut t = Tables {
-            tiles: vec![],
-            single: tsize == 1,
-            cols,
-            rows,
-        };
-        let mut specs = vec![];
-        for (gi, g) in self.grids.iter().enumerate() {
-            for y in (0..g.ys.len()).step_by(tsize) {
-                for x in (0..g.xs.len()).step_by(tsize) {
-                    specs.push((
-                        gi,
-                        (x, (x + tsize).min(g.xs.len())),
-                        (y, (y + tsize).min(g.ys.len())),
-                    ));
-                }
-            }
-        }
-        let tiles: Vec<Tile> = specs
-            .into_par_iter()
-            .filter_map(|(grid, ix, iy)| self.tile(&t, grid, ix, iy))
-            .collect();
-        t.tiles = tiles;
-        t
-    }
-
-    fn tile(
-        &self,
-        t: &Tables,
-        grid: usize,
-        ix: (usize, usize),
-        iy: (usize, usize),
-    ) -> Option<Tile> {
-        let mut v = [0.0; 9];
-        let mut caps = vec![];
-        let mut bounded = true;
-        for j in iy.0..iy.1 {
-            for i in ix.0..ix.1 {
-                let p = self.piece(grid, i, j);
-                if self.geom.domain(&p) == Domain::Outside {
-                    continue;
-                }
-                add(&mut v, &self.moment(t, grid, i, j));
-                match self.geom.cap(&p) {
-                    Some(c) => caps.push(c),
-                    None => bounded = false,
-                }
-            }
-        }
-        if caps.is_empty() && bounded {
-            return None;
-        }
-        let centre = caps.get(caps.len() / 2).map_or(DVec3::Z, |c| c.0);
-        let radius = if bounded {
-            caps.iter()
-                .map(|(c, r)| centre.cross(*c).length().atan2(centre.dot(*c)) + r)
-                .fold(0.0, f64::max)
-        } else {
-            f64::INFINITY
-        };
-        Some(Tile {
-            grid,
-            ix,
-            iy,
-            v,
-            centre,
-            radius,
-        })
-    }
-
-    /// `E(n)` (RGB) for a unit world normal `n`: the exact integral of the filtered texture
-    /// (module docs). Multiply by the dome's `intensity · 2^exposure · color ⊙ temperature` and
-    /// `diffuse` outside.
-    pub fn irradiance(&self, n: DVec3) -> DVec3 {
-        let t = self.tables();
-        let m = self.frame.horizon(n);
-        let mhat = m.normalize();
-        let curve = matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
-            .then(|| HorizonCurve::new(self.format, m));
-        let dot = |v: &[f64; 9]| {
-            DVec3::new(
-                m.dot(DVec3::new(v[0], v[1], v[2])),
-                m.dot(DVec3::new(v[3], v[4], v[5])),
-                m.dot(DVec3::new(v[6], v[7], v[8])),
-            )
-        };
-        let mut e = DVec3::ZERO;
-        for tile in &t.tiles {
-            match side(mhat, tile.centre, tile.radius) {
-                Side::Lit => e += dot(&tile.v),
-                Side::Dark => {}
-                Side::Crossed if t.single && tile.radius.is_finite() => {
-                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, curve.as_ref());
-                }
-                Side::Crossed => {
-                    for j in tile.iy.0..tile.iy.1 {
-                        for i in tile.ix.0..tile.ix.1 {
-                            let p = self.piece(tile.grid, i, j);
-                            match self.geom.cap(&p).map(|(c, r)| side(mhat, c, r)) {
-                                _ if self.geom.domain(&p) == Domain::Outside => {}
-                                Some(Side::Lit) => e += dot(&self.moment(t, tile.grid, i, j)),
-                                Some(Side::Dark) => {}
-                                _ => e += self.crossed(tile.grid, i, j, m, curve.as_ref()),
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        e
-    }
-
-    /// One piece's share of `E`, clipped exactly at the horizon.
-    fn crossed(
-        &self,
-        grid: usize,
-        i: usize,
-        j: usize,
-        m: DVec3,
-        curve: Option<&HorizonCurve>,
-    ) -> DVec3 {
-        let p = self.piece(grid, i, j);
-        let delta = self.geom.cap(&p).map_or(0.5, |c| c.1.min(0.5));
-        let v = exact(
-            &self.geom,
-            &self.img,
-            &p,
-            Some(m),
-            curve,
-            self.order(delta) + 2,
-            REL_TOL * self.scale(&p) * m.length(),
-            &mut |d, tex, jac| {
-                let k = m.dot(d) * self.weight(d) * jac;
-                [tex.x * k, tex.y * k, tex.z * k]
-            },
-        );
-        DVec3::from_array(v)
-    }
-
     /// The fast path's `E(n)` (see [`sh`]): nine multiply-adds per channel once projected.
     pub fn irradiance_sh9(&self, n: DVec3) -> DVec3 {
         self.sh9
@@ -489,7 +211,7 @@ impl DomeIrradiance {
     /// `∫ L d dᵀ dd` (world solid angle = dome solid angle there), per channel, exactly and in
     /// O(W·H): every monomial of degree ≤ 2 in `d = (sin θ sin φ, cos θ, sin θ cos φ)` times
     /// `sin θ` is a product of a function of φ and one of θ, so each texel's weight is a column
-    /// factor times a row factor (16-point rules per axis piece, as for the moments above).
+    /// factor times a row factor (16-point rules per axis piece, as for the moments of the tables).
     /// `None` for other formats and frames.
     pub fn separable_moments(&self) -> Option<[(f64, DVec3, glam::DMat3); 3]> {
         let w = self.conformal?;

@@ -15,10 +15,11 @@
 //! decoders are additionally run under `catch_unwind`, so that a decoder bug reached by a corrupt
 //! file becomes [`TextureError::DecoderPanic`] instead of aborting the caller.
 
-use std::io::Cursor;
+mod openexr;
+mod png_jpeg_hdr;
+
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 /// Largest accepted image: 2^28 pixels (16384 × 16384; a 16k × 8k latlong fits). At 12 bytes per
 /// linear RGB texel that is 3 GiB, the most a texture may claim before we refuse it.
@@ -154,9 +155,9 @@ pub fn load(path: &Path) -> Result<Image, TextureError> {
 pub fn decode(bytes: &[u8], source: &Path) -> Result<Image, TextureError> {
     if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
         // Sanitised while decoding.
-        load_exr(source, bytes)
+        openexr::load_exr(source, bytes)
     } else {
-        let mut img = load_ldr_or_hdr(source, bytes)?;
+        let mut img = png_jpeg_hdr::load_ldr_or_hdr(source, bytes)?;
         img.sanitize();
         Ok(img)
     }
@@ -198,252 +199,6 @@ fn guarded<T>(path: &Path, f: impl FnOnce() -> Result<T, TextureError>) -> Resul
     }
 }
 
-fn compression_name(c: exr::compression::Compression) -> Option<&'static str> {
-    use exr::compression::Compression::*;
-    // The ones `exr` 1.74 decodes; HTJ2K (and anything newer) is refused by name.
-    Some(match c {
-        Uncompressed => "none",
-        RLE => "rle",
-        ZIP1 => "zips",
-        ZIP16 => "zip",
-        PIZ => "piz",
-        PXR24 => "pxr24",
-        B44 => "b44",
-        B44A => "b44a",
-        DWAA(_) => "dwaa",
-        DWAB(_) => "dwab",
-        _ => return None,
-    })
-}
-
-fn load_exr(path: &Path, bytes: &[u8]) -> Result<Image, TextureError> {
-    use exr::prelude::*;
-    let exr_err = |source| TextureError::Exr {
-        path: path.to_owned(),
-        source,
-    };
-    // Header first: refuse absurd sizes and undecodable compressions before any pixel allocation.
-    let meta = guarded(path, || {
-        exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false).map_err(exr_err)
-    })?;
-    let Some(header) = meta.headers.iter().find(|h| !h.deep) else {
-        return Err(TextureError::Unsupported {
-            path: path.to_owned(),
-            what: "only deep-data parts in this OpenEXR file".into(),
-        });
-    };
-    let (w, h) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
-    check_size(path, w, h)?;
-    if compression_name(header.compression).is_none() {
-        return Err(TextureError::UnsupportedCompression {
-            path: path.to_owned(),
-            compression: format!("{:?}", header.compression),
-        });
-    }
-    let names: Vec<String> = header
-        .channels
-        .list
-        .iter()
-        .map(|c| c.name.to_string())
-        .collect();
-    if header
-        .channels
-        .list
-        .iter()
-        .any(|c| c.sampling != Vec2(1, 1))
-    {
-        return Err(TextureError::Unsupported {
-            path: path.to_owned(),
-            what: format!("subsampled channels in {names:?}"),
-        });
-    }
-    let envmap = header.own_attributes.environment_map.map(|e| match e {
-        exr::meta::attribute::EnvironmentMap::LatitudeLongitude => EnvMap::LatLong,
-        exr::meta::attribute::EnvironmentMap::Cube => EnvMap::Cube,
-    });
-    let find = |n: &str| names.iter().position(|c| c == n);
-    let plan: [usize; 3] = match (find("R"), find("G"), find("B"), find("Y")) {
-        (Some(r), Some(g), Some(b), _) => [r, g, b],
-        (_, _, _, Some(y)) if find("RY").is_none() && find("BY").is_none() => [y, y, y],
-        _ => {
-            return Err(TextureError::Unsupported {
-                path: path.to_owned(),
-                what: format!("no R, G, B (or lone Y) channels; found {names:?}"),
-            });
-        }
-    };
-    let map_err = |source| match source {
-        exr::error::Error::NotSupported(ref what) if what.contains("compression") => {
-            TextureError::UnsupportedCompression {
-                path: path.to_owned(),
-                compression: what.to_string(),
-            }
-        }
-        source => exr_err(source),
-    };
-    // Negative and NaN samples become 0 as they are stored (Image::sanitize's rule, folded into
-    // the decode so that an 8k map is not walked twice).
-    // Not `clamp`: f32::clamp keeps NaN, max(0) turns it into 0.
-    #[allow(clippy::manual_clamp)]
-    let clean = |v: f32| v.max(0.0).min(f32::MAX);
-    let (width, height, rgb) = if plan[0] != plan[1] {
-        // R, G, B: exr's batched sample conversion straight into the interleaved buffer.
-        let image = guarded(path, || {
-            read()
-                .no_deep_data()
-                .largest_resolution_level()
-                .specific_channels()
-                .required("R")
-                .required("G")
-                .required("B")
-                .collect_pixels(
-                    |size: Vec2<usize>, _| (size.0, size.1, vec![[0f32; 3]; size.0 * size.1]),
-                    move |px: &mut (usize, usize, Vec<[f32; 3]>),
-                          pos: Vec2<usize>,
-                          (r, g, b): (f32, f32, f32)| {
-                        px.2[pos.1 * px.0 + pos.0] = [clean(r), clean(g), clean(b)];
-                    },
-                )
-                .first_valid_layer()
-                .all_attributes()
-                .from_buffered(Cursor::new(bytes))
-                .map_err(map_err)
-        })?;
-        image.layer_data.channel_data.pixels
-    } else {
-        // A lone Y channel.
-        let image = guarded(path, || {
-            read()
-                .no_deep_data()
-                .largest_resolution_level()
-                .specific_channels()
-                .required("Y")
-                .collect_pixels(
-                    |size: Vec2<usize>, _| (size.0, size.1, vec![[0f32; 3]; size.0 * size.1]),
-                    move |px: &mut (usize, usize, Vec<[f32; 3]>),
-                          pos: Vec2<usize>,
-                          (y,): (f32,)| {
-                        px.2[pos.1 * px.0 + pos.0] = [clean(y); 3];
-                    },
-                )
-                .first_valid_layer()
-                .all_attributes()
-                .from_buffered(Cursor::new(bytes))
-                .map_err(map_err)
-        })?;
-        image.layer_data.channel_data.pixels
-    };
-    // The decoded layer must be the one whose header we checked.
-    if (width as u64, height as u64) != (w, h) || rgb.len() != width * height {
-        return Err(TextureError::Unsupported {
-            path: path.to_owned(),
-            what: "the first decodable layer differs from the first header".into(),
-        });
-    }
-    Ok(self::Image {
-        width,
-        height,
-        rgb,
-        envmap,
-        source: path.to_owned(),
-    })
-}
-
-/// §6: `c = value / 255` (or `/ 65535`); linear `= c / 12.92` for `c ≤ 0.04045`, else
-/// `((c + 0.055) / 1.055)^2.4`. Evaluated in f64, rounded once to f32.
-pub fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn lut8() -> &'static [f32; 256] {
-    static T: OnceLock<[f32; 256]> = OnceLock::new();
-    T.get_or_init(|| std::array::from_fn(|v| srgb_to_linear(v as f64 / 255.0) as f32))
-}
-
-fn lut16() -> &'static [f32] {
-    static T: OnceLock<Vec<f32>> = OnceLock::new();
-    T.get_or_init(|| {
-        (0..65536)
-            .map(|v| srgb_to_linear(v as f64 / 65535.0) as f32)
-            .collect()
-    })
-}
-
-fn load_ldr_or_hdr(path: &Path, bytes: &[u8]) -> Result<Image, TextureError> {
-    use image::{DynamicImage, ImageReader, Limits};
-    let dec_err = |source| TextureError::Decode {
-        path: path.to_owned(),
-        source,
-    };
-    let reader = || {
-        ImageReader::new(Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|source| TextureError::Io {
-                path: path.to_owned(),
-                source,
-            })
-    };
-    let (w, h) = guarded(path, || reader()?.into_dimensions().map_err(dec_err))?;
-    check_size(path, w as u64, h as u64)?;
-    let mut limits = Limits::default();
-    limits.max_image_width = Some(w);
-    limits.max_image_height = Some(h);
-    // The decoded buffer (at most 4 × 16-bit or 4 × f32 per pixel) plus the decoders' scratch.
-    limits.max_alloc = Some((w as u64 * h as u64 * 16).saturating_add(1 << 26));
-    let img = guarded(path, || {
-        let mut r = reader()?;
-        r.limits(limits);
-        r.decode().map_err(dec_err)
-    })?;
-    let (width, height) = (img.width() as usize, img.height() as usize);
-    let l8 = lut8();
-    let rgb: Vec<[f32; 3]> = match &img {
-        DynamicImage::ImageLuma8(b) => b.pixels().map(|p| [l8[p[0] as usize]; 3]).collect(),
-        DynamicImage::ImageLumaA8(b) => b.pixels().map(|p| [l8[p[0] as usize]; 3]).collect(),
-        DynamicImage::ImageRgb8(b) => b.pixels().map(|p| p.0.map(|v| l8[v as usize])).collect(),
-        DynamicImage::ImageRgba8(b) => b
-            .pixels()
-            .map(|p| [0, 1, 2].map(|k| l8[p[k] as usize]))
-            .collect(),
-        DynamicImage::ImageLuma16(b) => b.pixels().map(|p| [lut16()[p[0] as usize]; 3]).collect(),
-        DynamicImage::ImageLumaA16(b) => b.pixels().map(|p| [lut16()[p[0] as usize]; 3]).collect(),
-        DynamicImage::ImageRgb16(b) => b
-            .pixels()
-            .map(|p| p.0.map(|v| lut16()[v as usize]))
-            .collect(),
-        DynamicImage::ImageRgba16(b) => b
-            .pixels()
-            .map(|p| [0, 1, 2].map(|k| lut16()[p[k] as usize]))
-            .collect(),
-        // Radiance HDR decodes to linear float.
-        DynamicImage::ImageRgb32F(b) => b.pixels().map(|p| p.0).collect(),
-        DynamicImage::ImageRgba32F(b) => b.pixels().map(|p| [p[0], p[1], p[2]]).collect(),
-        other => {
-            return Err(TextureError::Unsupported {
-                path: path.to_owned(),
-                what: format!("pixel layout {:?}", other.color()),
-            });
-        }
-    };
-    if rgb.len() != width * height {
-        return Err(TextureError::Unsupported {
-            path: path.to_owned(),
-            what: "decoded size differs from the header".into(),
-        });
-    }
-    Ok(Image {
-        width,
-        height,
-        rgb,
-        envmap: None,
-        source: path.to_owned(),
-    })
-}
-
 /// A format that does not fit the file (exit 2 in the CLI, §6 D5/D6). Names the file.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum FormatError {
@@ -475,8 +230,9 @@ pub enum FormatError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::io::Cursor;
 
-    fn tmp(name: &str) -> (tempfile::TempDir, PathBuf) {
+    pub(super) fn tmp(name: &str) -> (tempfile::TempDir, PathBuf) {
         let d = tempfile::tempdir().unwrap();
         let p = d.path().join(name);
         (d, p)
@@ -498,7 +254,7 @@ mod tests {
     }
 
     /// A small ZIP-compressed half RGB EXR, as the Blender `*_zip_half.exr` copies are.
-    fn small_exr(w: usize, h: usize) -> Vec<u8> {
+    pub(super) fn small_exr(w: usize, h: usize) -> Vec<u8> {
         use exr::prelude::*;
         let ch = SpecificChannels::rgb(|pos: Vec2<usize>| {
             (
@@ -522,7 +278,7 @@ mod tests {
     }
 
     /// Byte offset of an attribute's value in an EXR header.
-    fn attr_value(bytes: &[u8], name: &str) -> usize {
+    pub(super) fn attr_value(bytes: &[u8], name: &str) -> usize {
         let key = [name.as_bytes(), &[0]].concat();
         let at = bytes
             .windows(key.len())
@@ -545,104 +301,6 @@ mod tests {
                 let msg = e.to_string();
                 assert!(msg.contains(&p.display().to_string()), "{msg}");
             }
-        }
-    }
-
-    #[test]
-    fn srgb_decoding_is_the_pinned_piecewise_formula() {
-        assert_eq!(srgb_to_linear(0.0), 0.0);
-        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-15);
-        assert!((srgb_to_linear(0.04045) - 0.04045 / 12.92).abs() < 1e-18);
-        assert!((srgb_to_linear(0.5) - ((0.5 + 0.055) / 1.055f64).powf(2.4)).abs() < 1e-15);
-        assert_eq!(lut8()[255], 1.0);
-        assert_eq!(lut16()[65535], 1.0);
-    }
-
-    #[test]
-    fn png_8_and_16_bit_decode_to_linear_rows_from_the_top() {
-        let (_d, p) = tmp("a.png");
-        let mut img = image::RgbImage::new(3, 2);
-        img.put_pixel(2, 0, image::Rgb([255, 128, 0]));
-        img.save(&p).unwrap();
-        let t = load(&p).unwrap();
-        assert_eq!((t.width, t.height, t.envmap), (3, 2, None));
-        let half = srgb_to_linear(128.0 / 255.0) as f32;
-        assert_eq!(t.texel(2, 0), [1.0, half, 0.0]);
-        assert_eq!(t.texel(0, 1), [0.0; 3]);
-        let (_d2, p16) = tmp("b.png");
-        let mut g = image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::new(2, 1);
-        g.put_pixel(1, 0, image::Luma([65535]));
-        g.save(&p16).unwrap();
-        let t = load(&p16).unwrap();
-        assert_eq!(t.rgb, vec![[0.0; 3], [1.0; 3]]);
-    }
-
-    #[test]
-    fn exr_half_zip_float_tiled_and_lone_y_channel() {
-        use exr::prelude::*;
-        let (_d, p) = tmp("zip.exr");
-        std::fs::write(&p, small_exr(8, 4)).unwrap();
-        let img = load(&p).unwrap();
-        assert_eq!((img.width, img.height), (8, 4));
-        assert_eq!(img.texel(4, 3), [1.0, 3.0, 0.5]);
-        // A tiled float RGB file with a data window offset from the origin: row 0 = data
-        // window min.y.
-        let (_d, p) = tmp("tiled.exr");
-        let ch = SpecificChannels::rgb(|pos: Vec2<usize>| (pos.0 as f32, pos.1 as f32, 0.5f32));
-        let mut layer = Layer::new(
-            (5, 3),
-            LayerAttributes::named("t"),
-            Encoding {
-                compression: Compression::PIZ,
-                blocks: Blocks::Tiles(Vec2(2, 2)),
-                line_order: LineOrder::Increasing,
-            },
-            ch,
-        );
-        layer.attributes.layer_position = Vec2(10, -4);
-        exr::prelude::Image::from_layer(layer)
-            .write()
-            .to_file(&p)
-            .unwrap();
-        let img = load(&p).unwrap();
-        assert_eq!((img.width, img.height), (5, 3));
-        assert_eq!(img.texel(4, 2), [4.0, 2.0, 0.5]);
-        // A lone Y channel is grey.
-        let (_d, p) = tmp("grey.exr");
-        let ch = AnyChannels::sort(SmallVec::from_vec(vec![AnyChannel::new(
-            "Y",
-            FlatSamples::F16(vec![f16::from_f32(0.25); 6]),
-        )]));
-        exr::prelude::Image::from_layer(Layer::new(
-            (3, 2),
-            LayerAttributes::named("g"),
-            Encoding::UNCOMPRESSED,
-            ch,
-        ))
-        .write()
-        .to_file(&p)
-        .unwrap();
-        let img = load(&p).unwrap();
-        assert_eq!(img.rgb, vec![[0.25; 3]; 6]);
-    }
-
-    #[test]
-    fn an_undecodable_compression_is_a_typed_error_naming_file_and_compression() {
-        let mut bytes = small_exr(8, 4);
-        // Compression codes: 10 = HTJ2K256 (OpenEXR 3.4), which exr 1.74 does not decode.
-        let v = attr_value(&bytes, "compression");
-        bytes[v] = 10;
-        let (_d, p) = tmp("htj2k.exr");
-        std::fs::write(&p, &bytes).unwrap();
-        match load(&p) {
-            Err(e @ TextureError::UnsupportedCompression { .. }) => {
-                let msg = e.to_string();
-                assert!(
-                    msg.contains("htj2k.exr") && msg.to_lowercase().contains("htj2k"),
-                    "{msg}"
-                );
-            }
-            other => panic!("expected UnsupportedCompression, got {other:?}"),
         }
     }
 

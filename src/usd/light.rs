@@ -1,0 +1,403 @@
+//! One light prim as luxeval reads it: its typed inputs turned into a model [`Light`] (with an
+//! optional caveat), or the reason it is not evaluated, naming the prim.
+
+use glam::DVec3;
+
+use super::stage as usd;
+use crate::model::{
+    Asset, Ies, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFormat, UpAxis,
+    Value,
+};
+
+/// Reads typed inputs of one light; a missing input (the schema table lacks it) or a value of the
+/// wrong kind becomes the reason the light is not evaluated, rather than a panic.
+struct Reader<'a> {
+    p: &'a usd::LightPrim,
+}
+
+impl Reader<'_> {
+    fn get(&self, name: &str) -> std::result::Result<&Value, String> {
+        self.p
+            .inputs
+            .iter()
+            .find(|i| i.name == name)
+            .map(|i| &i.value)
+            .ok_or_else(|| format!("{}: {} has no input {name}", self.p.path, self.p.usd_type))
+    }
+    fn float(&self, name: &str) -> std::result::Result<f64, String> {
+        match self.get(name)? {
+            Value::Float(v) => Ok(*v),
+            other => Err(self.kind(name, "float", other)),
+        }
+    }
+    fn bool(&self, name: &str) -> std::result::Result<bool, String> {
+        match self.get(name)? {
+            Value::Bool(v) => Ok(*v),
+            other => Err(self.kind(name, "bool", other)),
+        }
+    }
+    fn color(&self, name: &str) -> std::result::Result<DVec3, String> {
+        match self.get(name)? {
+            Value::Color(v) => Ok(DVec3::from_array(*v)),
+            other => Err(self.kind(name, "color", other)),
+        }
+    }
+    fn token(&self, name: &str) -> std::result::Result<&str, String> {
+        match self.get(name)? {
+            Value::Token(v) => Ok(v),
+            other => Err(self.kind(name, "token", other)),
+        }
+    }
+    /// The asset `name` refers to (authored and resolved paths), `None` when empty.
+    fn asset_ref(&self, name: &str) -> Option<Asset> {
+        match self.get(name) {
+            Ok(Value::Asset { authored, resolved }) if !authored.is_empty() => Some(Asset {
+                authored: authored.clone(),
+                resolved: resolved.clone(),
+                bytes: None,
+            }),
+            _ => None,
+        }
+    }
+    fn kind(&self, name: &str, want: &str, got: &Value) -> String {
+        format!(
+            "{}: {name} holds {got:?}, expected a {want} (schema table mismatch)",
+            self.p.path
+        )
+    }
+}
+
+/// The light luxeval evaluates for `p`, with an optional caveat; or why it is not evaluated.
+pub(super) fn convert(
+    p: &usd::LightPrim,
+    up: UpAxis,
+) -> std::result::Result<(Light, Option<String>), String> {
+    let r = Reader { p };
+    let path = &p.path;
+    let ty = p.usd_type.as_str();
+    if let Some(why) = &p.transform_error {
+        return Err(why.clone());
+    }
+    if let Some(api) = &p.light_api
+        && api == "LightAPI"
+    {
+        let on = match ty {
+            "" => "an untyped prim".to_string(),
+            ty => format!("a {ty} prim"),
+        };
+        return Err(format!(
+            "{path}: LightAPI is applied to {on}, which is not a UsdLux light type; \
+             luxeval does not evaluate it"
+        ));
+    }
+    if let Some(api) = &p.light_api {
+        let on = match ty {
+            "" => "an untyped prim".to_string(),
+            ty => format!("a {ty} prim"),
+        };
+        return Err(format!(
+            "{path}: {api} lights (on {on}) are not supported yet"
+        ));
+    }
+    let kind = match ty {
+        "DistantLight" => LightType::Distant {
+            angle: r.float("inputs:angle")?,
+        },
+        "SphereLight" => LightType::Sphere {
+            radius: r.float("inputs:radius")?,
+            treat_as_point: r.bool("treatAsPoint")?,
+        },
+        "DiskLight" => LightType::Disk {
+            radius: r.float("inputs:radius")?,
+        },
+        "RectLight" => LightType::Rect {
+            width: r.float("inputs:width")?,
+            height: r.float("inputs:height")?,
+        },
+        "CylinderLight" => LightType::Cylinder {
+            length: r.float("inputs:length")?,
+            radius: r.float("inputs:radius")?,
+            treat_as_line: r.bool("treatAsLine")?,
+        },
+        "DomeLight" | "DomeLight_1" => LightType::Dome,
+        "PortalLight" => {
+            return Err(format!(
+                "{path}: PortalLight is not supported yet (it shapes a dome light's emission)"
+            ));
+        }
+        "GeometryLight" => {
+            return Err(format!(
+                "{path}: GeometryLight is not supported (deprecated schema; use MeshLightAPI)"
+            ));
+        }
+        "PluginLight" => {
+            return Err(format!(
+                "{path}: PluginLight is not supported (its emission is defined by a renderer plugin)"
+            ));
+        }
+        other => return Err(format!("{path}: {other} is not a light type luxeval knows")),
+    };
+    let texture = match ty {
+        "RectLight" | "DomeLight" | "DomeLight_1" => texture(&r, ty)?,
+        _ => None,
+    };
+    let shaped = p.applied_schemas.iter().any(|s| s == "ShapingAPI");
+    let inputs = LightInputs {
+        intensity: r.float("inputs:intensity")?,
+        exposure: r.float("inputs:exposure")?,
+        color: r.color("inputs:color")?,
+        enable_color_temperature: r.bool("inputs:enableColorTemperature")?,
+        color_temperature: r.float("inputs:colorTemperature")?,
+        normalize: r.bool("inputs:normalize")?,
+        diffuse: r.float("inputs:diffuse")?,
+        specular: r.float("inputs:specular")?,
+    };
+    let shaping = if shaped {
+        Some(Shaping {
+            focus: r.float("inputs:shaping:focus")?,
+            focus_tint: r.color("inputs:shaping:focusTint")?,
+            cone_angle: r.float("inputs:shaping:cone:angle")?,
+            cone_softness: r.float("inputs:shaping:cone:softness")?,
+            // DESIGN.md §6 I7: IES inputs are read only where ShapingAPI is applied.
+            ies: match r.asset_ref("inputs:shaping:ies:file") {
+                Some(file) => Some(Ies {
+                    file,
+                    angle_scale: r.float("inputs:shaping:ies:angleScale")?,
+                    normalize: r.bool("inputs:shaping:ies:normalize")?,
+                }),
+                None => None,
+            },
+        })
+    } else {
+        None
+    };
+    let caveat = (shaped && !kind.is_shapeable())
+        .then(|| format!("{path}: ShapingAPI has no effect on a {ty} (DESIGN.md §2), ignored"));
+    let mut light = Light::new(kind).with_path(path.clone());
+    light.inputs = inputs;
+    light.shaping = shaping;
+    light.texture = texture;
+    Ok((light.with_usd_matrix(p.world).with_stage_up(up), caveat))
+}
+
+/// `inputs:texture:file`, `inputs:texture:format` (domes) and `poleAxis` (DomeLight_1), where
+/// `texture:file` is authored (an empty asset path is no texture).
+fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, String> {
+    let Some(file) = r.asset_ref("inputs:texture:file") else {
+        return Ok(None);
+    };
+    let mut t = Texture::new(file);
+    if ty != "RectLight" {
+        let token = r.token("inputs:texture:format")?;
+        t.format = TextureFormat::from_token(token).ok_or_else(|| {
+            format!(
+                "{}: inputs:texture:format = {token:?} is not one of automatic, latlong, \
+                 mirroredBall, angular, cubeMapVerticalCross",
+                r.p.path
+            )
+        })?;
+    }
+    if ty == "DomeLight_1" {
+        let token = r.token("poleAxis")?;
+        t.pole_axis = Some(PoleAxis::from_token(token).ok_or_else(|| {
+            format!(
+                "{}: poleAxis = {token:?} is not one of scene, Y, Z",
+                r.p.path
+            )
+        })?);
+    }
+    Ok(Some(t))
+}
+
+#[cfg(test)]
+pub(super) mod tests {
+    use super::*;
+    use crate::model::{Input, schema};
+
+    /// A light prim as `crate::usd` would return it, every input at its table fallback.
+    pub(crate) fn prim(ty: &str, applied: &[&str]) -> usd::LightPrim {
+        let inputs = schema::attrs_for(ty, applied)
+            .into_iter()
+            .map(|a| Input {
+                name: a.name.to_string(),
+                value: Value::fallback(a.fallback),
+                authored: false,
+            })
+            .collect();
+        usd::LightPrim {
+            path: format!("/Lights/{ty}"),
+            usd_type: ty.to_string(),
+            applied_schemas: applied.iter().map(|s| s.to_string()).collect(),
+            light_api: None,
+            transform_error: None,
+            visible: true,
+            world: [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+                [1.0, 2.0, 3.0, 1.0],
+            ],
+            inputs,
+        }
+    }
+
+    fn set(p: &mut usd::LightPrim, name: &str, value: Value) {
+        let i = p.inputs.iter_mut().find(|i| i.name == name).unwrap();
+        i.value = value;
+        i.authored = true;
+    }
+
+    #[test]
+    fn fallback_lights_convert_to_the_model_fallbacks() {
+        for ty in [
+            "DistantLight",
+            "SphereLight",
+            "DiskLight",
+            "RectLight",
+            "CylinderLight",
+            "DomeLight",
+            "DomeLight_1",
+        ] {
+            let (light, caveat) = convert(&prim(ty, &[]), UpAxis::Y).unwrap();
+            assert_eq!(caveat, None);
+            let expected = Light::new(LightType::fallback(ty).unwrap())
+                .with_path(format!("/Lights/{ty}"))
+                .with_usd_matrix(prim(ty, &[]).world);
+            assert_eq!(light, expected, "{ty}");
+            assert_eq!(light.origin(), DVec3::new(1.0, 2.0, 3.0));
+        }
+    }
+
+    #[test]
+    fn shaping_only_where_applied() {
+        let (plain, _) = convert(&prim("DiskLight", &[]), UpAxis::Y).unwrap();
+        assert_eq!(plain.shaping, None);
+        let mut p = prim("DiskLight", &["ShapingAPI"]);
+        let (defaults, _) = convert(&p, UpAxis::Y).unwrap();
+        assert_eq!(defaults.shaping, Some(Shaping::default()));
+        set(&mut p, "inputs:shaping:cone:angle", Value::Float(30.0));
+        set(
+            &mut p,
+            "inputs:shaping:focusTint",
+            Value::Color([1.0, 0.5, 0.0]),
+        );
+        let (authored, _) = convert(&p, UpAxis::Y).unwrap();
+        let s = authored.shaping.unwrap();
+        assert_eq!(s.cone_angle, 30.0);
+        assert_eq!(s.focus_tint, DVec3::new(1.0, 0.5, 0.0));
+    }
+
+    #[test]
+    fn unsupported_features_name_the_prim_and_feature() {
+        let mut rect = prim("RectLight", &[]);
+        set(
+            &mut rect,
+            "inputs:texture:file",
+            Value::Asset {
+                authored: "tex.png".into(),
+                resolved: None,
+            },
+        );
+        // RectLight textures are evaluated: read into the model, not skipped.
+        let (l, _) = convert(&rect, UpAxis::Y).unwrap();
+        assert_eq!(l.texture.unwrap().file.authored, "tex.png");
+
+        let mut ies = prim("SphereLight", &["ShapingAPI"]);
+        set(
+            &mut ies,
+            "inputs:shaping:ies:file",
+            Value::Asset {
+                authored: "a.ies".into(),
+                resolved: None,
+            },
+        );
+        // IES inputs are read where ShapingAPI is applied; an unresolved file is reported when
+        // the light is prepared (naming the prim and the file), not skipped here.
+        let (l, _) = convert(&ies, UpAxis::Y).unwrap();
+        let i = l.shaping.unwrap().ies.unwrap();
+        assert_eq!((i.file.authored.as_str(), i.file.resolved), ("a.ies", None));
+        assert_eq!((i.angle_scale, i.normalize), (0.0, false));
+
+        // An authored but empty asset path is no texture.
+        let mut empty = prim("DomeLight", &[]);
+        set(
+            &mut empty,
+            "inputs:texture:file",
+            Value::Asset {
+                authored: String::new(),
+                resolved: None,
+            },
+        );
+        assert!(convert(&empty, UpAxis::Y).is_ok());
+
+        for ty in ["PortalLight", "GeometryLight", "PluginLight"] {
+            let e = convert(&prim(ty, &[]), UpAxis::Y).unwrap_err();
+            assert!(e.contains(ty) && e.contains("/Lights/"), "{e}");
+        }
+        let mut mesh = prim("Mesh", &["MeshLightAPI"]);
+        mesh.light_api = Some("MeshLightAPI".into());
+        let e = convert(&mesh, UpAxis::Y).unwrap_err();
+        assert!(e.contains("MeshLightAPI"), "{e}");
+    }
+
+    #[test]
+    fn textures_are_read_into_the_model() {
+        let asset = || Value::Asset {
+            authored: "env.exr".into(),
+            resolved: Some("/abs/env.exr".into()),
+        };
+        let mut d1 = prim("DomeLight_1", &[]);
+        set(&mut d1, "inputs:texture:file", asset());
+        let t = texture(&Reader { p: &d1 }, "DomeLight_1").unwrap().unwrap();
+        assert_eq!(t.file.resolved.as_deref(), Some("/abs/env.exr"));
+        // The schema fallbacks: automatic, poleAxis scene.
+        assert_eq!(
+            (t.format, t.pole_axis),
+            (TextureFormat::Automatic, Some(PoleAxis::Scene))
+        );
+        set(
+            &mut d1,
+            "inputs:texture:format",
+            Value::Token("mirroredBall".into()),
+        );
+        set(&mut d1, "poleAxis", Value::Token("Z".into()));
+        let t = texture(&Reader { p: &d1 }, "DomeLight_1").unwrap().unwrap();
+        assert_eq!(
+            (t.format, t.pole_axis),
+            (TextureFormat::MirroredBall, Some(PoleAxis::Z))
+        );
+        // A plain DomeLight has no pole offset; a RectLight no format.
+        let mut d = prim("DomeLight", &[]);
+        set(&mut d, "inputs:texture:file", asset());
+        set(
+            &mut d,
+            "inputs:texture:format",
+            Value::Token("angular".into()),
+        );
+        let t = texture(&Reader { p: &d }, "DomeLight").unwrap().unwrap();
+        assert_eq!((t.format, t.pole_axis), (TextureFormat::Angular, None));
+        let mut rect = prim("RectLight", &[]);
+        set(&mut rect, "inputs:texture:file", asset());
+        let t = texture(&Reader { p: &rect }, "RectLight").unwrap().unwrap();
+        assert_eq!((t.format, t.pole_axis), (TextureFormat::Automatic, None));
+        // A token outside the schema's list names the prim and the attribute.
+        set(&mut d, "inputs:texture:format", Value::Token("cube".into()));
+        let e = texture(&Reader { p: &d }, "DomeLight").unwrap_err();
+        assert!(
+            e.contains("/Lights/DomeLight") && e.contains("texture:format"),
+            "{e}"
+        );
+        set(&mut d1, "poleAxis", Value::Token("X".into()));
+        let e = texture(&Reader { p: &d1 }, "DomeLight_1").unwrap_err();
+        assert!(e.contains("poleAxis"), "{e}");
+        // A textured RectLight is evaluated, not skipped.
+        assert!(convert(&rect, UpAxis::Y).unwrap().0.texture.is_some());
+    }
+
+    #[test]
+    fn shaping_on_distant_is_a_caveat() {
+        let (light, caveat) = convert(&prim("DistantLight", &["ShapingAPI"]), UpAxis::Y).unwrap();
+        assert!(light.shaping.is_some());
+        assert!(caveat.unwrap().contains("no effect"));
+    }
+}
