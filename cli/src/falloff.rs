@@ -87,7 +87,7 @@ pub fn run(a: &FalloffArgs) -> CliResult {
     {
         return Err(Failure::bad_input("--range: a log scale needs LOW > 0"));
     }
-    let (eval, scene) = open::prepare_irradiance(&a.scene, a.device, a.tolerance)?;
+    let (eval, scene) = open::prepare_irradiance(&a.scene, a.device, a.tolerance, &outputs)?;
     let bar = crate::query::progress_bar(
         plane.pixels() as u64,
         "px",

@@ -1,6 +1,8 @@
 //! The one opening path of every scene command: load the stage, print its warnings, select and
 //! validate the lights, open the device, prepare the lights once.
 
+use std::path::{Path, PathBuf};
+
 use luxeval::{Evaluator, Light, LuxError, PreparedScene, Stage};
 
 use crate::args::{DeviceArg, SceneArgs, ToleranceArg};
@@ -10,6 +12,11 @@ use crate::exit::{CliResult, Failure, in_scene};
 /// reported with the stage it comes from), their textures read with `--texture-filter`. Prints
 /// the stage's warnings.
 pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
+    Ok(lights_and_layers(args)?.0)
+}
+
+/// [`lights`] and every file read to compose the stage (its layers).
+fn lights_and_layers(args: &SceneArgs) -> CliResult<(Vec<Light>, Vec<PathBuf>)> {
     let scene = load(&args.scene, args.time.time)?;
     for w in scene.warnings() {
         eprintln!("warning: {w}");
@@ -21,7 +28,7 @@ pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
             t.filter = args.texture_filter.into();
         }
     }
-    Ok(lights)
+    Ok((lights, scene.files_read))
 }
 
 /// Loads the stage; an error about a light's attribute or transform is prefixed with the stage's
@@ -51,12 +58,16 @@ pub fn evaluator(device: Option<DeviceArg>, args: &SceneArgs) -> CliResult<Evalu
     Ok(eval.with_temperature_mode(args.temperature_mode.into()))
 }
 
-/// Loads, selects and prepares the lights on the chosen device.
+/// Loads, selects and prepares the lights on the chosen device, then refuses `outputs` that
+/// name a file the command read through the stage (a layer, an IES profile, a TILT file, a
+/// texture, a package), before anything is written (DESIGN.md §4; the files named on the
+/// command line are checked before the stage is read).
 pub fn prepare(
     args: &SceneArgs,
     device: Option<DeviceArg>,
+    outputs: &[(&str, &Path)],
 ) -> CliResult<(Evaluator, PreparedScene)> {
-    prepare_with(args, device, None)
+    prepare_with(args, device, None, outputs)
 }
 
 /// [`prepare`] for irradiance to a relative tolerance (`--tolerance`); checked before the stage
@@ -65,14 +76,16 @@ pub fn prepare_irradiance(
     args: &SceneArgs,
     device: Option<DeviceArg>,
     tolerance: ToleranceArg,
+    outputs: &[(&str, &Path)],
 ) -> CliResult<(Evaluator, PreparedScene)> {
-    prepare_with(args, device, Some(tolerance.tolerance))
+    prepare_with(args, device, Some(tolerance.tolerance), outputs)
 }
 
 fn prepare_with(
     args: &SceneArgs,
     device: Option<DeviceArg>,
     tolerance: Option<f64>,
+    outputs: &[(&str, &Path)],
 ) -> CliResult<(Evaluator, PreparedScene)> {
     if let Some(rel) = tolerance {
         // The range alone, before the stage is read (the device's own bound is checked below).
@@ -80,7 +93,7 @@ fn prepare_with(
             .with_irradiance_tolerance(rel)
             .map_err(|e| Failure::bad_input(format!("--{e}")))?;
     }
-    let lights = lights(args)?;
+    let (lights, layers) = lights_and_layers(args)?;
     if lights.is_empty() {
         eprintln!(
             "warning: {}: no light to evaluate; the output is all zeros",
@@ -99,5 +112,18 @@ fn prepare_with(
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
+    // Every file the command read, by what it was: no output may be one of them.
+    let mut inputs: Vec<(String, &Path)> = layers
+        .iter()
+        .map(|f| (format!("layer of {}", args.scene.display()), f.as_path()))
+        .collect();
+    inputs.extend(
+        scene
+            .files_read()
+            .into_iter()
+            .map(|f| (format!("file of a light of {}", args.scene.display()), f)),
+    );
+    let inputs: Vec<(&str, &Path)> = inputs.iter().map(|(n, p)| (n.as_str(), *p)).collect();
+    crate::io::check_outputs(outputs, &inputs)?;
     Ok((eval, scene))
 }

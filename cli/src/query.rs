@@ -99,9 +99,9 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
     let n = readers[0].rows();
     let (eval, scene) = match query {
         Query::Irradiance { tolerance, .. } => {
-            open::prepare_irradiance(&args.scene, args.device, tolerance)?
+            open::prepare_irradiance(&args.scene, args.device, tolerance, &outputs)?
         }
-        _ => open::prepare(&args.scene, args.device)?,
+        _ => open::prepare(&args.scene, args.device, &outputs)?,
     };
     check_output_rows(&scene, n, args.per_light)?;
     let lights = scene.len() as u64;

@@ -330,6 +330,37 @@ fn fifo_texture(d: &Path) {
 fn zero_texture(d: &Path) {
     dome_with(d, |p| std::os::unix::fs::symlink("/dev/zero", p).unwrap());
 }
+/// Stages whose light reads files through the stage: `layered.usda` (a sublayer `sub.usda`
+/// holding a spot with the profile `spot.ies`, whose TILT table is `spot.tilt`) and
+/// `textured.usda` (a dome whose texture is `sky.png`).
+fn read_through_the_stage(d: &Path) {
+    std::fs::write(
+        d.join("layered.usda"),
+        "#usda 1.0\n(\n    subLayers = [@sub.usda@]\n)\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("sub.usda"),
+        "#usda 1.0\ndef SphereLight \"L\" (\n    prepend apiSchemas = [\"ShapingAPI\"]\n)\n{\n    asset inputs:shaping:ies:file = @spot.ies@\n}\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("spot.ies"),
+        "IESNA:LM-63-2002\nTILT=spot.tilt\n1 -1 1 3 1 1 2 0 0 0\n1 1 100\n0 45 90\n0\n100 50 0\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("spot.tilt"), "1\n3\n0 45 90\n1 0.8 0.5\n").unwrap();
+    std::fs::write(
+        d.join("textured.usda"),
+        "#usda 1.0\ndef DomeLight \"D\"\n{\n    asset inputs:texture:file = @sky.png@\n}\n",
+    )
+    .unwrap();
+    std::fs::copy(
+        crate::repo().join("tests/data/textures/testImage.png"),
+        d.join("sky.png"),
+    )
+    .unwrap();
+}
 fn zero_dirs(d: &Path) {
     std::os::unix::fs::symlink("/dev/zero", d.join("zero.npy")).unwrap();
 }
@@ -362,6 +393,13 @@ cases! {
     output_is_input_through_hard_link: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/hard.npy", "--device", "cpu"], exit: 2, says: &["hard.npy", "--dirs"], setup: Some(hardlink_dirs), ..Case::default() };
     falloff_png_is_exr: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{out}/m.exr", "--png", "{out}/m.exr", "--device", "cpu"], exit: 2, says: &["--png", "-o", "m.exr"], ..Case::default() };
     falloff_output_is_scene: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{in}/ok.usda", "--device", "cpu"], exit: 2, says: &["SCENE", "ok.usda"], ..Case::default() };
+    // Every file a command reads through the stage is an input too: no output may name one.
+    output_is_a_sublayer: Case { args: &["emission", "{in}/layered.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/sub.usda", "--device", "cpu"], exit: 2, says: &["-o", "sub.usda", "layer of", "layered.usda"], setup: Some(read_through_the_stage), ..Case::default() };
+    output_is_the_ies_profile: Case { args: &["emission", "{in}/layered.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/spot.ies", "--device", "cpu"], exit: 2, says: &["-o", "spot.ies", "a light of", "layered.usda"], setup: Some(read_through_the_stage), ..Case::default() };
+    output_is_the_tilt_file: Case { args: &["irradiance", "{in}/layered.usda", "--points", "{in}/points.npy", "--normals", "{in}/normals.npy", "-o", "{in}/spot.tilt", "--device", "cpu"], exit: 2, says: &["-o", "spot.tilt", "a light of"], setup: Some(read_through_the_stage), ..Case::default() };
+    output_is_the_texture: Case { args: &["emission", "{in}/textured.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/sky.png", "--device", "cpu"], exit: 2, says: &["-o", "sky.png", "a light of", "textured.usda"], setup: Some(read_through_the_stage), ..Case::default() };
+    falloff_png_is_a_sublayer: Case { args: &["falloff", "{in}/layered.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{out}/m.exr", "--png", "{in}/sub.usda", "--device", "cpu"], exit: 2, says: &["--png", "sub.usda", "layer of"], setup: Some(read_through_the_stage), ..Case::default() };
+    read_through_the_stage_is_read: Case { args: &["emission", "{in}/layered.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 0, lit: true, setup: Some(read_through_the_stage), ..Case::default() };
     output_is_a_pipe: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/pipe", "--device", "cpu"], exit: 2, says: &["pipe", "not a regular file"], setup: Some(fifo), ..Case::default() };
     output_is_a_directory: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/sub", "--device", "cpu"], exit: 2, says: &["sub", "not a regular file"], setup: Some(mkdir_sub), ..Case::default() };
     output_in_missing_directory: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/no/such/dir/o.npy", "--device", "cpu"], exit: 2, says: &["{out}/no/such/dir/o.npy"], ..Case::default() };

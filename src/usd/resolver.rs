@@ -1,8 +1,9 @@
 //! The resolver every stage file is read through: openusd's filesystem resolver, refusing what
 //! is not a regular file, exceeds the size limit, or (usda text) nests braces too deep.
 
+use std::cell::RefCell;
 use std::io::{self, Read};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
 use openusd::ar;
@@ -19,6 +20,9 @@ pub(super) struct LimitedResolver {
     inner: Rc<ar::DefaultResolver>,
     max_bytes: u64,
     max_braces: u64,
+    /// Every file opened through this resolver (and its clones), each once: the files a
+    /// command reads through the stage, which no output may overwrite.
+    opened: Rc<RefCell<Vec<PathBuf>>>,
 }
 
 impl LimitedResolver {
@@ -29,7 +33,13 @@ impl LimitedResolver {
             // A prim is one level of braces; a variant set adds two and metadata dictionaries
             // a few more: twice the depth limit and some room is more than a legal stage uses.
             max_braces: limits.max_prim_depth.saturating_mul(2).saturating_add(64),
+            opened: Rc::default(),
         }
+    }
+
+    /// The files opened so far, in the order first opened.
+    pub(super) fn opened(&self) -> Vec<PathBuf> {
+        self.opened.borrow().clone()
     }
 
     /// The file (a package for a package-relative path) behind `resolved`, checked.
@@ -39,7 +49,12 @@ impl LimitedResolver {
             Some((package, _)) if ar::is_package_relative_path(text) => package,
             _ => text.to_string(),
         };
-        check_file(Path::new(&file), self.max_bytes)
+        check_file(Path::new(&file), self.max_bytes)?;
+        let mut opened = self.opened.borrow_mut();
+        if !opened.iter().any(|f| f.as_os_str() == file.as_str()) {
+            opened.push(PathBuf::from(file));
+        }
+        Ok(())
     }
 }
 

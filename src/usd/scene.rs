@@ -66,6 +66,10 @@ pub struct Stage {
     pub time: TimeRule,
     /// In stage traversal order (depth-first, USD child order).
     pub lights: Vec<StageLight>,
+    /// Every file read to compose the stage (its layers and the packages holding them), the
+    /// root layer first: what a command must never write over (DESIGN.md §4).
+    #[serde(skip)]
+    pub files_read: Vec<PathBuf>,
 }
 
 impl std::fmt::Display for TimeRule {
@@ -192,6 +196,7 @@ impl UsdStage {
             meters_per_unit: info.meters_per_unit,
             time: rule,
             lights,
+            files_read: self.files_read().to_vec(),
         })
     }
 }
@@ -302,6 +307,7 @@ mod tests {
                 StageLight::from_prim(prim("PortalLight", &[]), UpAxis::Y),
                 hidden,
             ],
+            files_read: vec!["x.usda".into()],
         };
         let all = scene.evaluable(&[]).unwrap();
         assert_eq!(all.len(), 1);

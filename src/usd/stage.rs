@@ -105,6 +105,8 @@ struct LightSite {
 /// An open stage and its light prims.
 pub struct UsdStage {
     file: PathBuf,
+    /// Every file read to compose it (layers, the packages holding them), the root first.
+    files: Vec<PathBuf>,
     info: StageInfo,
     lights: Vec<LightSite>,
     // Keeps the composed stage alive for the prim handles above.
@@ -158,7 +160,7 @@ impl UsdStage {
         let resolver = LimitedResolver::new(&limits);
         preflight(path, &resolver, &limits)?;
         let stage = ousd::Stage::builder()
-            .registry(openusd::sdf::LayerRegistry::new(Box::new(resolver)))
+            .registry(openusd::sdf::LayerRegistry::new(Box::new(resolver.clone())))
             .schema_registry(openusd_schemas::schema_registry())
             .load(ousd::InitialLoadSet::LoadAll)
             .open(name)
@@ -278,12 +280,23 @@ impl UsdStage {
         }
         // Reading attributes can compose more (e.g. the prims an inherit arc names).
         check_composition(path, &stage)?;
+        let mut files = resolver.opened();
+        if !files.iter().any(|f| f == path) {
+            files.insert(0, path.to_path_buf());
+        }
         Ok(UsdStage {
             file: path.to_path_buf(),
+            files,
             info,
             lights,
             _stage: stage,
         })
+    }
+
+    /// Every file read to compose the stage (its layers, and the packages holding them), the
+    /// root layer first: what a command must never write over (DESIGN.md §4).
+    pub fn files_read(&self) -> &[PathBuf] {
+        &self.files
     }
 
     pub fn info(&self) -> &StageInfo {
