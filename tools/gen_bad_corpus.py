@@ -233,4 +233,11 @@ for name, extra in [("ies_huge.usda", ""), ("ies_huge_normalized.usda", "    boo
     text(name, '\ndef SphereLight "L" (\n    prepend apiSchemas = ["ShapingAPI"]\n)\n{\n'
          f"    asset inputs:shaping:ies:file = @ies_huge.ies@\n{extra}}}\n")
 
+# Texture tokens the schema does not allow: the queries refuse the dome (exit 2) naming the prim
+# and the attribute, instead of skipping it.
+text("dome_bad_format.usda", '\ndef DomeLight "D"\n{\n    asset inputs:texture:file = @sky.exr@\n'
+     '    token inputs:texture:format = "cube"\n}\n')
+text("dome1_bad_pole_axis.usda", '\ndef DomeLight_1 "D"\n{\n    asset inputs:texture:file = @sky.exr@\n'
+     '    uniform token poleAxis = "X"\n}\n')
+
 print(len(os.listdir(OUT)), "files in", os.path.normpath(OUT))

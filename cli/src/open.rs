@@ -21,7 +21,10 @@ fn lights_and_layers(args: &SceneArgs) -> CliResult<(Vec<Light>, Vec<PathBuf>)> 
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
-    let mut lights = scene.evaluable(&args.lights)?;
+    let mut lights = scene.evaluable(&args.lights).map_err(|e| match e {
+        e @ LuxError::InvalidAttribute { .. } => in_scene(&args.scene, e),
+        e => e.into(),
+    })?;
     for l in &mut lights {
         l.validate().map_err(|e| in_scene(&args.scene, e))?;
         if let Some(t) = &mut l.texture {

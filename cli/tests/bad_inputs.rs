@@ -393,6 +393,9 @@ cases! {
     output_is_input_through_hard_link: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/hard.npy", "--device", "cpu"], exit: 2, says: &["hard.npy", "--dirs"], setup: Some(hardlink_dirs), ..Case::default() };
     falloff_png_is_exr: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{out}/m.exr", "--png", "{out}/m.exr", "--device", "cpu"], exit: 2, says: &["--png", "-o", "m.exr"], ..Case::default() };
     falloff_output_is_scene: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,4", "-o", "{in}/ok.usda", "--device", "cpu"], exit: 2, says: &["SCENE", "ok.usda"], ..Case::default() };
+    // A token the schema does not allow refuses the light (it was skipped with exit 0).
+    dome_texture_format_not_a_schema_token: Case { args: emission!("{in}/dome_bad_format.usda", "{in}/dirs.npy"), exit: 2, says: &["dome_bad_format.usda", "/D", "inputs:texture:format", "cube"], ..Case::default() };
+    dome1_pole_axis_not_a_schema_token: Case { args: emission!("{in}/dome1_bad_pole_axis.usda", "{in}/dirs.npy"), exit: 2, says: &["dome1_bad_pole_axis.usda", "/D", "poleAxis", "\"X\""], ..Case::default() };
     // Every file a command reads through the stage is an input too: no output may name one.
     output_is_a_sublayer: Case { args: &["emission", "{in}/layered.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/sub.usda", "--device", "cpu"], exit: 2, says: &["-o", "sub.usda", "layer of", "layered.usda"], setup: Some(read_through_the_stage), ..Case::default() };
     output_is_the_ies_profile: Case { args: &["emission", "{in}/layered.usda", "--dirs", "{in}/dirs.npy", "-o", "{in}/spot.ies", "--device", "cpu"], exit: 2, says: &["-o", "spot.ies", "a light of", "layered.usda"], setup: Some(read_through_the_stage), ..Case::default() };

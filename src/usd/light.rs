@@ -67,16 +67,49 @@ impl Reader<'_> {
     }
 }
 
+/// Why a light prim is not evaluated.
+#[derive(Debug)]
+pub(super) enum NotEvaluated {
+    /// luxeval does not evaluate it (yet): listed with this warning, skipped by the queries.
+    Skipped(String),
+    /// An input holds a value the schema does not allow: listed with a warning, and refused by
+    /// every query that would evaluate it (exit 2), naming the prim and the attribute.
+    Refused(RefusedInput),
+}
+
+/// An input value a query refuses: the attribute, its value as authored, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefusedInput {
+    pub attr: String,
+    pub value: String,
+    pub reason: String,
+}
+
+impl std::fmt::Display for NotEvaluated {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NotEvaluated::Skipped(why) => f.write_str(why),
+            NotEvaluated::Refused(r) => write!(f, "{} = {}: {}", r.attr, r.value, r.reason),
+        }
+    }
+}
+
+impl From<String> for NotEvaluated {
+    fn from(why: String) -> Self {
+        NotEvaluated::Skipped(why)
+    }
+}
+
 /// The light luxeval evaluates for `p`, with an optional caveat; or why it is not evaluated.
 pub(super) fn convert(
     p: &usd::LightPrim,
     up: UpAxis,
-) -> std::result::Result<(Light, Option<String>), String> {
+) -> std::result::Result<(Light, Option<String>), NotEvaluated> {
     let r = Reader { p };
     let path = &p.path;
     let ty = p.usd_type.as_str();
     if let Some(why) = &p.transform_error {
-        return Err(why.clone());
+        return Err(why.clone().into());
     }
     if let Some(api) = &p.light_api
         && api == "LightAPI"
@@ -88,16 +121,15 @@ pub(super) fn convert(
         return Err(format!(
             "{path}: LightAPI is applied to {on}, which is not a UsdLux light type; \
              luxeval does not evaluate it"
-        ));
+        )
+        .into());
     }
     if let Some(api) = &p.light_api {
         let on = match ty {
             "" => "an untyped prim".to_string(),
             ty => format!("a {ty} prim"),
         };
-        return Err(format!(
-            "{path}: {api} lights (on {on}) are not supported yet"
-        ));
+        return Err(format!("{path}: {api} lights (on {on}) are not supported yet").into());
     }
     let kind = match ty {
         "DistantLight" => LightType::Distant {
@@ -123,19 +155,21 @@ pub(super) fn convert(
         "PortalLight" => {
             return Err(format!(
                 "{path}: PortalLight is not supported yet (it shapes a dome light's emission)"
-            ));
+            )
+            .into());
         }
         "GeometryLight" => {
             return Err(format!(
                 "{path}: GeometryLight is not supported (deprecated schema; use MeshLightAPI)"
-            ));
+            )
+            .into());
         }
         "PluginLight" => {
             return Err(format!(
                 "{path}: PluginLight is not supported (its emission is defined by a renderer plugin)"
-            ));
+            ).into());
         }
-        other => return Err(format!("{path}: {other} is not a light type luxeval knows")),
+        other => return Err(format!("{path}: {other} is not a light type luxeval knows").into()),
     };
     let texture = match ty {
         "RectLight" | "DomeLight" | "DomeLight_1" => texture(&r, ty)?,
@@ -182,29 +216,34 @@ pub(super) fn convert(
 
 /// `inputs:texture:file`, `inputs:texture:format` (domes) and `poleAxis` (DomeLight_1), where
 /// `texture:file` is authored (an empty asset path is no texture).
-fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, String> {
+fn texture(r: &Reader, ty: &str) -> std::result::Result<Option<Texture>, NotEvaluated> {
     let Some(file) = r.asset_ref("inputs:texture:file") else {
         return Ok(None);
     };
     let mut t = Texture::new(file);
+    // A token the schema does not allow is refused, never read as the fallback.
+    let refused = |attr: &str, token: &str, allowed: &str| {
+        NotEvaluated::Refused(RefusedInput {
+            attr: attr.to_string(),
+            value: format!("{token:?}"),
+            reason: format!("not one of {allowed}"),
+        })
+    };
     if ty != "RectLight" {
         let token = r.token("inputs:texture:format")?;
         t.format = TextureFormat::from_token(token).ok_or_else(|| {
-            format!(
-                "{}: inputs:texture:format = {token:?} is not one of automatic, latlong, \
-                 mirroredBall, angular, cubeMapVerticalCross",
-                r.p.path
+            refused(
+                "inputs:texture:format",
+                token,
+                "automatic, latlong, mirroredBall, angular, cubeMapVerticalCross",
             )
         })?;
     }
     if ty == "DomeLight_1" {
         let token = r.token("poleAxis")?;
-        t.pole_axis = Some(PoleAxis::from_token(token).ok_or_else(|| {
-            format!(
-                "{}: poleAxis = {token:?} is not one of scene, Y, Z",
-                r.p.path
-            )
-        })?);
+        t.pole_axis = Some(
+            PoleAxis::from_token(token).ok_or_else(|| refused("poleAxis", token, "scene, Y, Z"))?,
+        );
     }
     Ok(Some(t))
 }
@@ -331,12 +370,12 @@ pub(super) mod tests {
         assert!(convert(&empty, UpAxis::Y).is_ok());
 
         for ty in ["PortalLight", "GeometryLight", "PluginLight"] {
-            let e = convert(&prim(ty, &[]), UpAxis::Y).unwrap_err();
+            let e = convert(&prim(ty, &[]), UpAxis::Y).unwrap_err().to_string();
             assert!(e.contains(ty) && e.contains("/Lights/"), "{e}");
         }
         let mut mesh = prim("Mesh", &["MeshLightAPI"]);
         mesh.light_api = Some("MeshLightAPI".into());
-        let e = convert(&mesh, UpAxis::Y).unwrap_err();
+        let e = convert(&mesh, UpAxis::Y).unwrap_err().to_string();
         assert!(e.contains("MeshLightAPI"), "{e}");
     }
 
@@ -380,16 +419,20 @@ pub(super) mod tests {
         set(&mut rect, "inputs:texture:file", asset());
         let t = texture(&Reader { p: &rect }, "RectLight").unwrap().unwrap();
         assert_eq!((t.format, t.pole_axis), (TextureFormat::Automatic, None));
-        // A token outside the schema's list names the prim and the attribute.
+        // A token outside the schema's list is refused (not skipped), naming the attribute.
         set(&mut d, "inputs:texture:format", Value::Token("cube".into()));
-        let e = texture(&Reader { p: &d }, "DomeLight").unwrap_err();
-        assert!(
-            e.contains("/Lights/DomeLight") && e.contains("texture:format"),
-            "{e}"
+        let Err(NotEvaluated::Refused(r)) = texture(&Reader { p: &d }, "DomeLight") else {
+            panic!("an unknown texture:format must be refused");
+        };
+        assert_eq!(
+            (r.attr.as_str(), r.value.as_str()),
+            ("inputs:texture:format", "\"cube\"")
         );
         set(&mut d1, "poleAxis", Value::Token("X".into()));
-        let e = texture(&Reader { p: &d1 }, "DomeLight_1").unwrap_err();
-        assert!(e.contains("poleAxis"), "{e}");
+        let Err(NotEvaluated::Refused(r)) = texture(&Reader { p: &d1 }, "DomeLight_1") else {
+            panic!("an unknown poleAxis must be refused");
+        };
+        assert_eq!(r.attr, "poleAxis");
         // A textured RectLight is evaluated, not skipped.
         assert!(convert(&rect, UpAxis::Y).unwrap().0.texture.is_some());
     }

@@ -29,5 +29,6 @@ pub(crate) mod stage;
 mod values;
 mod xform;
 
+pub use light::RefusedInput;
 pub use scene::{Stage, StageLight, TimeRule};
 pub use stage::{StageInfo, UsdStage};

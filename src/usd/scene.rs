@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::light::convert;
+use super::light::{NotEvaluated, RefusedInput, convert};
 use super::stage::{self as usd, UsdStage};
 use crate::error::{LuxError, Result};
 use crate::model::{Input, Light, UpAxis};
@@ -46,6 +46,10 @@ pub struct StageLight {
     pub light: Option<Light>,
     /// Why the light is not evaluated, or a caveat about how it is; names the prim.
     pub warning: Option<String>,
+    /// An input value the schema does not allow (a `texture:format` or `poleAxis` token): the
+    /// queries refuse the light (exit 2), naming the prim and the attribute, rather than skip it.
+    #[serde(skip)]
+    pub refusal: Option<RefusedInput>,
 }
 
 fn serialize_is_some<S: serde::Serializer>(
@@ -127,13 +131,16 @@ impl Stage {
                 ));
             }
         }
-        Ok(self
-            .lights
-            .iter()
-            .filter(|l| select.is_empty() || select.contains(&l.path))
-            .filter(|l| l.visible)
-            .filter_map(|l| l.light.clone())
-            .collect())
+        let selected = || {
+            self.lights
+                .iter()
+                .filter(|l| select.is_empty() || select.contains(&l.path))
+                .filter(|l| l.visible)
+        };
+        if let Some((l, r)) = selected().find_map(|l| Some((l, l.refusal.as_ref()?))) {
+            return Err(LuxError::attr(&l.path, &r.attr, &r.value, r.reason.clone()));
+        }
+        Ok(selected().filter_map(|l| l.light.clone()).collect())
     }
 
     /// One line per light that is listed but skipped by the queries (unsupported type or
@@ -265,9 +272,17 @@ fn describe_time(rule: TimeRule) -> String {
 
 impl StageLight {
     fn from_prim(p: usd::LightPrim, up: UpAxis) -> StageLight {
-        let (light, warning) = match convert(&p, up) {
-            Ok((light, caveat)) => (Some(light), caveat),
-            Err(why) => (None, Some(why)),
+        let (light, warning, refusal) = match convert(&p, up) {
+            Ok((light, caveat)) => (Some(light), caveat, None),
+            Err(NotEvaluated::Skipped(why)) => (None, Some(why), None),
+            Err(NotEvaluated::Refused(r)) => (
+                None,
+                Some(format!(
+                    "{}: {} = {}: {}; the queries refuse this light",
+                    p.path, r.attr, r.value, r.reason
+                )),
+                Some(r),
+            ),
         };
         StageLight {
             path: p.path,
@@ -278,6 +293,7 @@ impl StageLight {
             inputs: p.inputs,
             light,
             warning,
+            refusal,
         }
     }
 
