@@ -233,6 +233,16 @@ for name, extra in [("ies_huge.usda", ""), ("ies_huge_normalized.usda", "    boo
     text(name, '\ndef SphereLight "L" (\n    prepend apiSchemas = ["ShapingAPI"]\n)\n{\n'
          f"    asset inputs:shaping:ies:file = @ies_huge.ies@\n{extra}}}\n")
 
+# Zero-size lights beside an ordinary one (DESIGN.md §2): a disk scaled flat by an animator and a
+# DCC's point light (a radius-0 treatAsPoint sphere with normalize): both evaluated with a
+# warning, never refusing the stage.
+text("zero_size_beside_others.usda",
+     '\ndef DiskLight "Hidden"\n{\n    float3 xformOp:scale = (1, 0, 1)\n'
+     '    uniform token[] xformOpOrder = ["xformOp:scale"]\n}\n'
+     '\ndef SphereLight "Point"\n{\n    bool inputs:normalize = 1\n    float inputs:radius = 0\n'
+     '    float inputs:intensity = 8\n    bool treatAsPoint = 1\n}\n'
+     '\ndef RectLight "Key"\n{\n    float inputs:intensity = 5\n}\n')
+
 # Texture tokens the schema does not allow: the queries refuse the dome (exit 2) naming the prim
 # and the attribute, instead of skipping it.
 text("dome_bad_format.usda", '\ndef DomeLight "D"\n{\n    asset inputs:texture:file = @sky.exr@\n'

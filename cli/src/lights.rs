@@ -11,12 +11,12 @@ use crate::exit::{CliResult, Failure};
 /// `Ok(None)` for lights at infinity (distant, dome) or not evaluated; `Err` when the light
 /// cannot be prepared (a missing IES file, ...). The JSON records get the same from
 /// `luxeval::lights_json`.
-fn power(l: &StageLight) -> Result<Option<Power>, String> {
+fn power(l: &StageLight) -> Result<(Option<Power>, Option<String>), String> {
     let Some(light) = &l.light else {
-        return Ok(None);
+        return Ok((None, None));
     };
     let r = Reference::new(light, TemperatureMode::default()).map_err(|e| e.to_string())?;
-    Ok(r.power())
+    Ok((r.power(), r.warning().map(str::to_string)))
 }
 
 pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
@@ -48,7 +48,11 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
         if let Some(w) = &l.warning {
             outln!("  warning: {w}");
         }
-        match power(l) {
+        let power = power(l);
+        if let Ok((_, Some(w))) = &power {
+            outln!("  warning: {w}");
+        }
+        match power.map(|(p, _)| p) {
             Ok(Some(p)) => outln!(
                 "  power  {:.6} lm ({:.6} W at 683 lm/W; RGB flux ({:.6}, {:.6}, {:.6}))",
                 p.lumens,

@@ -485,9 +485,11 @@ cases! {
     time_argument_nan: Case { args: &["lights", "{in}/ok.usda", "--time", "nan"], exit: 2, says: &["--time"], ..Case::default() };
 
     // --- Messages name the file (and prim, attribute or row) ------------------------------------
-    zero_size_light_with_normalize: Case { args: emission!("{in}/zero_size_normalize.usda", "{in}/dirs.npy"), exit: 2, says: &["zero_size_normalize.usda", "/L", "inputs:normalize"], ..Case::default() };
+    // DESIGN.md §2 "Zero-size lights": evaluated with a warning, never refused.
+    zero_size_light_with_normalize_is_a_point: Case { args: emission!("{in}/zero_size_normalize.usda", "{in}/dirs.npy"), exit: 0, lit: true, says: &["warning: /L", "point"], ..Case::default() };
+    zero_size_lights_beside_others: Case { args: &["irradiance", "{in}/zero_size_beside_others.usda", "--points", "{in}/points.npy", "--normals", "{in}/normals.npy", "-o", "{out}/out.npy", "--per-light", "--device", "cpu"], exit: 0, lit: true, says: &["warning: /Hidden", "emits nothing", "warning: /Point", "point"], ..Case::default() };
     negative_radius: Case { args: emission!("{in}/negative_radius.usda", "{in}/dirs.npy"), exit: 2, says: &["negative_radius.usda", "/L", "inputs:radius"], ..Case::default() };
-    singular_transform: Case { args: emission!("{in}/singular_scale.usda", "{in}/dirs.npy"), exit: 2, says: &["singular_scale.usda", "/L", "singular"], ..Case::default() };
+    singular_transform_emits_nothing: Case { args: emission!("{in}/singular_scale.usda", "{in}/dirs.npy"), exit: 0, says: &["warning: /L", "singular", "emits nothing"], ..Case::default() };
     dirs_row_nan: Case { args: emission!("{in}/ok.usda", "{in}/dirs_nan.npy"), exit: 2, says: &["dirs_nan.npy", "row 2", "not finite"], ..Case::default() };
     dirs_row_zero: Case { args: emission!("{in}/ok.usda", "{in}/dirs_zero_row.npy"), exit: 2, says: &["dirs_zero_row.npy", "row 1", "zero"], ..Case::default() };
     points_row_inf: Case { args: &["irradiance", "{in}/ok.usda", "--points", "{in}/points_inf.npy", "--normals", "{in}/normals.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["points_inf.npy", "row 0"], ..Case::default() };

@@ -474,16 +474,27 @@ impl Light {
                 reason: format!("is not affine (last column {last_col:?}, expected [0, 0, 0, 1])"),
             });
         }
-        let a = self.linear();
-        let det = a.determinant();
-        let scale = a.x_axis.length() * a.y_axis.length() * a.z_axis.length();
-        if !(det.abs() > 1e-12 * scale) || scale == 0.0 {
+        // A singular map flattens an area light to zero size, which DESIGN.md §2 "Zero-size
+        // lights" evaluates (prepare::zero_size) instead of refusing; the other types need their
+        // frame.
+        let sized = !matches!(self.kind, LightType::Distant { .. } | LightType::Dome);
+        if !sized && self.is_singular() {
+            let det = self.linear().determinant();
             return Err(LuxError::InvalidTransform {
                 light: self.path.clone(),
                 reason: format!("is singular (determinant {det:e})"),
             });
         }
         Ok(())
+    }
+
+    /// Whether the world transform's linear part is singular: `|det| ≤ 1e-12 ·` the product
+    /// of its column lengths (docs/INPUTS.md), or a column is zero.
+    pub fn is_singular(&self) -> bool {
+        let a = self.linear();
+        let det = a.determinant();
+        let scale = a.x_axis.length() * a.y_axis.length() * a.z_axis.length();
+        !(det.abs() > 1e-12 * scale) || scale == 0.0
     }
 
     /// The linear part of the world transform (columns: images of local X, Y, Z).

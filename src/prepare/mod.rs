@@ -12,6 +12,7 @@ pub mod ies_kinks;
 pub mod normalize;
 pub mod profile;
 pub mod texture;
+pub mod zero_size;
 
 use std::sync::Arc;
 
@@ -103,6 +104,9 @@ pub struct Prepared {
     /// The files on disk its assets were read from (IES profile, TILT file, texture, or the
     /// package holding them), so that no output is written over one of them.
     pub files_read: Vec<std::path::PathBuf>,
+    /// How the light is evaluated other than as authored, naming the prim (a zero-size light,
+    /// [`zero_size`]).
+    pub warning: Option<String>,
 }
 
 /// What one kind of light carries beyond the shared frame, base radiance and shaping of
@@ -192,6 +196,12 @@ impl Prepared {
         cache: &mut AssetCache,
     ) -> Result<Self> {
         light.validate()?;
+        // DESIGN.md §2 "Zero-size lights": evaluated in their place, never refused.
+        let substituted = zero_size::substitute(light);
+        let (light, warning) = match &substituted {
+            Some((substitute, warning)) => (substitute, Some(warning.clone())),
+            None => (light, None),
+        };
         let linear = light.linear();
         let to_local = linear.inverse();
         let size_factor = normalize::size_factor(light);
@@ -308,6 +318,7 @@ impl Prepared {
             files_read.extend(cache.files(&t.file));
         }
         Ok(Prepared {
+            warning,
             files_read,
             base,
             size_factor,

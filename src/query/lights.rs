@@ -16,7 +16,12 @@ pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
             json["power"] = serde_json::Value::Null;
             let Some(light) = &l.light else { continue };
             match Reference::new(light, TemperatureMode::default()) {
-                Ok(r) => json["power"] = serde_json::to_value(r.power())?,
+                Ok(r) => {
+                    json["power"] = serde_json::to_value(r.power())?;
+                    if let (Some(w), true) = (r.warning(), json["warning"].is_null()) {
+                        json["warning"] = w.into();
+                    }
+                }
                 Err(e) => json["power_error"] = e.to_string().into(),
             }
         }

@@ -22,6 +22,12 @@ impl Reference {
         })
     }
 
+    /// How the light is evaluated other than as authored, naming the prim: a zero-size light
+    /// (DESIGN.md §2) is a point or emits nothing.
+    pub fn warning(&self) -> Option<&str> {
+        self.p.warning.as_deref()
+    }
+
     /// The light as evaluated (a ShapingAPI whose factor is 1 everywhere is dropped).
     pub fn light(&self) -> &Light {
         &self.p.light

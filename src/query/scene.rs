@@ -54,7 +54,8 @@ impl PreparedScene {
     /// A scene of lights already prepared (the GPU records are packed from exactly these
     /// constants).
     pub(crate) fn from_prepared(backend: Backend, lights: Vec<Prepared>) -> Result<Self> {
-        let mut warnings = Vec::new();
+        // How lights are evaluated other than as authored (zero-size lights), on every device.
+        let mut warnings: Vec<String> = lights.iter().filter_map(|p| p.warning.clone()).collect();
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
