@@ -549,11 +549,15 @@ mod tests {
         );
         let e = Light::rect(1.0, -2.0).validate().unwrap_err().to_string();
         assert!(e.contains("inputs:height"), "{e}");
-        let e = Light::disk(1.0)
-            .with_transform(DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0)))
+        // A singular transform leaves a distant light without a direction: refused.
+        let e = Light::distant(0.5)
+            .with_transform(DMat4::from_scale(DVec3::new(1.0, 1.0, 0.0)))
             .validate()
             .unwrap_err()
             .to_string();
         assert!(e.contains("singular"), "{e}");
+        // A disk scaled flat is a zero-size light (DESIGN.md §2), evaluated by prepare.
+        let flat = Light::disk(1.0).with_transform(DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0)));
+        assert!(flat.validate().is_ok() && flat.is_singular());
     }
 }
