@@ -43,8 +43,11 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
         range,
         contours: flags & 2 != 0,
     };
-    let sized = check_size(w, h);
+    // Any size through the check alone (no panic, no overflow)...
+    let _ = check_size(w, h);
+    // ...and rendered sizes through both.
     let (w, h) = (w.clamp(1, 1 << 14), h.clamp(1, 1 << 14));
+    let sized = check_size(w, h);
     if u64::from(w) * u64::from(h) > MAX_RENDERED {
         return;
     }

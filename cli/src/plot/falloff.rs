@@ -63,9 +63,11 @@ fn zoom(width: u32, height: u32) -> u32 {
 /// (a very elongated map: the colour bar and captions add a frame to both sides), before the
 /// map is evaluated.
 pub fn check_size(width: u32, height: u32) -> Result<()> {
-    let z = u64::from(zoom(width, height));
-    let pixels = (u64::from(width) * z + FRAME_W) * (u64::from(height) * z + FRAME_H);
-    if pixels > MAX_PNG_PIXELS {
+    // In u128: any two u32 sides, enlarged and framed, multiply without overflow.
+    let z = u128::from(zoom(width, height));
+    let pixels = (u128::from(width) * z + u128::from(FRAME_W))
+        * (u128::from(height) * z + u128::from(FRAME_H));
+    if pixels > u128::from(MAX_PNG_PIXELS) {
         return Err(LuxError::input(
             "--png",
             format!(
@@ -316,6 +318,15 @@ pub fn write(path: &Path, r: &Rendered) -> Result<()> {
 mod tests {
     use super::*;
     use glam::DVec3;
+
+    /// Any two sides, however large, are checked without overflow (found by fuzz/falloff_png).
+    #[test]
+    fn the_size_check_takes_any_sides() {
+        assert!(check_size(u32::MAX, u32::MAX).is_err());
+        assert!(check_size(u32::MAX, 1).is_err());
+        assert!(check_size(33_818_560, 1).is_err());
+        assert!(check_size(1024, 1024).is_ok());
+    }
 
     #[test]
     fn auto_range_spans_three_decades() {
