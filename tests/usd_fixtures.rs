@@ -232,6 +232,15 @@ fn composition_usdz_matches_usd_core() {
     check_scene("composition_rig_packaged_usdz");
 }
 
+/// A light inherits the transform of every Xformable ancestor, whatever its type (SkelRoot,
+/// Skeleton, Volume, SpatialAudio, GenerativeProcedural), and none from prims that are not
+/// Xformable (an untyped prim, a Scope), at every time, as usd-core computes it (it once got an
+/// identity matrix under SkelRoot, Skeleton and Volume, silently).
+#[test]
+fn ancestors_of_every_xformable_type_match_usd_core() {
+    check_scene("ancestors");
+}
+
 /// The same scene as text, as Pixar's binary crate and packed in a usdz resolves to the same
 /// lights; only asset paths differ, the usdz's resolving inside the package.
 #[test]

@@ -869,11 +869,105 @@ def dump(scene_rel, out_name, times):
 
 COMPOSITION_TIMES = [-1, 0, 1, 1.5, 2, 2.25, 3, 4.5, 7, 10]
 
+# Lights under every kind of Xformable ancestor (usd-core composes each one's xformOps into the
+# world matrix) and under prims that are not Xformable (an untyped prim, a Scope: their ops are
+# ignored). A time-sampled op checks that ancestors are read at the query time too.
+ANCESTORS_USDA = """#usda 1.0
+(
+    startTimeCode = 0
+    endTimeCode = 2
+)
+
+def SkelRoot "Rig"
+{
+    double3 xformOp:translate = (0, 5, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def Skeleton "Skel"
+    {
+        float xformOp:rotateY.timeSamples = {
+            0: 0,
+            2: 90,
+        }
+        double3 xformOp:translate = (1, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateY"]
+
+        def RectLight "Key"
+        {
+            double3 xformOp:translate = (0, 0, 1)
+            uniform token[] xformOpOrder = ["xformOp:translate"]
+        }
+    }
+}
+
+def Volume "Cloud"
+{
+    float3 xformOp:scale = (2, 2, 2)
+    double3 xformOp:translate = (0, 0, 3)
+    uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:scale"]
+
+    def SphereLight "Glow"
+    {
+    }
+}
+
+def SpatialAudio "Speaker"
+{
+    double3 xformOp:translate = (4, 0, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def DiskLight "Led"
+    {
+    }
+}
+
+def GenerativeProcedural "Proc"
+{
+    double3 xformOp:translate = (0, -2, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def SphereLight "Spark"
+    {
+    }
+}
+
+def "Untyped"
+{
+    double3 xformOp:translate = (0, 7, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def SphereLight "Loose"
+    {
+    }
+}
+
+def Scope "Group"
+{
+    double3 xformOp:translate = (0, 9, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def SphereLight "Scoped"
+    {
+    }
+}
+"""
+
+
+def write_ancestors():
+    write(os.path.join(DATA, "usd", "ancestors", "ancestors.usda"), ANCESTORS_USDA.encode("ascii"))
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--luxtest-src", default="/work/shared/data/luxtest", help="the research/data/luxtest copy")
+    ap.add_argument("--only-ancestors", action="store_true",
+                    help="write and dump only the ancestor-transform fixture (leaves the others as they are)")
     args = ap.parse_args()
+
+    if args.only_ancestors:
+        write_ancestors()
+        dump("usd/ancestors/ancestors.usda", "ancestors", [0, 1, 2])
+        return
 
     copy_luxtest(args.luxtest_src)
     write_composition()
@@ -889,6 +983,8 @@ def main():
         dump(f"usd/composition/root.{ext}", f"composition_root_{ext}", COMPOSITION_TIMES)
     dump("usd/composition/scene.usdz", "composition_scene_usdz", COMPOSITION_TIMES)
     dump("usd/composition/rig_packaged.usdz", "composition_rig_packaged_usdz", COMPOSITION_TIMES)
+    write_ancestors()
+    dump("usd/ancestors/ancestors.usda", "ancestors", [0, 1, 2])
 
 
 if __name__ == "__main__":
