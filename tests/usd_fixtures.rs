@@ -652,3 +652,27 @@ fn ies_bytes_survive() {
         assert!(lf > 0 && lf == crlf, "{name}: {lf} LF, {crlf} CRLF");
     }
 }
+
+/// An input of another light schema authored on a light whose schema lacks it (a texture on a
+/// SphereLight) is not read, and `lights` says so instead of ignoring it without a word; a
+/// renderer's own namespaced input is not the schema table's and passes silently.
+#[test]
+fn inputs_a_light_type_does_not_have_are_said_out_loud() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("stray.usda");
+    std::fs::write(
+        &path,
+        "#usda 1.0\ndef SphereLight \"L\"\n{\n    asset inputs:texture:file = @sky.exr@\n    \
+         float inputs:karma:spread = 2\n}\n",
+    )
+    .unwrap();
+    let stage = Stage::load(&path, None).unwrap();
+    let l = &stage.lights[0];
+    assert!(l.light.is_some(), "the light is still evaluated");
+    let w = l.warning.as_deref().unwrap_or_default();
+    assert!(
+        w.starts_with("/L") && w.contains("inputs:texture:file") && w.contains("SphereLight"),
+        "{w}"
+    );
+    assert!(!w.contains("karma"), "{w}");
+}

@@ -205,8 +205,19 @@ pub(super) fn convert(
     } else {
         None
     };
-    let caveat = (shaped && !kind.is_shapeable())
-        .then(|| format!("{path}: ShapingAPI has no effect on a {ty} (DESIGN.md §2), ignored"));
+    let mut caveats: Vec<String> = Vec::new();
+    if shaped && !kind.is_shapeable() {
+        caveats.push(format!(
+            "{path}: ShapingAPI has no effect on a {ty} (DESIGN.md §2), ignored"
+        ));
+    }
+    if !p.stray_inputs.is_empty() {
+        caveats.push(format!(
+            "{path}: {} authored, but a {ty} has no such input; ignored",
+            p.stray_inputs.join(", ")
+        ));
+    }
+    let caveat = (!caveats.is_empty()).then(|| caveats.join("; "));
     let mut light = Light::new(kind).with_path(path.clone());
     light.inputs = inputs;
     light.shaping = shaping;
@@ -277,6 +288,7 @@ pub(super) mod tests {
                 [1.0, 2.0, 3.0, 1.0],
             ],
             inputs,
+            stray_inputs: Vec::new(),
         }
     }
 

@@ -87,6 +87,9 @@ pub(crate) struct LightPrim {
     pub transform_error: Option<String>,
     /// Every attribute of `schema::attrs_for(usd_type, applied_schemas)`, in that order.
     pub inputs: Vec<Input>,
+    /// Authored inputs of another light schema that this light's schema does not have (e.g.
+    /// `inputs:texture:file` on a SphereLight): not read, and said so.
+    pub stray_inputs: Vec<String>,
 }
 
 /// What does not change with time: found once at open.
@@ -97,6 +100,8 @@ struct LightSite {
     applied_schemas: Vec<String>,
     light_api: Option<String>,
     attrs: Vec<schema::SchemaAttr>,
+    /// See [`LightPrim::stray_inputs`].
+    stray_inputs: Vec<String>,
     /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
     /// usd-core between samples (see [`needs_own_xform`]); its world matrix is composed here.
     own_xform_chain: bool,
@@ -246,6 +251,19 @@ impl UsdStage {
             for a in &attrs {
                 reject_spline(&p, &prim.attribute(a.name))?;
             }
+            // Inputs of the schema table that this light's schema lacks (a renderer's own
+            // namespaced inputs are not the table's, so they pass without a word).
+            let stray_inputs: Vec<String> = prim
+                .authored_property_names()
+                .map_err(e)?
+                .iter()
+                .map(|t| t.as_str())
+                .filter(|n| {
+                    schema::TABLE.iter().any(|a| a.name == *n)
+                        && !attrs.iter().any(|a| a.name == *n)
+                })
+                .map(str::to_string)
+                .collect();
             let mut own_xform_chain = false;
             let mut cur = Some(prim.clone());
             while let Some(q) = cur.filter(|q| !q.path().is_abs_root()) {
@@ -275,6 +293,7 @@ impl UsdStage {
                 applied_schemas,
                 light_api,
                 attrs,
+                stray_inputs,
                 own_xform_chain,
             });
         }
@@ -345,6 +364,7 @@ impl UsdStage {
                 world,
                 transform_error,
                 inputs,
+                stray_inputs: site.stray_inputs.clone(),
             });
         }
         Ok(out)
