@@ -70,13 +70,14 @@ impl RowKind {
     pub fn check_f32(self, start: u64, rows: &[[f32; 3]]) -> Result<(), BadRow> {
         match rows
             .par_iter()
-            .position_first(|r| self.problem_f32(r).is_some())
+            .enumerate()
+            .find_map_first(|(i, r)| Some((i, self.problem_f32(r)?)))
         {
             None => Ok(()),
-            Some(i) => Err(BadRow {
+            Some((i, problem)) => Err(BadRow {
                 row: start + i as u64,
                 values: format!("{:?}", rows[i]),
-                problem: self.problem_f32(&rows[i]).expect("found above"),
+                problem,
             }),
         }
     }

@@ -28,6 +28,10 @@ pub fn run(a: &IesArgs) -> CliResult {
         crate::io::check_outputs(&[("--png", png)], &[("FILE", &a.file)])?;
     }
     let file = luxeval::read_ies(&a.file).map_err(|e| Failure::bad_input(e.to_string()))?;
+    // The TILT file the profile names is read too: the plot must not overwrite it.
+    if let (Some(png), Some(tilt)) = (&a.png, file.tilt_file(&a.file)) {
+        crate::io::check_outputs(&[("--png", png)], &[("the TILT file of FILE", &tilt)])?;
+    }
     let profile = Profile::new(&file)
         .map_err(|e| Failure::bad_input(format!("{}: {e}", a.file.display())))?;
     let report = Report::new(&a.file, &file, &profile);

@@ -287,10 +287,17 @@ impl Prepared {
                 },
             },
             _ => {
+                // A texture on any other type is refused rather than evaluated as if untextured.
                 if let Some(t) = &light.texture {
-                    // A texture on any other type is refused rather than evaluated as if
-                    // untextured.
-                    prepare_texture(light, t, linear, cache)?;
+                    return Err(LuxError::attr(
+                        &light.path,
+                        "inputs:texture:file",
+                        &t.file.authored,
+                        format!(
+                            "{} textures are not evaluated (only DomeLight and RectLight textures are)",
+                            light.kind.usd_type()
+                        ),
+                    ));
                 }
                 KindData::Shape
             }
@@ -308,15 +315,20 @@ impl Prepared {
                 _ => IrradiancePath::Device,
             }
         };
-        let mut files_read = Vec::new();
-        if let Some(i) = evaluated.shaping.as_ref().and_then(|s| s.ies.as_ref())
-            && ies.is_some()
-        {
-            files_read.extend(cache.files(&i.file));
-        }
-        if let Some(t) = &light.texture {
-            files_read.extend(cache.files(&t.file));
-        }
+        // The files the assets above were loaded from (the profile's, the texture's).
+        let files_read = [
+            evaluated
+                .shaping
+                .as_ref()
+                .and_then(|s| s.ies.as_ref())
+                .filter(|_| ies.is_some())
+                .map(|i| &i.file),
+            light.texture.as_ref().map(|t| &t.file),
+        ]
+        .into_iter()
+        .flatten()
+        .flat_map(|a| cache.files(a))
+        .collect();
         Ok(Prepared {
             warning,
             files_read,
@@ -339,26 +351,14 @@ impl Prepared {
     }
 }
 
-/// Loads a light's texture (once per file, through `cache`) and resolves its format and frame
-/// (DESIGN.md §6 D1–D6). Domes only (a RectLight's is [`prepare_rect_texture`]); a texture on
-/// any other type is refused rather than evaluated as if untextured.
+/// Loads a dome's texture (once per file, through `cache`) and resolves its format and frame
+/// (DESIGN.md §6 D1–D6). A RectLight's is [`prepare_rect_texture`].
 fn prepare_texture(
     light: &Light,
     t: &Texture,
     linear: DMat3,
     cache: &mut AssetCache,
 ) -> Result<texture::PreparedTexture> {
-    if light.kind != LightType::Dome {
-        return Err(LuxError::attr(
-            &light.path,
-            "inputs:texture:file",
-            &t.file.authored,
-            format!(
-                "{} textures are not evaluated (only DomeLight and RectLight textures are)",
-                light.kind.usd_type()
-            ),
-        ));
-    }
     let asset_err = |attr: &str, source: AssetError| {
         LuxError::asset(&light.path, attr, &t.file.authored, source)
     };

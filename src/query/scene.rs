@@ -21,9 +21,12 @@ pub struct PreparedScene {
     pub(super) gpu: Option<GpuLights>,
     /// The buffers of the last GPU call, reused by the next call of the same size class.
     scratch: Mutex<Option<Scratch>>,
-    /// What the caller should know about how the scene is evaluated (textures the GPU holds
-    /// reduced); see [`PreparedScene::warnings`].
+    /// What the caller should know about how the scene is evaluated: the lights' own warnings
+    /// (zero-size lights), then `device_warnings`; see [`PreparedScene::warnings`].
     warnings: Vec<String>,
+    /// How this device's values differ from the reference by design (textures the GPU holds
+    /// reduced), which the conformance check cannot compare.
+    device_warnings: Vec<String>,
     /// The CPU's irradiance rule (the reference's, or one for a requested tolerance).
     rule: Adaptive,
 }
@@ -54,8 +57,7 @@ impl PreparedScene {
     /// A scene of lights already prepared (the GPU records are packed from exactly these
     /// constants).
     pub(crate) fn from_prepared(backend: Backend, lights: Vec<Prepared>) -> Result<Self> {
-        // How lights are evaluated other than as authored (zero-size lights), on every device.
-        let mut warnings: Vec<String> = lights.iter().filter_map(|p| p.warning.clone()).collect();
+        let mut device_warnings = Vec::new();
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
@@ -65,7 +67,7 @@ impl PreparedScene {
                 let (tex_atlas, offsets, reduced) = texture_atlas::scene_atlas(&lights, limit)
                     .map_err(|e| LuxError::input("textures", e.to_string()))?;
                 for r in reduced {
-                    warnings.push(format!(
+                    device_warnings.push(format!(
                         "{}: the GPU reads this {} × {} texture reduced to {} × {} (2 × 2 box \
                          averages), to fit the device's storage binding limit of {limit} bytes; \
                          its GPU values differ from the CPU reference (--device cpu), which reads \
@@ -82,21 +84,35 @@ impl PreparedScene {
                 g.upload(&records, &atlas.data, &tex_atlas)?
             }
         };
+        // How lights are evaluated other than as authored (zero-size lights), on every device.
+        let warnings = lights
+            .iter()
+            .filter_map(|p| p.warning.clone())
+            .chain(device_warnings.iter().cloned())
+            .collect();
         Ok(PreparedScene {
             backend,
             lights,
             gpu,
             scratch: Mutex::new(None),
             warnings,
+            device_warnings,
             rule: Adaptive::REFERENCE,
         })
     }
 
-    /// Warnings about how this scene is evaluated: each texture the GPU holds at a lower
-    /// resolution than its file because the scene's textures exceed the device's storage
-    /// binding limit (named with both sizes). Empty on the CPU reference.
+    /// Warnings about how this scene is evaluated: each zero-size light and how it is evaluated
+    /// (DESIGN.md §2), then each texture the GPU holds at a lower resolution than its file
+    /// because the scene's textures exceed the device's storage binding limit (named with both
+    /// sizes; none on the CPU reference).
     pub fn warnings(&self) -> &[String] {
         &self.warnings
+    }
+
+    /// The warnings of [`PreparedScene::warnings`] that say this device's values differ from
+    /// the reference by design (reduced textures).
+    pub(crate) fn device_warnings(&self) -> &[String] {
+        &self.device_warnings
     }
 
     /// The number of lights.

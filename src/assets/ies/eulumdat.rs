@@ -104,6 +104,16 @@ pub fn parse_any(
     Err(IesError::whole_file(K::UnknownFormat))
 }
 
+/// Where `TILT=<name>` of the profile file `profile` is read from: beside it (LM-63-2002 §3;
+/// DESIGN.md §6 I1).
+pub(crate) fn tilt_path(profile: &Path, name: &str) -> std::path::PathBuf {
+    profile
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
+        .join(name)
+}
+
 /// Reads `path` with `parse_any`, resolving `TILT=<name>` against the file's directory
 /// (§6 I1). Every error names `path`; a missing TILT file's error names both files.
 pub fn read_file(path: &Path) -> Result<IesFile, IesError> {
@@ -114,9 +124,8 @@ pub fn read_file(path: &Path) -> Result<IesFile, IesError> {
     };
     let bytes = crate::assets::package::read_file(path)
         .map_err(|e| with_file(IesError::whole_file(K::Io(e.to_string()))))?;
-    let dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let resolver = |tilt: &str| {
-        let p = dir.join(tilt);
+        let p = tilt_path(path, tilt);
         crate::assets::package::read_file(&p).map_err(|e| format!("{}: {e}", p.display()))
     };
     parse_any(&bytes, &resolver).map_err(with_file)

@@ -166,6 +166,15 @@ pub struct IesFile {
 }
 
 impl IesFile {
+    /// The TILT file this profile names (`TILT=<name>`), where `luxeval::read_ies` read it
+    /// from for the profile file at `profile`; `None` for `TILT=NONE` or `INCLUDE`.
+    pub fn tilt_file(&self, profile: &std::path::Path) -> Option<std::path::PathBuf> {
+        match &self.tilt.as_ref()?.source {
+            TiltSource::File(name) => Some(super::eulumdat::tilt_path(profile, name)),
+            TiltSource::Include => None,
+        }
+    }
+
     /// `m · b · (f₃ for 1986/1991)`: what every stored value is multiplied by (§6 I1).
     pub fn candela_scale(&self) -> f64 {
         let f3 = match self.format {
