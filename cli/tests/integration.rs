@@ -15,9 +15,12 @@ mod common;
 
 mod bad_inputs;
 mod cli;
+mod maps;
 mod pipeline_cache;
 mod robustness;
 mod stream;
+mod stream_refusals;
+mod support;
 
 /// The repository's root, where tests/data/ and assets/ are.
 pub fn repo() -> PathBuf {

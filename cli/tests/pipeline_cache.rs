@@ -5,12 +5,13 @@
 //! `luxeval info` reports each case.
 
 use crate::common;
+use crate::support::{asset, command};
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
 fn luxeval(cache_dir: &Path, args: &[&str]) -> Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_luxeval"))
+    let o = command()
         .args(args)
         .env("LUXEVAL_CACHE_DIR", cache_dir)
         .output()
@@ -21,14 +22,6 @@ fn luxeval(cache_dir: &Path, args: &[&str]) -> Output {
         String::from_utf8_lossy(&o.stderr)
     );
     o
-}
-
-fn asset(name: &str) -> String {
-    crate::repo()
-        .join("assets")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
 }
 
 fn emission(cache_dir: &Path, out: &Path) -> Vec<u8> {
