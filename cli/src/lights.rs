@@ -35,6 +35,9 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
         scene.meters_per_unit,
         scene.time
     );
+    for w in &scene.stage_warnings {
+        outln!("  warning: {w}");
+    }
     for l in &scene.lights {
         let status = match (&l.light, l.visible) {
             (Some(_), true) => "evaluated",

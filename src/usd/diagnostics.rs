@@ -5,43 +5,63 @@ use std::path::{Path, PathBuf};
 use openusd::sdf;
 use openusd::usd as ousd;
 
+use super::resolver::LayerSyntaxError;
 use crate::error::{LuxError, Result};
 
-/// Layer-level composition failures are errors: a light rig whose reference did not load would
-/// otherwise be evaluated without its lights, silently. Other diagnostics (an arc to a prim the
-/// layer lacks, a variant selection naming no variant) compose as usd-core does, with a warning.
-pub(super) fn check_composition(file: &Path, stage: &ousd::Stage) -> Result<()> {
+/// What openusd reports while composing, as usd-core treats it: a sublayer, reference or payload
+/// that cannot be found, or whose file format luxeval does not read (`.mtlx`, `.drc`, `.abc`, …),
+/// is left out of the composition with a warning naming the arc, its layer and the prim, and the
+/// rest of the stage (its other lights) is read (docs/INPUTS.md "Stages"). A layer that is
+/// found and is USD but malformed is an error: its lights would be missing without a reason a
+/// user can act on. Other diagnostics (an arc to a prim the layer lacks, a variant selection
+/// naming no variant) compose as usd-core does, logged.
+///
+/// Diagnostics are taken in sorted order, so a stage gives the same first error every run
+/// (openusd's order follows its hash maps). Returns the warnings, sorted.
+pub(super) fn check_composition(file: &Path, stage: &ousd::Stage) -> Result<Vec<String>> {
     use openusd::pcp::CompositionDiagnostic as D;
-    for d in stage.composition_errors() {
+    let mut diagnostics = stage.composition_errors();
+    diagnostics.sort_by_cached_key(|d| d.to_string());
+    let mut warnings = Vec::new();
+    for d in diagnostics {
         match d {
             D::UnresolvedLayer {
                 asset_path,
                 arc,
                 introduced_by,
                 site_path,
-            } => {
-                return Err(LuxError::Io {
-                    path: anchored(&introduced_by, &asset_path),
-                    source: std::io::Error::new(
-                        std::io::ErrorKind::NotFound,
-                        format!(
-                            "cannot open the {arc:?} layer @{asset_path}@ authored on {site_path} in {introduced_by}"
-                        ),
-                    ),
-                });
-            }
+            } => warnings.push(format!(
+                "{introduced_by}: the {arc:?} layer @{asset_path}@ authored on <{site_path}> \
+                 cannot be found; the stage is composed without it, as usd-core does, so \
+                 lights it would add are missing"
+            )),
             D::UnresolvedSublayer {
                 asset_path,
                 introduced_by,
-            } => {
-                return Err(LuxError::Io {
-                    path: anchored(&introduced_by, &asset_path),
-                    source: std::io::Error::new(
-                        std::io::ErrorKind::NotFound,
-                        format!("cannot open the sublayer @{asset_path}@ of {introduced_by}"),
-                    ),
-                });
-            }
+            } => warnings.push(format!(
+                "{introduced_by}: the sublayer @{asset_path}@ cannot be found; the stage is \
+                 composed without it, as usd-core does, so lights it would add are missing"
+            )),
+            D::MalformedLayer {
+                asset_path,
+                arc,
+                introduced_by,
+                site_path,
+                ..
+            } if !readable_format(&asset_path) => warnings.push(format!(
+                "{introduced_by}: the {arc:?} layer @{asset_path}@ authored on <{site_path}> is \
+                 in a format luxeval does not read; the stage is composed without it, as \
+                 usd-core does without that format's plugin, so lights it would add are missing"
+            )),
+            D::MalformedSublayer {
+                asset_path,
+                introduced_by,
+                ..
+            } if !readable_format(&asset_path) => warnings.push(format!(
+                "{introduced_by}: the sublayer @{asset_path}@ is in a format luxeval does not \
+                 read; the stage is composed without it, as usd-core does without that \
+                 format's plugin, so lights it would add are missing"
+            )),
             D::MalformedLayer {
                 asset_path,
                 arc,
@@ -87,7 +107,24 @@ pub(super) fn check_composition(file: &Path, stage: &ousd::Stage) -> Result<()> 
             other => log::warn!("{}: {other}", file.display()),
         }
     }
-    Ok(())
+    warnings.sort();
+    warnings.dedup();
+    Ok(warnings)
+}
+
+/// Whether `asset` names a layer of a format openusd reads (by its extension, as openusd's
+/// layer registry chooses the format): `.usda`, `.usdc`, `.usd`, `.usdz`, also inside a package.
+pub(super) fn readable_format(asset: &str) -> bool {
+    // `pkg.usdz[inner.usda]`: the innermost layer's name; `a.usda:SDF_FORMAT_ARGS:…`: its path.
+    let name = asset.trim_end_matches(']');
+    let name = name.rsplit('[').next().unwrap_or(name);
+    let name = name.split(":SDF_FORMAT_ARGS:").next().unwrap_or(name);
+    let ext = Path::new(name)
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or_default()
+        .to_ascii_lowercase();
+    matches!(ext.as_str(), "usda" | "usdc" | "usd" | "usdz")
 }
 
 /// `asset` as a path: itself when absolute (openusd reports some resolved), else anchored to
@@ -123,14 +160,22 @@ fn located(rendered: &str) -> (Option<usize>, String) {
 pub(super) fn open_error(path: &Path, e: openusd::Error) -> LuxError {
     use openusd::Error as E;
     match e {
-        E::Io(source) => LuxError::Io {
-            path: path.to_path_buf(),
-            source,
-        },
-        E::Format(sdf::FormatError::Io(source)) => LuxError::Io {
-            path: path.to_path_buf(),
-            source,
-        },
+        E::Io(source) | E::Format(sdf::FormatError::Io(source)) => {
+            match source
+                .get_ref()
+                .and_then(|e| e.downcast_ref::<LayerSyntaxError>())
+            {
+                Some(syntax) => LuxError::Format {
+                    path: path.to_path_buf(),
+                    line: Some(syntax.error.line),
+                    reason: syntax.error.reason.clone(),
+                },
+                None => LuxError::Io {
+                    path: path.to_path_buf(),
+                    source,
+                },
+            }
+        }
         E::Parse(pe) => LuxError::Format {
             path: path.to_path_buf(),
             line: Some(pe.line()),
@@ -186,6 +231,28 @@ mod tests {
         assert_eq!(line, Some(5));
         assert_eq!(reason, "Expected a number");
         assert_eq!(located("plain failure"), (None, "plain failure".into()));
+    }
+
+    #[test]
+    fn formats_read_by_extension() {
+        for a in [
+            "a.usda",
+            "b/c.USD",
+            "p.usdz",
+            "p.usdz[x/y.usdc]",
+            "a.usda:SDF_FORMAT_ARGS:x=1",
+        ] {
+            assert!(readable_format(a), "{a}");
+        }
+        for a in [
+            "looks.mtlx",
+            "mesh.drc",
+            "anim.abc",
+            "p.usdz[x.mtlx]",
+            "noext",
+        ] {
+            assert!(!readable_format(a), "{a}");
+        }
     }
 
     #[test]

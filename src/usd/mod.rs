@@ -26,6 +26,7 @@ mod light;
 mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;
+mod usda;
 mod values;
 mod xform;
 

@@ -1,5 +1,6 @@
 //! The resolver every stage file is read through: openusd's filesystem resolver, refusing what
-//! is not a regular file, exceeds the size limit, or (usda text) nests braces too deep.
+//! is not a regular file, exceeds the size limit, or (usda text) nests braces too deep, and
+//! handing openusd every text layer as luxeval's own reader reads it ([`super::usda`]).
 
 use std::cell::RefCell;
 use std::io::{self, Read};
@@ -8,6 +9,7 @@ use std::rc::Rc;
 
 use openusd::ar;
 
+use super::usda;
 use crate::limits::{ENV_MAX_FILE_BYTES, ENV_MAX_PRIM_DEPTH, Limits, raise_hint};
 
 /// openusd's filesystem resolver, refusing to open what is not a regular file (an endless device
@@ -23,7 +25,31 @@ pub(super) struct LimitedResolver {
     /// Every file opened through this resolver (and its clones), each once: the files a
     /// command reads through the stage, which no output may overwrite.
     opened: Rc<RefCell<Vec<PathBuf>>>,
+    /// What the text reader read differently from how it was written, each once, naming the
+    /// layer and line.
+    notes: Rc<RefCell<Vec<String>>>,
 }
+
+/// Text luxeval's reader cannot read: rendered as openusd renders its parse errors
+/// (`error: why` and ` --> file:line:col`), so every path that reports a layer's failure finds
+/// the line the same way.
+#[derive(Debug)]
+pub(super) struct LayerSyntaxError {
+    pub file: String,
+    pub error: usda::SyntaxError,
+}
+
+impl std::fmt::Display for LayerSyntaxError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "error: {}\n --> {}:{}:1",
+            self.error.reason, self.file, self.error.line
+        )
+    }
+}
+
+impl std::error::Error for LayerSyntaxError {}
 
 impl LimitedResolver {
     pub(super) fn new(limits: &Limits) -> Self {
@@ -34,7 +60,13 @@ impl LimitedResolver {
             // a few more: twice the depth limit and some room is more than a legal stage uses.
             max_braces: limits.max_prim_depth.saturating_mul(2).saturating_add(64),
             opened: Rc::default(),
+            notes: Rc::default(),
         }
+    }
+
+    /// What the text reader read differently from how it was written, in the order found.
+    pub(super) fn notes(&self) -> Vec<String> {
+        self.notes.borrow().clone()
     }
 
     /// The files opened so far, in the order first opened.
@@ -96,7 +128,8 @@ impl ar::Resolver for LimitedResolver {
         let mut asset = self.inner.open_asset(resolved_path)?;
         let mut bytes = Vec::new();
         asset.read_to_end(&mut bytes)?;
-        if bytes.starts_with(b"#usda") {
+        // Text is recognised by its cookie, as openusd does (a `.usd` may hold either).
+        if bytes.trim_ascii_start().starts_with(b"#usda") {
             let depth = brace_depth(&bytes);
             if depth > self.max_braces {
                 return Err(io::Error::new(
@@ -108,6 +141,29 @@ impl ar::Resolver for LimitedResolver {
                     ),
                 ));
             }
+            let text = std::str::from_utf8(&bytes).map_err(|e| {
+                io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    format!("{resolved_path}: a text layer must be UTF-8: {e}"),
+                )
+            })?;
+            let read = usda::canonical(text, self.max_braces as usize).map_err(|error| {
+                io::Error::new(
+                    io::ErrorKind::InvalidData,
+                    LayerSyntaxError {
+                        file: resolved_path.to_string(),
+                        error,
+                    },
+                )
+            })?;
+            let mut notes = self.notes.borrow_mut();
+            for n in read.notes {
+                let n = format!("{resolved_path}, {n}");
+                if !notes.contains(&n) {
+                    notes.push(n);
+                }
+            }
+            bytes = read.text.into_bytes();
         }
         Ok(Box::new(io::Cursor::new(ar::AssetBuffer::Owned(bytes))))
     }

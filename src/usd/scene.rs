@@ -70,6 +70,9 @@ pub struct Stage {
     pub time: TimeRule,
     /// In stage traversal order (depth-first, USD child order).
     pub lights: Vec<StageLight>,
+    /// What reading the stage says out loud ([`UsdStage::warnings`]): layers left out of the
+    /// composition, values read differently from how they were written.
+    pub stage_warnings: Vec<String>,
     /// Every file read to compose the stage (its layers and the packages holding them), the
     /// root layer first: what a command must never write over (DESIGN.md §4).
     #[serde(skip)]
@@ -143,10 +146,12 @@ impl Stage {
         Ok(selected().filter_map(|l| l.light.clone()).collect())
     }
 
-    /// One line per light that is listed but skipped by the queries (unsupported type or
-    /// feature, invisible), naming the prim.
+    /// The stage's own warnings ([`Stage::stage_warnings`]), then one line per light that is
+    /// listed but skipped by the queries (unsupported type or feature, invisible), naming the
+    /// prim.
     pub fn warnings(&self) -> Vec<String> {
-        self.lights
+        let lights = self
+            .lights
             .iter()
             .filter_map(|l| match (&l.light, &l.warning) {
                 (None, Some(w)) => Some(w.clone()),
@@ -157,8 +162,8 @@ impl Stage {
                     describe_time(self.time)
                 )),
                 _ => None,
-            })
-            .collect()
+            });
+        self.stage_warnings.iter().cloned().chain(lights).collect()
     }
 }
 
@@ -203,6 +208,7 @@ impl UsdStage {
             meters_per_unit: info.meters_per_unit,
             time: rule,
             lights,
+            stage_warnings: self.warnings().to_vec(),
             files_read: self.files_read().to_vec(),
         })
     }
@@ -323,6 +329,7 @@ mod tests {
                 StageLight::from_prim(prim("PortalLight", &[]), UpAxis::Y),
                 hidden,
             ],
+            stage_warnings: Vec::new(),
             files_read: vec!["x.usda".into()],
         };
         let all = scene.evaluable(&[]).unwrap();

@@ -114,14 +114,19 @@ pub struct UsdStage {
     files: Vec<PathBuf>,
     info: StageInfo,
     lights: Vec<LightSite>,
+    /// What was read differently from how it was written, or left out (see
+    /// [`UsdStage::warnings`]).
+    warnings: Vec<String>,
     // Keeps the composed stage alive for the prim handles above.
     _stage: ousd::Stage,
 }
 
 impl UsdStage {
     /// Opens `path` with every payload loaded. A missing or unreadable file is
-    /// [`LuxError::Io`]; a malformed one [`LuxError::Format`] (with the line for `.usda`); a
-    /// sublayer, reference or payload that cannot be found or read is an error naming that layer.
+    /// [`LuxError::Io`]; a malformed one [`LuxError::Format`] (with the line for `.usda`), also
+    /// when it is a sublayer, reference or payload of the stage. A sublayer, reference or payload
+    /// that cannot be found, or is in a format luxeval does not read, is left out with a
+    /// warning ([`UsdStage::warnings`]), as usd-core leaves it out.
     pub fn open(path: &Path) -> Result<UsdStage> {
         // The filesystem's own error (not found, permission denied) is the clearest message.
         let io = |source| LuxError::Io {
@@ -215,7 +220,7 @@ impl UsdStage {
         stage
             .traverse(PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone()))
             .map_err(e)?;
-        check_composition(path, &stage)?;
+        let mut warnings = check_composition(path, &stage)?;
 
         let mut lights = Vec::new();
         let mut own_xform: HashMap<String, bool> = HashMap::new();
@@ -298,7 +303,12 @@ impl UsdStage {
             });
         }
         // Reading attributes can compose more (e.g. the prims an inherit arc names).
-        check_composition(path, &stage)?;
+        for w in check_composition(path, &stage)? {
+            if !warnings.contains(&w) {
+                warnings.push(w);
+            }
+        }
+        warnings.extend(resolver.notes());
         let mut files = resolver.opened();
         if !files.iter().any(|f| f == path) {
             files.insert(0, path.to_path_buf());
@@ -308,6 +318,7 @@ impl UsdStage {
             files,
             info,
             lights,
+            warnings,
             _stage: stage,
         })
     }
@@ -316,6 +327,13 @@ impl UsdStage {
     /// root layer first: what a command must never write over (DESIGN.md §4).
     pub fn files_read(&self) -> &[PathBuf] {
         &self.files
+    }
+
+    /// What the stage's reading says out loud: sublayers, references and payloads left out of
+    /// the composition (not found, or a format luxeval does not read), then values the text
+    /// reader read differently from how they were written; each names its layer.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     pub fn info(&self) -> &StageInfo {
