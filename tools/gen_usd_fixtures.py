@@ -17,6 +17,9 @@ What it writes, all under tests/data/:
   them. ``root.usdc`` is the root layer saved by usd-core's crate writer; ``scene.usdz`` is the whole
   scene packed by ``UsdUtils.CreateNewUsdzPackage`` (assets included).
 - usd/errors/: broken scenes (malformed text, missing references and sublayers).
+- usd/ancestors/: lights under an ancestor of every Xformable type (--only-ancestors).
+- usd/reader/: lights written in every text form usd-core reads and openusd 0.8 alone did not,
+  beside a MaterialX reference and a missing sublayer (--only-reader).
 - usd/expected/*.json: what usd-core resolves for every light of every scene above, at every time
   code the scene authors and under the EarliestTime rule: type, applied schemas, visibility, world
   matrix, and every scalar input with its value, authored flag and resolved asset path.
@@ -953,6 +956,83 @@ def Scope "Group"
 """
 
 
+# The text reader's fixture (tests/data/usd/reader/): every form usd-core reads that openusd 0.8
+# alone refused, on the lights' own inputs, beside a reference to a MaterialX layer and a sublayer
+# that does not exist (usd-core composes without both, with a warning). Written as text by hand:
+# usd-core would write it back canonically, and the point is the author's spelling.
+READER_USDA = r'''#usda 1.0
+(
+    doc = """A layer as DCCs and OpenUSD's own test scenes write it:
+    every form below is read by usd-core."""
+    metersPerUnit = .01
+    upAxis = "Y"
+    subLayers = [
+        @./missing_sublayer.usda@
+    ]
+)
+
+// A comment in the C++ style, as testUsdLuxLightListAPI writes them.
+def Xform "Lights" /* and a block comment */
+{
+    double3 xformOp:translate = (0., .5, -1.)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+
+    def SphereLight "Sphere"
+    {
+        config token info:id = "SphereLight"   // config: the old spelling of uniform
+        float inputs:intensity = 2.
+        float inputs:radius = .25
+        color3f inputs:color = (1, .5, 0.)
+        bool inputs:normalize = 2
+        float inputs:exposure.timeSamples = {
+            0: 0.,
+            1.: .5,
+        }
+    }
+
+    def DomeLight "Dome"
+    {
+        asset inputs:texture:file = "grid.png"
+        float inputs:intensity = 1.e-1
+    }
+
+    def DiskLight "Off" (
+        active = False
+    )
+    {
+    }
+
+    def RectLight "Rect" (
+        prepend apiSchemas = ["ShapingAPI"]
+    )
+    {
+        float inputs:width = 2.
+        float inputs:shaping:cone:angle = 45.
+        float inputs:shaping:cone:softness = .1
+        float inputs:shaping:focus = -.5e-1
+    }
+}
+
+def Xform "Looks" (
+    prepend references = @./looks.mtlx@</MaterialX>
+)
+{
+    def DistantLight "BesideTheLook"
+    {
+        float inputs:angle = 1.
+    }
+}
+'''
+
+
+def write_reader():
+    d = os.path.join(DATA, "usd", "reader")
+    write(os.path.join(d, "forms.usda"), READER_USDA.encode("utf-8"))
+    # A MaterialX document (not USD): what usd-core without the MaterialX plugin cannot read.
+    write(os.path.join(d, "looks.mtlx"), b'<?xml version="1.0"?>\n<materialx version="1.38">\n</materialx>\n')
+    write(os.path.join(d, "grid.png"), png_bytes(2, 1, [255, 0, 0, 0, 0, 255]))
+
+
 def write_ancestors():
     write(os.path.join(DATA, "usd", "ancestors", "ancestors.usda"), ANCESTORS_USDA.encode("ascii"))
 
@@ -962,7 +1042,14 @@ def main():
     ap.add_argument("--luxtest-src", default="/work/shared/data/luxtest", help="the research/data/luxtest copy")
     ap.add_argument("--only-ancestors", action="store_true",
                     help="write and dump only the ancestor-transform fixture (leaves the others as they are)")
+    ap.add_argument("--only-reader", action="store_true",
+                    help="write and dump only the text reader's fixture (leaves the others as they are)")
     args = ap.parse_args()
+
+    if args.only_reader:
+        write_reader()
+        dump("usd/reader/forms.usda", "reader_forms", [0, 1])
+        return
 
     if args.only_ancestors:
         write_ancestors()
@@ -985,6 +1072,8 @@ def main():
     dump("usd/composition/rig_packaged.usdz", "composition_rig_packaged_usdz", COMPOSITION_TIMES)
     write_ancestors()
     dump("usd/ancestors/ancestors.usda", "ancestors", [0, 1, 2])
+    write_reader()
+    dump("usd/reader/forms.usda", "reader_forms", [0, 1])
 
 
 if __name__ == "__main__":

@@ -37,8 +37,8 @@ pub struct QueryArgs {
     /// the sum over lights.
     #[arg(long)]
     pub per_light: bool,
-    /// Where to evaluate. Default: the GPU, falling back to the CPU reference with a warning when
-    /// no adapter exists.
+    /// Where to evaluate. Default `auto`: a hardware GPU adapter when there is one, else the CPU
+    /// reference (a software adapter such as lavapipe only with `--device gpu`).
     #[arg(long, value_enum)]
     pub device: Option<DeviceArg>,
 }
@@ -72,9 +72,14 @@ pub struct TimeArg {
     pub time: Option<f64>,
 }
 
+/// `--device` (DESIGN.md §4).
 #[derive(Clone, Copy, ValueEnum)]
 pub enum DeviceArg {
+    /// A hardware GPU adapter when there is one, else the CPU reference (the default).
+    Auto,
+    /// The GPU, software adapters (lavapipe) included; an error without one.
     Gpu,
+    /// The f64 CPU reference.
     Cpu,
 }
 

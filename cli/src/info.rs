@@ -6,6 +6,8 @@ use crate::exit::CliResult;
 
 pub fn run(json: bool) -> CliResult {
     let adapters = luxeval::adapters();
+    // What `--device auto` (the default) picks and why; then the adapter `--device gpu` opens.
+    let auto = Evaluator::auto().map(|(_, why)| why);
     let chosen = Evaluator::gpu();
     if json {
         let v = serde_json::json!({
@@ -13,6 +15,10 @@ pub fn run(json: bool) -> CliResult {
             "adapters": adapters.iter().map(|a| serde_json::json!({
                 "name": a.name, "backend": a.backend, "device_type": a.device_type, "driver": a.driver,
             })).collect::<Vec<_>>(),
+            "auto": match &auto {
+                Ok(why) => serde_json::json!({ "chosen": why }),
+                Err(e) => serde_json::json!({ "error": e.to_string() }),
+            },
             "chosen": match &chosen {
                 Ok(g) => {
                     let adapter = g.adapter().unwrap_or_else(unknown_adapter);
@@ -52,10 +58,14 @@ pub fn run(json: bool) -> CliResult {
                 a.driver
             );
         }
+        match &auto {
+            Ok(why) => outln!("--device auto (the default): {why}"),
+            Err(e) => outln!("--device auto (the default): cannot open the adapter: {e}"),
+        }
         match &chosen {
             Ok(g) => {
                 let a = g.adapter().unwrap_or_else(unknown_adapter);
-                outln!("chosen: {} ({})", a.name, a.backend);
+                outln!("--device gpu: {} ({})", a.name, a.backend);
                 let Some(l) = g.device_limits() else {
                     return Ok(());
                 };
@@ -93,7 +103,7 @@ pub fn run(json: bool) -> CliResult {
                 }
             }
             Err(e) => {
-                outln!("chosen: none: {e}\n  queries fall back to the CPU reference (--device cpu)")
+                outln!("--device gpu: none: {e}")
             }
         }
     }

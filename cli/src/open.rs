@@ -43,20 +43,20 @@ pub fn load(path: &std::path::Path, time: Option<f64>) -> CliResult<Stage> {
     })
 }
 
-/// The evaluator `device` asks for: the GPU (an error when there is none), the CPU, or by
-/// default the GPU with a fallback to the CPU reference and a warning.
+/// The evaluator `device` asks for: the GPU (an error when there is none), the CPU, or
+/// by default (`auto`) a hardware GPU, else the CPU reference with a warning saying why.
 pub fn evaluator(device: Option<DeviceArg>, args: &SceneArgs) -> CliResult<Evaluator> {
     let eval = match device {
         Some(DeviceArg::Cpu) => Evaluator::cpu(),
         Some(DeviceArg::Gpu) => Evaluator::gpu()?,
-        None => match Evaluator::gpu() {
-            Ok(e) => e,
-            Err(LuxError::NoAdapter { reason, .. }) => {
-                eprintln!("warning: no GPU adapter ({reason}); using the CPU reference");
-                Evaluator::cpu()
+        None | Some(DeviceArg::Auto) => {
+            let (eval, why) = Evaluator::auto()?;
+            // Said when it is not the GPU one might expect (a GPU choice is what `auto` means).
+            if !eval.is_gpu() {
+                eprintln!("warning: --device auto: {why}");
             }
-            Err(e) => return Err(e.into()),
-        },
+            eval
+        }
     };
     Ok(eval.with_temperature_mode(args.temperature_mode.into()))
 }

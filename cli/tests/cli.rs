@@ -51,6 +51,59 @@ fn emission_on_the_bundled_scene_equals_the_library() {
     assert_eq!(values, studio_emission_on_cpu(Accumulate::PerLight).1);
 }
 
+/// `--device auto`, the default (DESIGN.md §4): a hardware adapter when there is one, never a
+/// software one. Where every adapter is a software one (lavapipe on CI), the default is the CPU
+/// reference, bit for bit, and the first warning says so and why; `info` says what auto picks.
+#[test]
+fn the_default_device_is_a_hardware_gpu_else_the_cpu() {
+    let info = luxeval(&["info", "--json"]);
+    assert!(info.status.success(), "{}", stderr(&info));
+    let info: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let adapters = info["adapters"].as_array().unwrap();
+    let hardware = adapters.iter().any(|a| a["device_type"] != "Cpu");
+    let auto = info["auto"]["chosen"].as_str().unwrap();
+    assert_eq!(auto.starts_with("the hardware adapter"), hardware, "{auto}");
+
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, device: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "emission",
+            &asset("studio.usda"),
+            "--dirs",
+            &asset("dirs.npy"),
+            "-o",
+            out.to_str().unwrap(),
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>();
+        args.extend(device.iter().map(|d| d.to_string()));
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = luxeval(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (stderr(&o), read_npy_f32(&out).1)
+    };
+    let (said, default) = run("default.npy", &[]);
+    let (said_auto, auto_values) = run("auto.npy", &["--device", "auto"]);
+    assert_eq!(default, auto_values);
+    assert_eq!(said, said_auto);
+    if !hardware {
+        let (_, cpu) = run("cpu.npy", &["--device", "cpu"]);
+        assert_eq!(default, cpu, "auto without a hardware adapter is the CPU reference");
+        let first = said.lines().find(|l| l.starts_with("warning:")).unwrap_or_default();
+        assert!(
+            first.starts_with("warning: --device auto: the CPU reference:"),
+            "{said}"
+        );
+        let software: Vec<&str> = adapters.iter().filter_map(|a| a["name"].as_str()).collect();
+        if !software.is_empty() {
+            assert!(first.contains("only software ones"), "{first}");
+            assert!(software.iter().all(|n| first.contains(n)), "{first}");
+        }
+    }
+}
+
 /// The bundled scene's lights and the library's CPU emission of them along assets/dirs.npy,
 /// flattened as the CLI writes it.
 fn studio_emission_on_cpu(acc: Accumulate) -> (Vec<luxeval::Light>, Vec<f32>) {

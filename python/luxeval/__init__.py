@@ -16,7 +16,7 @@ This package mirrors the Rust library (``luxeval::Stage``, ``Evaluator``, ``Prep
   (``lights``, device, ``temperature_mode``, ``texture_filter``) and reuse them, with the GPU pipelines and buffers.
 - :class:`InputError` (a ``ValueError``): bad input, naming the file, prim and attribute or the
   argument. :class:`DeviceError` (a ``RuntimeError``): no GPU with ``device="gpu"``, a device
-  failure. :class:`DeviceWarning`: ``device="auto"`` found no GPU and uses the CPU reference.
+  failure. :class:`DeviceWarning`: ``device="auto"`` found no hardware GPU and uses the CPU reference.
 - :func:`device_name`: which device a ``device=`` argument selects.
 - :mod:`luxeval.dask` (needs ``dask`` and ``distributed``): the same queries over chunked dask
   arrays, one opened stage per worker process.

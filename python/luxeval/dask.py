@@ -19,7 +19,7 @@ keyed by the stage's absolute path and requested time); the stage keeps its prep
 (``lights``, device, ``temperature_mode``, ``texture_filter``), so the GPU pipelines and buffers are built once per
 worker, not per chunk. The path must name the same file on every worker (a shared file system).
 
-Devices: each worker picks its own. With ``device="auto"`` (the default) a worker without a GPU
+Devices: each worker picks its own. With ``device="auto"`` (the default) a worker without a hardware GPU
 adapter evaluates on the f64 CPU reference and issues one ``luxeval.DeviceWarning`` (in that
 worker's log); its chunks then agree with GPU chunks to the usual 1e-4 relative tolerance, not
 bitwise. With ``device="gpu"`` such a worker raises ``luxeval.DeviceError``, which

@@ -1,6 +1,7 @@
 //! Which evaluator a query runs on. The GPU is opened once per process and shared by every
-//! stage (its pipelines are compiled once); a missing adapter is remembered too, so that
-//! `device="auto"` warns once and then uses the CPU reference without asking again.
+//! stage (its pipelines are compiled once); a missing adapter is remembered too. `device="auto"`
+//! (DESIGN.md §4) is decided once per process: a hardware adapter, else the CPU reference with
+//! one `DeviceWarning` saying why (a software adapter such as lavapipe only with "gpu").
 
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -76,6 +77,8 @@ enum Gpu {
 }
 
 static GPU: Mutex<Option<Gpu>> = Mutex::new(None);
+/// What `device="auto"` chose, and why.
+static AUTO: Mutex<Option<(Evaluator, String)>> = Mutex::new(None);
 static WARNED: AtomicBool = AtomicBool::new(false);
 
 /// The process's GPU evaluator, opened on first use (with the GIL released), or why there is
@@ -101,8 +104,23 @@ fn gpu(py: Python<'_>) -> PyResult<Result<Evaluator, String>> {
     r.map_err(|e| errors::lux(e, None))
 }
 
-/// The evaluator for `device`: the GPU (an error without one), the CPU reference, or the GPU
-/// with a fallback to the CPU reference and one `DeviceWarning` per process.
+/// The process's `device="auto"` evaluator and why it was chosen, decided on first use (with the
+/// GIL released).
+fn auto(py: Python<'_>) -> PyResult<(Evaluator, String)> {
+    let r = py.detach(|| {
+        let mut a = AUTO
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if a.is_none() {
+            *a = Some(Evaluator::auto()?);
+        }
+        Ok(a.clone().expect("set above"))
+    });
+    r.map_err(|e| errors::lux(e, None))
+}
+
+/// The evaluator for `device`: the GPU (an error without one), the CPU reference, or (`auto`) a
+/// hardware GPU, else the CPU reference with one `DeviceWarning` per process.
 pub fn evaluator(py: Python<'_>, device: Device, mode: TemperatureMode) -> PyResult<Evaluator> {
     let eval = match device {
         Device::Cpu => Evaluator::cpu(),
@@ -110,18 +128,16 @@ pub fn evaluator(py: Python<'_>, device: Device, mode: TemperatureMode) -> PyRes
             Ok(e) => e,
             Err(reason) => return Err(DeviceError::new_err(no_adapter(&reason))),
         },
-        Device::Auto => match gpu(py)? {
-            Ok(e) => e,
-            Err(reason) => {
-                if !WARNED.swap(true, Ordering::SeqCst) {
-                    let msg = format!("no GPU adapter ({reason}); using the CPU reference");
-                    let msg = std::ffi::CString::new(msg.replace('\0', " "))
-                        .expect("NULs replaced above");
-                    PyErr::warn(py, &py.get_type::<DeviceWarning>(), &msg, 2)?;
-                }
-                Evaluator::cpu()
+        Device::Auto => {
+            let (eval, why) = auto(py)?;
+            if !eval.is_gpu() && !WARNED.swap(true, Ordering::SeqCst) {
+                let msg = format!("device=\"auto\": {why}");
+                let msg =
+                    std::ffi::CString::new(msg.replace('\0', " ")).expect("NULs replaced above");
+                PyErr::warn(py, &py.get_type::<DeviceWarning>(), &msg, 2)?;
             }
-        },
+            eval
+        }
     };
     Ok(eval.with_temperature_mode(mode))
 }
@@ -135,8 +151,9 @@ fn no_adapter(reason: &str) -> String {
 
 /// The device a query with this ``device=`` argument runs on: the GPU adapter's name and
 /// backend (e.g. ``"llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan)"``) or ``"cpu (f64 reference)"``.
-/// Opens the GPU if it is not open yet (``device="auto"`` falls back to the CPU reference with a
-/// ``DeviceWarning`` when there is none; ``device="gpu"`` raises ``DeviceError``).
+/// Opens the GPU if it is not open yet (``device="auto"`` is the CPU reference, with a
+/// ``DeviceWarning`` saying why, when there is no hardware adapter; ``device="gpu"`` raises
+/// ``DeviceError`` when there is no adapter at all).
 #[pyfunction]
 #[pyo3(signature = (device = "auto"))]
 pub fn device_name(py: Python<'_>, device: &str) -> PyResult<String> {

@@ -369,7 +369,7 @@ impl Stage {
     /// ``dirs``: (N, 3), any real dtype. Returns float32 (N, 3), the sum over lights, or
     /// (L, N, 3) with ``per_light=True``, in the order of ``light_paths(lights)``.
     /// ``lights``: a prim path or a list of them (default: every visible, evaluable light).
-    /// ``device``: ``"auto"`` (the GPU, else the CPU reference with one ``DeviceWarning``),
+    /// ``device``: ``"auto"`` (a hardware GPU, else the CPU reference with one ``DeviceWarning``),
     /// ``"gpu"`` (``DeviceError`` without one) or ``"cpu"`` (the f64 reference, rounded to
     /// float32). ``temperature_mode``: ``"spec"``, ``"usd"`` or ``"planckian"``.
     /// ``texture_filter``: ``"bilinear"`` or ``"nearest"`` (dome and rect textures).

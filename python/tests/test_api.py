@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import ast
 import inspect
+import json
 import os
 import pickle
 import signal
@@ -241,11 +242,16 @@ def test_prepared_lights_are_reused(device):
     ]
 
 
-def test_auto_is_the_gpu_when_there_is_one(has_gpu):
+def test_auto_is_a_hardware_gpu_else_the_cpu(cli):
+    """DESIGN.md §4: ``device="auto"`` picks a hardware adapter when the machine has one, and
+    never a software one (lavapipe, on CI: ``device="gpu"`` opens that)."""
+    info = json.loads(subprocess.run([str(cli), "info", "--json"], capture_output=True,
+                                     text=True, check=True).stdout)
+    hardware = any(a["device_type"] != "Cpu" for a in info["adapters"])
     stage = luxeval.Stage(STUDIO)
     stage.emission(sphere_dirs(10))
-    assert stage.prepared == [(None, "gpu" if has_gpu else "cpu", "spec", "bilinear")]
-    assert (luxeval.device_name() != "cpu (f64 reference)") == has_gpu
+    assert stage.prepared == [(None, "gpu" if hardware else "cpu", "spec", "bilinear")]
+    assert (luxeval.device_name() != "cpu (f64 reference)") == hardware
 
 
 def test_time_is_read_as_given():

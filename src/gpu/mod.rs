@@ -77,6 +77,18 @@ fn instance() -> wgpu::Instance {
     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
 }
 
+/// How much `--device auto` prefers an adapter of this type (lower first), `None` for software
+/// adapters, which it never picks.
+fn hardware_rank(t: wgpu::DeviceType) -> Option<u8> {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => Some(0),
+        wgpu::DeviceType::IntegratedGpu => Some(1),
+        wgpu::DeviceType::VirtualGpu => Some(2),
+        wgpu::DeviceType::Other => Some(3),
+        wgpu::DeviceType::Cpu => None,
+    }
+}
+
 /// Every adapter wgpu can see on this machine.
 pub fn adapters() -> Vec<AdapterSummary> {
     let instance = instance();
@@ -132,15 +144,52 @@ impl GpuContext {
     /// Opens the adapter named by `LUXEVAL_ADAPTER` (a name substring), else the default
     /// high-performance adapter. No pipeline is built yet.
     pub fn new() -> Result<Self> {
-        pollster::block_on(Self::new_async())
+        pollster::block_on(Self::new_async(false))
     }
 
-    async fn new_async() -> Result<Self> {
+    /// Opens a hardware adapter (`--device auto`, DESIGN.md §4): the best of those matching
+    /// `LUXEVAL_ADAPTER` when set, else of all, that is not a software one (wgpu's
+    /// `DeviceType::Cpu`: lavapipe/llvmpipe, SwiftShader, WARP run the kernels on the same cores
+    /// as the f64 reference, more slowly). `NoAdapter` names the software adapters it passed over.
+    pub fn new_hardware() -> Result<Self> {
+        pollster::block_on(Self::new_async(true))
+    }
+
+    async fn new_async(hardware_only: bool) -> Result<Self> {
         let t0 = std::time::Instant::now();
         let instance = instance();
         let t_instance = t0.elapsed();
-        let adapter = match std::env::var(ADAPTER_ENV) {
-            Ok(want) if !want.is_empty() => {
+        let want = std::env::var(ADAPTER_ENV).unwrap_or_default();
+        let adapter = match want.as_str() {
+            _ if hardware_only => {
+                let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+                let named = |a: &wgpu::Adapter| {
+                    want.is_empty() || a.get_info().name.to_lowercase().contains(&want.to_lowercase())
+                };
+                let software: Vec<String> = adapters
+                    .iter()
+                    .filter(|a| named(a) && a.get_info().device_type == wgpu::DeviceType::Cpu)
+                    .map(|a| a.get_info().name)
+                    .collect();
+                adapters
+                    .into_iter()
+                    .filter(|a| named(a))
+                    .filter_map(|a| Some((hardware_rank(a.get_info().device_type)?, a)))
+                    .min_by_key(|(rank, _)| *rank)
+                    .map(|(_, a)| a)
+                    .ok_or_else(|| LuxError::NoAdapter {
+                        reason: match (software.is_empty(), want.is_empty()) {
+                            (true, true) => "no GPU adapter".to_string(),
+                            (true, false) => format!("no adapter matches {ADAPTER_ENV}={want:?}"),
+                            (false, _) => format!(
+                                "no hardware GPU adapter, only software ones ({})",
+                                software.join(", ")
+                            ),
+                        },
+                        source: None,
+                    })?
+            }
+            want if !want.is_empty() => {
                 let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
                 let names: Vec<String> = adapters.iter().map(|a| a.get_info().name).collect();
                 adapters

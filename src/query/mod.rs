@@ -98,6 +98,37 @@ impl Evaluator {
         })
     }
 
+    /// `--device auto` (DESIGN.md §4): a GPU evaluator on a hardware adapter when there is one
+    /// (the best matching `LUXEVAL_ADAPTER` when set), else the CPU reference. A software adapter
+    /// (lavapipe/llvmpipe, SwiftShader, WARP) is never picked: it runs the kernels on the same
+    /// cores as the f64 reference, more slowly; [`Evaluator::gpu`] opens one. Returns the
+    /// evaluator and a sentence saying what was chosen and why, for `info` and the first warning.
+    pub fn auto() -> Result<(Self, String)> {
+        match GpuContext::new_hardware() {
+            Ok(ctx) => {
+                let a = ctx.adapter();
+                let why = format!(
+                    "the hardware adapter {} ({}, {})",
+                    a.name, a.device_type, a.backend
+                );
+                let eval = Evaluator {
+                    backend: Backend::Gpu(Arc::new(ctx)),
+                    temperature_mode: TemperatureMode::default(),
+                    irradiance_tolerance: None,
+                };
+                Ok((eval, why))
+            }
+            Err(LuxError::NoAdapter { reason, .. }) => Ok((
+                Evaluator::cpu(),
+                format!(
+                    "the CPU reference: {reason} (a software adapter is slower than the f64 \
+                     reference on the same cores; --device gpu uses one)"
+                ),
+            )),
+            Err(e) => Err(e),
+        }
+    }
+
     pub fn with_temperature_mode(mut self, mode: TemperatureMode) -> Self {
         self.temperature_mode = mode;
         self
