@@ -39,6 +39,7 @@ mod robustness;
 mod tolerance;
 mod twins;
 mod usd_fixtures;
+mod usd_parity;
 mod usd_rect_texture;
 mod wgsl;
 

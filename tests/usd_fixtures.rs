@@ -140,8 +140,9 @@ fn compare(ctx: &str, ours: &StageLight, exp: &Json, problems: &mut Vec<String>)
     }
 }
 
-/// Opens `scene` (relative to tests/data) and checks every light at every recorded time.
-fn check_scene(fixture: &str) {
+/// Opens `scene` (relative to tests/data) and checks every light at every recorded time (also
+/// the OpenUSD parity corpus's, tests/usd_parity.rs).
+pub(crate) fn check_scene(fixture: &str) {
     let exp = expected(fixture);
     let path = data().join(exp["scene"].as_str().unwrap());
     let stage = UsdStage::open(&path).unwrap_or_else(|e| panic!("{fixture}: {e}"));

@@ -20,6 +20,12 @@ What it writes, all under tests/data/:
 - usd/ancestors/: lights under an ancestor of every Xformable type (--only-ancestors).
 - usd/reader/: lights written in every text form usd-core reads and openusd 0.8 alone did not,
   beside a MaterialX reference and a missing sublayer (--only-reader).
+- usd/openusd/: a parity corpus of OpenUSD's own light test scenes (PixarAnimationStudios/OpenUSD
+  @ v24.08, Tomorrow Open Source Technology License 1.0, LICENSE.txt beside them), copied byte for
+  byte in their repository layout with the local files they reference (sha256 checked), from an
+  extracted checkout given as --openusd-src. `--only-openusd` writes only these and their
+  expected JSON (usd/expected/openusd_*.json); tools/usd_parity.py runs the same comparison over
+  a whole checkout.
 - usd/expected/*.json: what usd-core resolves for every light of every scene above, at every time
   code the scene authors and under the EarliestTime rule: type, applied schemas, visibility, world
   matrix, and every scalar input with its value, authored flag and resolved asset path.
@@ -31,6 +37,7 @@ import json
 import os
 import shutil
 import struct
+import subprocess
 import sys
 import zipfile
 import zlib
@@ -83,6 +90,123 @@ tools/gen_usd_fixtures.py, which checks every file's sha256.
 Not copied (the scenes reference them, so they resolve to nothing here): `../bega_omni002_4777lm.ies`
 and `../04f377f94ce81cd7b5101fffdf571454.ies` (BEGA photometry, CC BY-ND 4.0).
 """
+
+# OpenUSD's light test scenes: every file they need, by its path in the OpenUSD repository at
+# OPENUSD_TAG, with its sha256 there. The scenes cover every light type OpenUSD's test scenes use
+# (SphereLight, DomeLight, RectLight, DistantLight, DiskLight) and the constructs that stopped
+# luxeval's text reader on the whole corpus (tools/usd_parity.py): a reference to a MaterialX
+# .mtlx layer, asset values written as strings, `//` comments, the `config` qualifier, numbers
+# written `.1` and `0.`; beside them scenes that read: payloads, sublayers, instancing, collections,
+# time samples on transforms, inputs and visibility, textures that resolve.
+OPENUSD_TAG = "v24.08"
+OPENUSD_COMMIT = "59992d2178afcebd89273759f2bddfe730e59aa8"
+OPENUSD_FILES = {
+    "LICENSE.txt": "6324b95f7dcf156e6ea4d9458462739c812d2188cfa7e4447741fe953ea29d0b",
+    "pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/root.usda": "29464a5bff2b8c532dbcacfbfd021ae48ab82a5854be3a6bb680f0325b387915",
+    "pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/root_with_instances.usda": "edb933ac9f0901a3c1a0c0966d2589ee6e268b5f94b8705969f849a1227a58a8",
+    "pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/torch.usda": "ebcb64e70860ce26e118476f68110781ed648b352fd9f190a56132f8e8ba83e8",
+    "pxr/usd/usdLux/testenv/testUsdLuxLinkingAPI/linking_example.usda": "91157ac24f836f17790734100eff21d8eaf01276f91a878bbeacda063fa9ab49",
+    "pxr/usd/usdLux/testenv/testUsdLuxLinkingAPI/meshWithFaceSet.usda": "c5c7bd9a45fffce57852b9528064ac3f74863f6a899b8ed30e394f4210304f6f",
+    "pxr/usdImaging/bin/testusdview/testenv/testUsdviewLightVisibility/testVarying.usda": "8cde0e8c3baca15015c62700d8042150023048071b45bf6581503acd8521d03b",
+    "pxr/usdImaging/bin/testusdview/testenv/testUsdviewRenderSettingsEdits/test.usda": "cf9808e2ea5cc4d0b42bfa1ad5b9c4bf33ae59a7d470064361eda9ce7f5381a6",
+    "pxr/usdImaging/bin/usdrecord/testenv/MotionBlurTest/motionBlur.usda": "846cfe80c108287200ffb3751ab3f8df09e6ae89eca52efd7fe9461f85e17047",
+    "pxr/usdImaging/usdImaging/testenv/testUsdImagingDelegateChanges/inherited_primvars.usda": "eee4cf3fd7bb23328fa7276cf719f8d18a4e4c451bcc13cd6d05a3e5f49d8524",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLAnimatedLights/lightMoving.usda": "8960ed9df6d41d5920d83a8db34ad7adb7657409be08c79ffcf1b9af1bec1369",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLDomeLight/domeLightYup.usda": "7bd67aaeca68a4c1ace97c872dd0f6350e0d18fca289756f5e7c1513862d76cc",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLDomeLight/testImage.png": "8e3383a6a6de37e112f04e092fd93c37938078f7ff6c8ca3dd4fc05d82c7c228",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLInstancing/instancedCubes.usda": "177928f97c71421fa4638101cdb55b451c33e9c9f91227375150d2a28b8eeb19",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLInstancing/lightGray.png": "4e80275fd38685ee4f317f775628d151053a9101d554ca73d3dd99e17681c52e",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXBasic/mtlxFiles/standard_surface_default.mtlx": "d9a8055550be959c573150a50e90cf418c175c076fbb384cc410157306d3155f",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXBasic/mxLights.usda": "16b3dfaa4d3648388dd872b49f4407f3e576d5715adc87b4dfa04b3e6f429830",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXvsNative/mtlxFiles/normalMap.png": "97cb0a805ac833250ef095d215bc6436292e7216a3a5554e75b563411f54d277",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXvsNative/nativeEmissive.usda": "2ccc63431b828795ccda62cf013f27cb7a9fc34706445afd843868dccfcc94e6",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXvsNative/nativeNormalMap.usda": "da0100dbd0d43a1cea24c59cb7d2c67fcb27cb967b4f05cfb4d9ab5d5252ac01",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLPointInstancer/ni_pi_xform.usda": "07276578178ad01a1e3b50095a1e671a68dba17e3008906fa227c8b64636783b",
+    "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLPointInstancer/pi_pi_xform.usda": "1f48e595090624941efa0d92f8eff0fcad8f17cab99f661db28fc7495b212efb",
+}
+
+# Not copied (too big for the repository; neither holds a light):
+# - testUsdLuxLightListAPI/teapot.usda (1.1 MB of mesh, referenced by root.usda as
+#   /World/Geo/teapot): replaced by OPENUSD_TEAPOT_STANDIN, a prim of the same name and type with
+#   nothing under it, so that the reference composes and every light is where it was.
+# - testUsdImagingGLMaterialXvsNative/StinsonBeach.hdr (1.4 MB, nativeEmissive.usda's dome
+#   texture): absent, so its inputs:texture:file resolves to nothing here, in usd-core as in
+#   luxeval (the expected JSON is usd-core's reading of the copy).
+OPENUSD_TEAPOT = "pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/teapot.usda"
+OPENUSD_TEAPOT_STANDIN = """#usda 1.0
+(
+    defaultPrim = "teapot_Base"
+    doc = "luxeval: a stand-in for OpenUSD's teapot.usda (1.1 MB of mesh, no light), written by tools/gen_usd_fixtures.py; the prim root.usda references, with nothing under it"
+)
+
+def Mesh "teapot_Base" (
+    kind = "model"
+)
+{
+}
+"""
+
+# (fixture name, scene): each becomes usd/expected/openusd_<name>.json.
+OPENUSD_SCENES = [
+    ("light_list_root", "pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/root.usda"),
+    ("light_list_root_with_instances", "pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/root_with_instances.usda"),
+    ("linking_example", "pxr/usd/usdLux/testenv/testUsdLuxLinkingAPI/linking_example.usda"),
+    ("usdview_light_visibility_varying", "pxr/usdImaging/bin/testusdview/testenv/testUsdviewLightVisibility/testVarying.usda"),
+    ("usdview_render_settings_edits", "pxr/usdImaging/bin/testusdview/testenv/testUsdviewRenderSettingsEdits/test.usda"),
+    ("usdrecord_motion_blur", "pxr/usdImaging/bin/usdrecord/testenv/MotionBlurTest/motionBlur.usda"),
+    ("delegate_inherited_primvars", "pxr/usdImaging/usdImaging/testenv/testUsdImagingDelegateChanges/inherited_primvars.usda"),
+    ("gl_animated_light_moving", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLAnimatedLights/lightMoving.usda"),
+    ("gl_dome_light_yup", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLDomeLight/domeLightYup.usda"),
+    ("gl_instanced_cubes", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLInstancing/instancedCubes.usda"),
+    ("gl_mx_lights", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXBasic/mxLights.usda"),
+    ("gl_native_emissive", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXvsNative/nativeEmissive.usda"),
+    ("gl_native_normal_map", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXvsNative/nativeNormalMap.usda"),
+    ("gl_point_instancer_ni_pi_xform", "pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLPointInstancer/ni_pi_xform.usda"),
+]
+
+OPENUSD_README = """\
+# OpenUSD light test scenes (third-party test data)
+
+Copied byte for byte from github.com/PixarAnimationStudios/OpenUSD at tag `{tag}` (commit
+`{commit}`), in the repository's own layout (`pxr/...` here is `pxr/...` there), by
+`tools/gen_usd_fixtures.py --only-openusd`, which checks every file's sha256. Licensed under the
+Tomorrow Open Source Technology License 1.0 (OpenUSD's `LICENSE.txt`, copied beside this file).
+
+They are luxeval's parity corpus (`tests/usd_parity.rs`): every light of every scene below must
+read as usd-core reads it (`../expected/openusd_<name>.json`, written by usd-core only).
+`tools/usd_parity.py` runs the same comparison over a whole OpenUSD checkout.
+
+| fixture | scene (path in OpenUSD) | lights | what it exercises |
+| --- | --- | --- | --- |
+{rows}
+
+Not copied (too big, and neither holds a light):
+
+- `pxr/usd/usdLux/testenv/testUsdLuxLightListAPI/teapot.usda` (1.1 MB of mesh, referenced by
+  `root.usda`): `teapot.usda` here is **our stand-in**, not OpenUSD's file: the prim `root.usda`
+  references (`Mesh "teapot_Base"`, the default prim) with nothing under it, so that the reference
+  composes and every light is where it was.
+- `pxr/usdImaging/usdImagingGL/testenv/testUsdImagingGLMaterialXvsNative/StinsonBeach.hdr`
+  (1.4 MB, the dome texture of `nativeEmissive.usda`): absent, so that light's
+  `inputs:texture:file` resolves to nothing here, in usd-core as in luxeval.
+"""
+
+OPENUSD_NOTES = {
+    "light_list_root": "a `//` comment (line 47); payloads and a reference (the teapot stand-in)",
+    "light_list_root_with_instances": "`root.usda` as a sublayer (its `//` comment), instanceable payloads: lights as instance proxies",
+    "linking_example": "8 sphere lights with light-link collections, a reference",
+    "usdview_light_visibility_varying": "time-sampled visibility, startTimeCode 1 to 10, most LightAPI inputs authored",
+    "usdview_render_settings_edits": "the `config` qualifier (line 94); `inputs:focus` on a RectLight without ShapingAPI",
+    "usdrecord_motion_blur": "time-sampled transforms, startTimeCode 1 to 10",
+    "delegate_inherited_primvars": "a rect light with most LightAPI inputs authored, startTimeCode 1",
+    "gl_animated_light_moving": "time-sampled transforms, startTimeCode 1 to 3",
+    "gl_dome_light_yup": "`asset inputs:texture:file = \"testImage.png\"`, an asset written as a string (line 53); startTimeCode 1",
+    "gl_instanced_cubes": "a dome texture that resolves (`lightGray.png`), instanceable prims",
+    "gl_mx_lights": "a reference to a MaterialX `.mtlx` layer (which pip's usd-core cannot open either: it composes the stage without it, with a warning); disk and distant lights",
+    "gl_native_emissive": "numbers written `0.` (line 62); its dome texture is not copied",
+    "gl_native_normal_map": "numbers written `.1` (line 101)",
+    "gl_point_instancer_ni_pi_xform": "a reference to another scene, instancing",
+}
 
 LIGHT_TYPES = {
     "DistantLight", "SphereLight", "DiskLight", "RectLight", "CylinderLight", "DomeLight",
@@ -716,6 +840,49 @@ def copy_luxtest(src):
     write(os.path.join(dst, "README.md"), LUXTEST_README)
 
 
+def openusd_bytes(rel, src, git_dir):
+    """One file of OpenUSD at OPENUSD_TAG: from the extracted tree `src` when it holds it, else
+    from the git repository `git_dir` (`git show TAG:path`)."""
+    path = os.path.join(src, rel)
+    if os.path.isfile(path):
+        with open(path, "rb") as f:
+            return f.read()
+    try:
+        return subprocess.run(["git", "-C", git_dir, "show", f"{OPENUSD_TAG}:{rel}"],
+                              check=True, capture_output=True).stdout
+    except (OSError, subprocess.CalledProcessError) as e:
+        sys.exit(f"{rel}: not in {src}, nor at {OPENUSD_TAG} in {git_dir} ({e})")
+
+
+def copy_openusd(src, git_dir):
+    dst = os.path.join(DATA, "usd", "openusd")
+    if os.path.isdir(dst):
+        shutil.rmtree(dst)
+    for rel, digest in sorted(OPENUSD_FILES.items()):
+        data = openusd_bytes(rel, src, git_dir)
+        got = hashlib.sha256(data).hexdigest()
+        if got != digest:
+            sys.exit(f"{rel}: sha256 {got} does not match the recorded {digest}")
+        write(os.path.join(dst, rel), data)
+    write(os.path.join(dst, OPENUSD_TEAPOT), OPENUSD_TEAPOT_STANDIN.encode("ascii"))
+    rows = []
+    for name, rel in OPENUSD_SCENES:
+        stage = Usd.Stage.Open(os.path.join(dst, rel))
+        types = sorted({str(p.GetTypeName()) for p in lights_of(stage)})
+        rows.append(f"| `{name}` | `{rel}` | {', '.join(types)} | {OPENUSD_NOTES[name]} |")
+    write(os.path.join(dst, "README.md"),
+          OPENUSD_README.format(tag=OPENUSD_TAG, commit=OPENUSD_COMMIT, rows="\n".join(rows)))
+
+
+def dump_openusd():
+    for name, rel in OPENUSD_SCENES:
+        layer = Sdf.Layer.FindOrOpen(os.path.join(DATA, "usd", "openusd", rel))
+        # Every integer frame a scene with startTimeCode and endTimeCode authors (its first is
+        # luxeval's default time), beside EarliestTime (the default of a scene without them).
+        dump("usd/openusd/" + rel, "openusd_" + name,
+             None if layer.HasStartTimeCode() and layer.HasEndTimeCode() else [])
+
+
 def write_composition():
     comp = os.path.join(DATA, "usd", "composition")
     if os.path.isdir(comp):
@@ -835,12 +1002,16 @@ def is_light(prim):
     return any(str(s) in LIGHT_APIS for s in prim.GetAppliedSchemas())
 
 
+def lights_of(stage):
+    return [p for p in stage.Traverse(Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)) if is_light(p)]
+
+
 def dump(scene_rel, out_name, times):
     path = os.path.join(DATA, scene_rel)
     stage = Usd.Stage.Open(path)
     if stage is None:
         sys.exit(f"cannot open {path}")
-    lights = [p for p in stage.Traverse(Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)) if is_light(p)]
+    lights = lights_of(stage)
     layer = stage.GetRootLayer()
     start = layer.startTimeCode if layer.HasStartTimeCode() else None
     end = layer.endTimeCode if layer.HasEndTimeCode() else None
@@ -1044,11 +1215,22 @@ def main():
                     help="write and dump only the ancestor-transform fixture (leaves the others as they are)")
     ap.add_argument("--only-reader", action="store_true",
                     help="write and dump only the text reader's fixture (leaves the others as they are)")
+    ap.add_argument("--openusd-src", default="/work/corpus/openusd-v24.08",
+                    help=f"an OpenUSD checkout (or extracted tree) at {OPENUSD_TAG}")
+    ap.add_argument("--openusd-git", default="/work/.mirror/PixarAnimationStudios+OpenUSD/repo",
+                    help="an OpenUSD git repository, for the files --openusd-src lacks (LICENSE.txt)")
+    ap.add_argument("--only-openusd", action="store_true",
+                    help="copy and dump only the OpenUSD parity corpus (leaves the others as they are)")
     args = ap.parse_args()
 
     if args.only_reader:
         write_reader()
         dump("usd/reader/forms.usda", "reader_forms", [0, 1])
+        return
+
+    if args.only_openusd:
+        copy_openusd(args.openusd_src, args.openusd_git)
+        dump_openusd()
         return
 
     if args.only_ancestors:
@@ -1074,6 +1256,8 @@ def main():
     dump("usd/ancestors/ancestors.usda", "ancestors", [0, 1, 2])
     write_reader()
     dump("usd/reader/forms.usda", "reader_forms", [0, 1])
+    copy_openusd(args.openusd_src, args.openusd_git)
+    dump_openusd()
 
 
 if __name__ == "__main__":
