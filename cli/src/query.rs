@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::io;
 use crate::io::npy::{self, RowKind};
 use crate::plot::polar;
-use luxeval::{Accumulate, Evaluator, Limits, PreparedScene, Reference};
+use luxeval::{Accumulate, Evaluator, PreparedScene, Reference};
 
 use crate::args::{QueryArgs, SceneArgs, ToleranceArg};
 use crate::exit::{CliResult, Failure, in_scene};
@@ -72,19 +72,19 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
     // are read, checked and evaluated chunk by chunk below (docs/INPUTS.md "Streaming").
     let mut readers = match query {
         Query::Emission { dirs } | Query::Intensity { dirs, .. } => {
-            vec![npy::Reader::open(dirs, RowKind::Directions)?]
+            vec![npy::Reader::open_streaming(dirs, RowKind::Directions)?]
         }
         Query::Radiance { points, dirs } => {
-            let p = npy::Reader::open(points, RowKind::Points)?;
-            let d = npy::Reader::open(dirs, RowKind::Directions)?;
+            let p = npy::Reader::open_streaming(points, RowKind::Points)?;
+            let d = npy::Reader::open_streaming(dirs, RowKind::Directions)?;
             same_rows(("--points", &p), ("--dirs", &d))?;
             vec![p, d]
         }
         Query::Irradiance {
             points, normals, ..
         } => {
-            let p = npy::Reader::open(points, RowKind::Points)?;
-            let n = npy::Reader::open(normals, RowKind::Directions)?;
+            let p = npy::Reader::open_streaming(points, RowKind::Points)?;
+            let n = npy::Reader::open_streaming(normals, RowKind::Directions)?;
             same_rows(("--points", &p), ("--normals", &n))?;
             vec![p, n]
         }
@@ -189,11 +189,20 @@ fn same_rows(a: (&str, &npy::Reader), b: (&str, &npy::Reader)) -> CliResult {
     Ok(())
 }
 
-/// `--per-light` writes lights × rows: bounded like any other array.
+/// The output is written chunk by chunk, never held (docs/INPUTS.md "Streaming"): any number of
+/// rows the disk holds, `--per-light`'s lights × rows included; only a size that does not fit a
+/// file's 64-bit length is refused.
 fn check_output_rows(scene: &PreparedScene, n: u64, per_light: bool) -> CliResult {
     let lights = if per_light { scene.len().max(1) } else { 1 };
-    let rows = (lights as u64).saturating_mul(n);
-    Limits::from_env()?.check_samples("the output (lights × rows)", rows)?;
+    if (lights as u64)
+        .checked_mul(n)
+        .and_then(|rows| rows.checked_mul(12))
+        .is_none()
+    {
+        return Err(Failure::bad_input(format!(
+            "the output ({lights} lights × {n} rows of 12 bytes) does not fit a 64-bit file size"
+        )));
+    }
     Ok(())
 }
 

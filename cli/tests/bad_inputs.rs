@@ -296,6 +296,27 @@ fn symlink_dirs(d: &Path) {
 fn hardlink_dirs(d: &Path) {
     std::fs::hard_link(d.join("dirs.npy"), d.join("hard.npy")).unwrap();
 }
+/// `{in}/many_dirs.npy`: 100 valid float32 directions (1 328 bytes), larger than the limits
+/// its case sets.
+fn many_dirs(d: &Path) {
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (100, 3), }";
+    let mut h = header.to_string();
+    while (10 + h.len() + 1) % 64 != 0 {
+        h.push(' ');
+    }
+    h.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(h.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(h.as_bytes());
+    for i in 0..100 {
+        let a = i as f32 * 0.37;
+        for v in [a.cos(), -0.5, a.sin()] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(d.join("many_dirs.npy"), bytes).unwrap();
+}
+
 fn fifo(d: &Path) {
     let p = std::ffi::CString::new(d.join("pipe").to_str().unwrap()).unwrap();
     // SAFETY: a valid C string.
@@ -448,8 +469,8 @@ cases! {
     points_f64_beyond_float32: Case { args: &["radiance", "{in}/ok.usda", "--points", "{in}/points_f64_huge.npy", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 2, says: &["points_f64_huge.npy", "row 1", "float32"], ..Case::default() };
 
     // --- Counts and sizes that overflow or exceed a limit; endless inputs -----------------------
-    npy_rows_times_size_wraps: Case { args: emission!("{in}/ok.usda", "{in}/npy_rows_wrap.npy"), exit: 2, says: &["npy_rows_wrap.npy", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
-    npy_rows_wrap_with_samples_unlimited: Case { args: emission!("{in}/ok.usda", "{in}/npy_rows_wrap.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "18446744073709551615")], says: &["npy_rows_wrap.npy", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
+    npy_rows_times_size_wraps: Case { args: emission!("{in}/ok.usda", "{in}/npy_rows_wrap.npy"), exit: 2, says: &["npy_rows_wrap.npy", "do not fit a 64-bit size"], ..Case::default() };
+    npy_rows_wrap_with_samples_unlimited: Case { args: emission!("{in}/ok.usda", "{in}/npy_rows_wrap.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "18446744073709551615")], says: &["npy_rows_wrap.npy", "do not fit a 64-bit size"], ..Case::default() };
     npy_more_rows_than_data: Case { args: emission!("{in}/ok.usda", "{in}/npy_more_rows_than_data.npy"), exit: 2, says: &["npy_more_rows_than_data.npy", "ends inside the data"], ..Case::default() };
     npy_trailing_data: Case { args: emission!("{in}/ok.usda", "{in}/npy_trailing_data.npy"), exit: 2, says: &["npy_trailing_data.npy", "more data"], ..Case::default() };
     npy_huge_header: Case { args: emission!("{in}/ok.usda", "{in}/npy_huge_header.npy"), exit: 2, says: &["npy_huge_header.npy", "header of"], ..Case::default() };
@@ -467,11 +488,14 @@ cases! {
     dirs_link_to_dev_zero: Case { args: emission!("{in}/ok.usda", "{in}/zero.npy"), exit: 2, says: &["zero.npy"], setup: Some(zero_dirs), ..Case::default() };
     scene_link_to_dev_zero: Case { args: emission!("{in}/zero.usda", "{in}/dirs.npy"), exit: 2, says: &["zero.usda", "not a regular file"], setup: Some(zero_scene), ..Case::default() };
     sublayer_link_to_dev_zero: Case { args: &["lights", "{in}/sublayer_zero.usda"], exit: 2, says: &["zero.usda", "sublayer_zero.usda"], setup: Some(zero_sublayer), ..Case::default() };
-    npy_over_file_limit: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "100")], says: &["dirs.npy", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
     scene_over_file_limit: Case { args: &["lights", "{in}/ok.usda"], exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "100")], says: &["ok.usda", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
     referenced_layer_over_file_limit: Case { args: &["lights", "{in}/references_big_layer.usda"], exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "1000")], says: &["big_layer.usda", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
-    rows_over_sample_limit: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "3")], says: &["dirs.npy", "4 rows", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
-    per_light_rows_over_sample_limit: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu", "--per-light"], exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "7")], says: &["lights × rows", "8 rows"], ..Case::default() };
+    // The query commands stream: the limits on rows and bytes bound what is held in memory,
+    // not what is read or written chunk by chunk (docs/INPUTS.md "Streaming").
+    streamed_rows_and_bytes_are_not_bounded_by_the_limits: Case { args: emission!("{in}/ok.usda", "{in}/many_dirs.npy"), exit: 0, env: &[("LUXEVAL_MAX_SAMPLES", "3"), ("LUXEVAL_MAX_FILE_BYTES", "300")], setup: Some(many_dirs), lit: true, ..Case::default() };
+    a_layer_over_the_file_limit_is_refused: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_FILE_BYTES", "100")], says: &["ok.usda", "LUXEVAL_MAX_FILE_BYTES"], ..Case::default() };
+    streamed_per_light_rows_are_not_bounded: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu", "--per-light"], exit: 0, env: &[("LUXEVAL_MAX_SAMPLES", "7")], lit: true, ..Case::default() };
+    held_rows_are_bounded_by_the_sample_limit: Case { args: &["falloff", "{in}/ok.usda", "--origin", "-1,0,-1", "--u", "2,0,0", "--v", "0,0,2", "--res", "4,2", "-o", "{out}/m.exr", "--device", "cpu"], exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "7")], says: &["--res", "8 rows", "LUXEVAL_MAX_SAMPLES"], ..Case::default() };
     limit_variable_not_a_number: Case { args: emission!("{in}/ok.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_SAMPLES", "lots")], says: &["LUXEVAL_MAX_SAMPLES", "\"lots\""], ..Case::default() };
 
     // --- Values of the wrong type, or NaN -------------------------------------------------------

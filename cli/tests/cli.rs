@@ -90,8 +90,14 @@ fn the_default_device_is_a_hardware_gpu_else_the_cpu() {
     assert_eq!(said, said_auto);
     if !hardware {
         let (_, cpu) = run("cpu.npy", &["--device", "cpu"]);
-        assert_eq!(default, cpu, "auto without a hardware adapter is the CPU reference");
-        let first = said.lines().find(|l| l.starts_with("warning:")).unwrap_or_default();
+        assert_eq!(
+            default, cpu,
+            "auto without a hardware adapter is the CPU reference"
+        );
+        let first = said
+            .lines()
+            .find(|l| l.starts_with("warning:"))
+            .unwrap_or_default();
         assert!(
             first.starts_with("warning: --device auto: the CPU reference:"),
             "{said}"

@@ -164,7 +164,11 @@ impl GpuContext {
             _ if hardware_only => {
                 let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
                 let named = |a: &wgpu::Adapter| {
-                    want.is_empty() || a.get_info().name.to_lowercase().contains(&want.to_lowercase())
+                    want.is_empty()
+                        || a.get_info()
+                            .name
+                            .to_lowercase()
+                            .contains(&want.to_lowercase())
                 };
                 let software: Vec<String> = adapters
                     .iter()

@@ -75,10 +75,23 @@ pub struct Reader {
 }
 
 impl Reader {
-    /// Opens `path` and reads and checks its header. For a regular file, a data size that
-    /// differs from what the header declares (a truncated file, trailing bytes) is refused
-    /// here, before any row is read; from a pipe it is refused when the stream ends.
+    /// Opens `path` and reads and checks its header, for an array that will be held whole: its
+    /// rows and bytes are bounded by [`Limits`]. For a regular file, a data size that differs
+    /// from what the header declares (a truncated file, trailing bytes) is refused here, before
+    /// any row is read; from a pipe it is refused when the stream ends.
     pub fn open(path: &Path, kind: RowKind) -> Result<Reader> {
+        Self::open_with(path, kind, false)
+    }
+
+    /// [`Reader::open`] for an array read chunk by chunk and never held (the query commands,
+    /// docs/INPUTS.md "Streaming"): any number of rows, since memory holds a few chunks whatever
+    /// the array's size. The limits still bound what would be held whole: a Fortran-order array
+    /// from a pipe, which cannot be read by columns.
+    pub fn open_streaming(path: &Path, kind: RowKind) -> Result<Reader> {
+        Self::open_with(path, kind, true)
+    }
+
+    fn open_with(path: &Path, kind: RowKind, streaming: bool) -> Result<Reader> {
         let limits = Limits::from_env()?;
         let io_err = |source| LuxError::Io {
             path: path.to_path_buf(),
@@ -92,7 +105,9 @@ impl Reader {
                 "is a directory, not a .npy file",
             )));
         }
-        if meta.is_file() && meta.len() > limits.max_file_bytes {
+        // What this reader will hold: the whole array unless it streams from a file or in C
+        // order (decided once the header is read); the file's size bounds it up front.
+        if !streaming && meta.is_file() && meta.len() > limits.max_file_bytes {
             return Err(format_err(
                 path,
                 format!(
@@ -141,25 +156,33 @@ impl Reader {
         let text =
             String::from_utf8(text).map_err(|_| format_err(path, "the header is not text"))?;
         let h = parse_header(&text).map_err(|why| format_err(path, format!("header {why}")))?;
-        limits.check_samples(&path.display().to_string(), h.rows)?;
+        let held_whole = !streaming || (h.fortran && !meta.is_file());
+        if held_whole {
+            limits.check_samples(&path.display().to_string(), h.rows)?;
+        }
         // Overflow-free: a header whose rows × 3 × itemsize wraps around is refused, not read as
         // empty.
-        let bytes = h
-            .rows
-            .checked_mul(3 * h.item as u64)
-            .filter(|b| *b <= limits.max_file_bytes)
-            .ok_or_else(|| {
-                format_err(
-                    path,
-                    format!(
-                        "{} rows of 3 × {} bytes exceed the limit of {} bytes ({})",
-                        h.rows,
-                        h.item,
-                        limits.max_file_bytes,
-                        Limits::raise_hint(Limits::ENV_MAX_FILE_BYTES)
-                    ),
-                )
-            })?;
+        let bytes = h.rows.checked_mul(3 * h.item as u64).ok_or_else(|| {
+            format_err(
+                path,
+                format!(
+                    "{} rows of 3 × {} bytes do not fit a 64-bit size",
+                    h.rows, h.item
+                ),
+            )
+        })?;
+        if held_whole && bytes > limits.max_file_bytes {
+            return Err(format_err(
+                path,
+                format!(
+                    "{} rows of 3 × {} bytes exceed the limit of {} bytes ({})",
+                    h.rows,
+                    h.item,
+                    limits.max_file_bytes,
+                    Limits::raise_hint(Limits::ENV_MAX_FILE_BYTES)
+                ),
+            ));
+        }
         let data = (8 + len_bytes + header_len) as u64;
         if meta.is_file() {
             // A regular file tells its size: a truncated or padded file is refused before any
