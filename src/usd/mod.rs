@@ -26,9 +26,11 @@ mod light;
 mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;
+mod unapplied;
 mod values;
 mod xform;
 
 pub use light::RefusedInput;
 pub use scene::{Stage, StageLight, TimeRule};
 pub use stage::{StageInfo, UsdStage};
+pub use unapplied::{LightList, LinkCollection};
