@@ -92,7 +92,9 @@ pub use query::lights_json;
 pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
 pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]
-pub use usd::{RefusedInput, Stage, StageInfo, StageLight, TimeRule, UsdStage};
+pub use usd::{
+    LightList, LinkCollection, RefusedInput, Stage, StageInfo, StageLight, TimeRule, UsdStage,
+};
 /// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
 /// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that
 /// the types match.

@@ -720,3 +720,140 @@ fn inputs_a_light_type_does_not_have_are_said_out_loud() {
     );
     assert!(!w.contains("karma"), "{w}");
 }
+
+/// usd-core composes a fixture scene's lights and light lists as these records; luxeval must
+/// report of them what its rule says (`StageLight::link_collections`: a collection that names a
+/// path, excludes the root or authors an expression).
+#[test]
+fn unapplied_scene_matches_usd_core() {
+    check_scene("unapplied");
+}
+
+/// What a renderer applies and luxeval does not (light filters, light-link and shadow-link
+/// collections, shaping inputs without ShapingAPI, light lists) is reported as usd-core
+/// composes it: targets folded across layers, mapped through a reference and into an instance.
+/// The expectations are usd-core's raw records (tools/gen_usd_fixtures.py --only-unapplied);
+/// only the rule of which collections say something is applied here.
+#[test]
+fn filters_links_and_light_lists_match_usd_core() {
+    let exp = expected("unapplied_links");
+    let path = data().join(exp["scene"].as_str().unwrap());
+    let strings = |v: &Json| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap().to_string())
+            .collect()
+    };
+    let mut problems = Vec::new();
+    for sample in exp["samples"].as_array().unwrap() {
+        let time = sample["time"].as_f64();
+        let ctx = format!("unapplied @ {time:?}");
+        let stage = Stage::load(&path, time).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+        let theirs = exp["lights"].as_array().unwrap();
+        assert_eq!(stage.lights.len(), theirs.len(), "{ctx}");
+        for (ours, t) in stage.lights.iter().zip(theirs) {
+            let mut bad = |what: String| problems.push(format!("{ctx} {}: {what}", ours.path));
+            assert_eq!(ours.path, t["path"].as_str().unwrap(), "{ctx}");
+            if ours.light_filters != strings(&t["filters"]) {
+                bad(format!(
+                    "light:filters {:?} vs usd-core {}",
+                    ours.light_filters, t["filters"]
+                ));
+            }
+            let said: Vec<Json> = t["collections"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|c| {
+                    c["include_root"] == false
+                        || !c["includes"].as_array().unwrap().is_empty()
+                        || !c["excludes"].as_array().unwrap().is_empty()
+                        || !c["membership_expression"].is_null()
+                })
+                .map(|c| {
+                    serde_json::json!({
+                        "name": c["name"],
+                        "include_root": c["include_root"],
+                        "includes": c["includes"],
+                        "excludes": c["excludes"],
+                        "expansion_rule": c["expansion_rule"],
+                        "membership_expression": c["membership_expression"],
+                    })
+                })
+                .collect();
+            let ours_said = serde_json::to_value(&ours.link_collections).unwrap();
+            if ours_said != Json::Array(said.clone()) {
+                bad(format!(
+                    "link collections {ours_said} vs usd-core {}",
+                    Json::Array(said)
+                ));
+            }
+            let mut shaping = match t["shaping_api"].as_bool().unwrap() {
+                true => Vec::new(),
+                false => strings(&t["authored_shaping_inputs"]),
+            };
+            shaping.sort();
+            let mut ours_shaping = ours.shaping_without_api.clone();
+            ours_shaping.sort();
+            if ours_shaping != shaping {
+                bad(format!(
+                    "shaping without ShapingAPI {ours_shaping:?} vs usd-core {shaping:?}"
+                ));
+            }
+        }
+        let lists = serde_json::to_value(&stage.light_lists).unwrap();
+        if lists != sample["light_lists"] {
+            problems.push(format!(
+                "{ctx}: light lists {lists} vs usd-core {}",
+                sample["light_lists"]
+            ));
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "{} mismatches with usd-core:\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
+
+    // The fixture holds every case: each kind reported somewhere, a light with ShapingAPI and
+    // authored shaping inputs reported for nothing, and lights that author empty or
+    // unrestricting collections (`Quiet`) reported for nothing.
+    let stage = Stage::load(&path, None).unwrap();
+    let light = |p: &str| stage.lights.iter().find(|l| l.path == p).unwrap();
+    assert!(!light("/World/Filtered").light_filters.is_empty());
+    assert!(!light("/World/Linked").link_collections.is_empty());
+    assert!(!light("/World/UnshapedSpot").shaping_without_api.is_empty());
+    for quiet in ["/World/ShapedSpot", "/World/Quiet"] {
+        let l = light(quiet);
+        assert!(
+            l.light_filters.is_empty()
+                && l.link_collections.is_empty()
+                && l.shaping_without_api.is_empty()
+                && l.warning.is_none(),
+            "{l:?}"
+        );
+    }
+    assert!(
+        light("/World/ShapedSpot")
+            .light
+            .as_ref()
+            .unwrap()
+            .shaping
+            .is_some()
+    );
+    // Unshaped: the inputs are not part of the light, and the light says so.
+    let spot = light("/World/UnshapedSpot");
+    assert!(spot.light.as_ref().unwrap().shaping.is_none());
+    let w = spot.warning.as_deref().unwrap();
+    assert!(
+        w.contains("inputs:shaping:cone:angle") && w.contains("ShapingAPI is not applied"),
+        "{w}"
+    );
+    assert!(
+        !w.contains("has no such input"),
+        "said once, not as a stray input: {w}"
+    );
+    assert!(stage.light_lists.len() > 1);
+}

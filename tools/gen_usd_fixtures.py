@@ -29,6 +29,10 @@ What it writes, all under tests/data/:
 - usd/expected/*.json: what usd-core resolves for every light of every scene above, at every time
   code the scene authors and under the EarliestTime rule: type, applied schemas, visibility, world
   matrix, and every scalar input with its value, authored flag and resolved asset path.
+- usd/unapplied/ (``--only-unapplied``): lights with light filters, light-link and shadow-link
+  collections, shaping inputs without ShapingAPI, and ListAPI / LightListAPI light lists, some
+  through a reference and an instance; usd/expected/unapplied_links.json holds what usd-core
+  composes for them (targets, collection attributes, authored shaping inputs, light lists).
 """
 
 import argparse
@@ -42,7 +46,7 @@ import sys
 import zipfile
 import zlib
 
-from pxr import Sdf, Usd, UsdGeom, UsdUtils
+from pxr import Sdf, Usd, UsdGeom, UsdLux, UsdUtils
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
@@ -1208,6 +1212,249 @@ def write_ancestors():
     write(os.path.join(DATA, "usd", "ancestors", "ancestors.usda"), ANCESTORS_USDA.encode("ascii"))
 
 
+# What luxeval reads and does not apply (tests/usd_fixtures.rs "unapplied"): light filters, link
+# collections (some that restrict, some that say nothing: an explicit empty list, includeRoot
+# authored true), shaping inputs with and without ShapingAPI, light lists with and without their
+# API, and targets that usd-core maps through a reference (list edits folded) and into an
+# instance.
+UNAPPLIED_RIG_USDA = """#usda 1.0
+
+def Xform "Rig"
+{
+    def LightFilter "Gobo"
+    {
+    }
+
+    def SphereLight "Key"
+    {
+        rel light:filters = </Rig/Gobo>
+        rel collection:lightLink:includes = </Rig/Prop>
+    }
+
+    def Xform "Prop"
+    {
+    }
+}
+"""
+
+UNAPPLIED_USDA = """#usda 1.0
+(
+    startTimeCode = 0
+    endTimeCode = 1
+)
+
+def Xform "World" (
+    prepend apiSchemas = ["ListAPI"]
+)
+{
+    rel lightList = [</World/Filtered>, </World/Linked>, </World/Rig/Key>]
+    token lightList:cacheBehavior.timeSamples = {
+        0: "consumeAndHalt",
+        1: "consumeAndContinue",
+    }
+
+    def LightFilter "Gobo"
+    {
+    }
+
+    def LightFilter "Barn"
+    {
+    }
+
+    def SphereLight "Filtered"
+    {
+        rel light:filters = [</World/Gobo>, </World/Barn>]
+    }
+
+    def RectLight "Linked"
+    {
+        uniform bool collection:lightLink:includeRoot = 0
+        rel collection:lightLink:includes = </World/Geo/Floor>
+        rel collection:lightLink:excludes = </World/Geo/Floor/Tile>
+        uniform token collection:lightLink:expansionRule = "explicitOnly"
+        rel collection:shadowLink:excludes = </World/Geo/Wall>
+    }
+
+    def DiskLight "RootOff"
+    {
+        uniform bool collection:shadowLink:includeRoot = 0
+    }
+
+    def SphereLight "Expr"
+    {
+        uniform pathExpression collection:lightLink:membershipExpression = "/World/Geo/Floor//"
+    }
+
+    def SphereLight "Quiet"
+    {
+        uniform bool collection:lightLink:includeRoot = 1
+        rel collection:lightLink:includes = None
+        rel collection:shadowLink:excludes = []
+        rel light:filters = []
+    }
+
+    def DiskLight "UnshapedSpot"
+    {
+        float inputs:intensity = 5
+        float inputs:shaping:cone:angle = 30
+        float inputs:shaping:cone:softness = 0.2
+    }
+
+    def DiskLight "ShapedSpot" (
+        prepend apiSchemas = ["ShapingAPI"]
+    )
+    {
+        float inputs:shaping:cone:angle = 30
+        float inputs:shaping:focus = 2
+    }
+
+    def Xform "Rig" (
+        prepend references = @rig.usda@</Rig>
+    )
+    {
+        over "Key"
+        {
+            prepend rel light:filters = </World/Barn>
+            delete rel collection:lightLink:includes = </World/Rig/Prop>
+            prepend rel collection:lightLink:excludes = </World/Geo/Wall>
+        }
+    }
+
+    def Xform "Inst" (
+        instanceable = true
+        prepend references = @rig.usda@</Rig>
+    )
+    {
+    }
+
+    def Scope "Geo"
+    {
+        def Xform "Floor"
+        {
+            def Xform "Tile"
+            {
+            }
+        }
+
+        def Xform "Wall"
+        {
+        }
+    }
+}
+
+def Scope "Lists" (
+    prepend apiSchemas = ["LightListAPI"]
+)
+{
+    rel lightList = </World/Linked>
+}
+
+def Scope "Bare"
+{
+    token lightList:cacheBehavior = "ignore"
+}
+"""
+
+UNAPPLIED_TIMES = [0, 1]
+
+
+def write_unapplied():
+    d = os.path.join(DATA, "usd", "unapplied")
+    write(os.path.join(d, "unapplied.usda"), UNAPPLIED_USDA.encode("ascii"))
+    write(os.path.join(d, "rig.usda"), UNAPPLIED_RIG_USDA.encode("ascii"))
+
+
+def targets(rel):
+    return [str(p) for p in rel.GetTargets()] if rel else []
+
+
+def link_record(coll):
+    """Everything usd-core composes for one of a light's link collections (UsdCollectionAPI)."""
+    include_root = coll.GetIncludeRootAttr()
+    expression = coll.GetMembershipExpressionAttr()
+    return {
+        "name": coll.GetName(),
+        "include_root": bool(include_root.Get()),
+        "include_root_authored": bool(include_root.HasAuthoredValue()),
+        "includes": targets(coll.GetIncludesRel()),
+        "includes_authored": bool(coll.GetIncludesRel().HasAuthoredTargets()),
+        "excludes": targets(coll.GetExcludesRel()),
+        "excludes_authored": bool(coll.GetExcludesRel().HasAuthoredTargets()),
+        "expansion_rule": str(coll.GetExpansionRuleAttr().Get()),
+        "membership_expression": (
+            expression.Get().GetText() if expression.HasAuthoredValue() else None
+        ),
+    }
+
+
+def dump_unapplied(scene_rel, out_name, times):
+    """What usd-core composes for what luxeval reads and does not apply: every light's
+    ``light:filters`` targets, both link collections, its authored ``inputs:shaping:*`` and
+    whether ShapingAPI is applied; every prim's light list (ListAPI / LightListAPI applied, or
+    ``lightList`` / ``lightList:cacheBehavior`` authored) at each time. Raw data: which of it
+    luxeval reports is luxeval's rule, applied by the test to these records."""
+    path = os.path.join(DATA, scene_rel)
+    stage = Usd.Stage.Open(path)
+    if stage is None:
+        sys.exit(f"cannot open {path}")
+    prims = list(stage.Traverse(Usd.TraverseInstanceProxies(Usd.PrimDefaultPredicate)))
+    lights = []
+    for p in prims:
+        if not is_light(p):
+            continue
+        light = UsdLux.LightAPI(p)
+        lights.append({
+            "path": str(p.GetPath()),
+            "filters": targets(light.GetFiltersRel()),
+            "collections": [
+                link_record(light.GetLightLinkCollectionAPI()),
+                link_record(light.GetShadowLinkCollectionAPI()),
+            ],
+            "shaping_api": bool(p.HasAPI(UsdLux.ShapingAPI)),
+            "authored_shaping_inputs": [
+                a.GetName() for a in p.GetAuthoredAttributes()
+                if a.GetName().startswith("inputs:shaping:")
+            ],
+        })
+    samples = []
+    for t in [None] + list(times):
+        tc = Usd.TimeCode.EarliestTime() if t is None else Usd.TimeCode(t)
+        lists = []
+        for p in prims:
+            apis = [s for s in ("ListAPI", "LightListAPI") if s in p.GetAppliedSchemas()]
+            rel = p.GetRelationship("lightList")
+            behavior = p.GetAttribute("lightList:cacheBehavior")
+            if not (apis or (rel and rel.HasAuthoredTargets()) or (behavior and behavior.HasAuthoredValue())):
+                continue
+            value = behavior.Get(tc) if behavior else None
+            lists.append({
+                "path": str(p.GetPath()),
+                "api": apis[0] if apis else None,
+                "targets": targets(rel),
+                "cache_behavior": None if value is None else str(value),
+            })
+        samples.append({"time": t, "light_lists": lists})
+    out = {
+        "generator": "tools/gen_usd_fixtures.py",
+        "usd_version": ".".join(str(x) for x in Usd.GetVersion()),
+        "scene": scene_rel,
+        "lights": lights,
+        "samples": samples,
+    }
+    dst = os.path.join(DATA, "usd", "expected", out_name + ".json")
+    os.makedirs(os.path.dirname(dst), exist_ok=True)
+    with open(dst, "w") as f:
+        json.dump(out, f, indent=None, separators=(",", ":"))
+        f.write("\n")
+    print(f"{dst}: {len(lights)} lights, {len(samples[0]['light_lists'])} light lists x {len(samples)} times")
+
+
+def unapplied():
+    write_unapplied()
+    dump("usd/unapplied/unapplied.usda", "unapplied", UNAPPLIED_TIMES)
+    dump_unapplied("usd/unapplied/unapplied.usda", "unapplied_links", UNAPPLIED_TIMES)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--luxtest-src", default="/work/shared/data/luxtest", help="the research/data/luxtest copy")
@@ -1221,6 +1468,8 @@ def main():
                     help="an OpenUSD git repository, for the files --openusd-src lacks (LICENSE.txt)")
     ap.add_argument("--only-openusd", action="store_true",
                     help="copy and dump only the OpenUSD parity corpus (leaves the others as they are)")
+    ap.add_argument("--only-unapplied", action="store_true",
+                    help="write and dump only the filters / linking / light-list fixture (leaves the others as they are)")
     args = ap.parse_args()
 
     if args.only_reader:
@@ -1236,6 +1485,9 @@ def main():
     if args.only_ancestors:
         write_ancestors()
         dump("usd/ancestors/ancestors.usda", "ancestors", [0, 1, 2])
+        return
+    if args.only_unapplied:
+        unapplied()
         return
 
     copy_luxtest(args.luxtest_src)
@@ -1258,6 +1510,7 @@ def main():
     dump("usd/reader/forms.usda", "reader_forms", [0, 1])
     copy_openusd(args.openusd_src, args.openusd_git)
     dump_openusd()
+    unapplied()
 
 
 if __name__ == "__main__":

@@ -1,5 +1,7 @@
 //! `luxeval lights`: every light of a stage with its type, visibility, world matrix and every
-//! input, authored or the schema fallback.
+//! input, authored or the schema fallback; and what luxeval reads but does not apply (light
+//! filters, light-link and shadow-link collections, shaping inputs without ShapingAPI, the
+//! stage's light lists), said out loud.
 
 use std::path::Path;
 
@@ -38,6 +40,21 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
     for w in &scene.stage_warnings {
         outln!("  warning: {w}");
     }
+    for list in &scene.light_lists {
+        let api = list
+            .api
+            .as_deref()
+            .unwrap_or("no ListAPI / LightListAPI applied");
+        let targets = match list.targets.is_empty() {
+            true => "(no targets)".to_string(),
+            false => list.targets.join(", "),
+        };
+        outln!(
+            "  lightList on {} ({api}): {targets}; cacheBehavior {}  (not read: luxeval traverses the whole stage)",
+            list.path,
+            list.cache_behavior.as_deref().unwrap_or("(not authored)")
+        );
+    }
     for l in &scene.lights {
         let status = match (&l.light, l.visible) {
             (Some(_), true) => "evaluated",
@@ -50,6 +67,21 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
         }
         if let Some(w) = &l.warning {
             outln!("  warning: {w}");
+        }
+        if !l.light_filters.is_empty() {
+            outln!(
+                "  light:filters  {}  (not applied)",
+                l.light_filters.join(", ")
+            );
+        }
+        for c in &l.link_collections {
+            outln!("  collection:{}  {}  (not applied)", c.name, c.describe());
+        }
+        if !l.shaping_without_api.is_empty() {
+            outln!(
+                "  without ShapingAPI  {}  (not part of the light: evaluated unshaped)",
+                l.shaping_without_api.join(", ")
+            );
         }
         let power = power(l);
         if let Ok((_, Some(w))) = &power {

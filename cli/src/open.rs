@@ -25,6 +25,11 @@ fn lights_and_layers(args: &SceneArgs) -> CliResult<(Vec<Light>, Vec<PathBuf>)> 
         e @ LuxError::InvalidAttribute { .. } => in_scene(&args.scene, e),
         e => e.into(),
     })?;
+    // One line for everything a renderer would apply and luxeval does not (filters, linking,
+    // shaping inputs without ShapingAPI, light lists); `luxeval lights` lists each.
+    if let Some(w) = scene.unapplied(&args.lights) {
+        eprintln!("warning: {}: {w}", args.scene.display());
+    }
     for l in &mut lights {
         l.validate().map_err(|e| in_scene(&args.scene, e))?;
         if let Some(t) = &mut l.texture {

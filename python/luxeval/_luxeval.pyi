@@ -63,7 +63,16 @@ class Stage:
     @property
     def lights(self) -> list[dict[str, Any]]:
         """Every light of the stage in traversal order, as the records of
-        ``luxeval lights --json``. A new list on each access."""
+        ``luxeval lights --json`` (with ``light_filters``, ``link_collections`` and
+        ``shaping_without_api``: read, not applied). A new list on each access."""
+    @property
+    def light_lists(self) -> list[dict[str, Any]]:
+        """The stage's light lists (ListAPI / LightListAPI; not read by luxeval): ``path``,
+        ``api``, ``targets``, ``cache_behavior``."""
+    @property
+    def unapplied(self) -> Optional[str]:
+        """One line on the light filters, link collections, shaping inputs without ShapingAPI
+        and light lists luxeval does not apply, or ``None``: the query commands' warning."""
     @property
     def warnings(self) -> list[str]:
         """One message per light the queries skip (unsupported, invisible), naming its prim."""

@@ -286,11 +286,38 @@ impl Stage {
     /// ``world`` (row-vector, ``world[3]`` is the translation), ``inputs`` (each with ``name``,
     /// ``value``, ``authored``), ``evaluable``, ``warning``, ``power`` (``rgb``, ``lumens``,
     /// ``watts``; ``None`` for lights at infinity or not evaluated) and, when the light cannot be
-    /// prepared, ``power_error``). A new list on each access.
+    /// prepared, ``power_error``; and what luxeval reads but does not apply: ``light_filters``
+    /// (the ``light:filters`` targets), ``link_collections`` (the light-link and shadow-link
+    /// collections that restrict the light, each with ``name``, ``include_root``,
+    /// ``includes``, ``excludes``, ``expansion_rule``, ``membership_expression``) and
+    /// ``shaping_without_api`` (``inputs:shaping:*`` authored without ShapingAPI: the light is
+    /// evaluated unshaped)). A new list on each access.
     #[getter]
     fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         py.import(intern!(py, "json"))?
             .call_method1(intern!(py, "loads"), (&self.lights_json,))
+    }
+
+    /// The stage's light lists (ListAPI / LightListAPI), which luxeval does not read (it
+    /// traverses the whole stage), as dicts: ``path``, ``api`` (``None`` where neither API is
+    /// applied), ``targets``, ``cache_behavior`` (``None`` where not authored). The
+    /// ``light_lists`` of ``luxeval lights --json``; a new list on each access.
+    #[getter]
+    fn light_lists<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = serde_json::to_string(&self.scene.light_lists).map_err(|e| {
+            errors::DeviceError::new_err(format!("serialising the light lists: {e}"))
+        })?;
+        py.import(intern!(py, "json"))?
+            .call_method1(intern!(py, "loads"), (text,))
+    }
+
+    /// What the stage's visible, evaluable lights have (light filters, light-link and
+    /// shadow-link collections, shaping inputs without ShapingAPI) and the stage (light lists)
+    /// that a renderer applies and luxeval does not, in one line, or ``None``: the warning
+    /// every ``luxeval`` query command prints (after ``warning: SCENE:``).
+    #[getter]
+    fn unapplied(&self) -> Option<String> {
+        self.scene.unapplied(&[])
     }
 
     /// One message per light that the queries skip (unsupported type or feature, invisible),

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import luxeval
-from helpers import LUXTEST, STUDIO, cli_query, floor_points, run_cli, sphere_dirs
+from helpers import LUXTEST, REPO, STUDIO, cli_query, floor_points, run_cli, sphere_dirs
 
 LUXTEST_SCENES = sorted(LUXTEST.glob("*.usda"))
 
@@ -184,3 +184,24 @@ def test_texture_filter_equals_cli(cli, tmp_path, device, texture_filter):
     assert not np.array_equal(
         got, stage.emission(dirs, per_light=True, device=device, texture_filter=other)
     )
+
+
+UNAPPLIED = REPO / "tests" / "data" / "usd" / "unapplied" / "unapplied.usda"
+
+
+def test_what_luxeval_does_not_apply_is_the_cli_s(cli, tmp_path):
+    # Light filters, link collections, shaping inputs without ShapingAPI and light lists: the
+    # fields of `luxeval lights --json`, and the one warning of a query command.
+    doc = json.loads(run_cli(cli, "lights", UNAPPLIED, "--json").stdout)
+    stage = luxeval.Stage(UNAPPLIED)
+    assert stage.lights == doc["lights"]
+    assert stage.light_lists == doc["light_lists"]
+    filtered = next(l for l in stage.lights if l["path"] == "/World/Filtered")
+    assert filtered["light_filters"] == ["/World/Gobo", "/World/Barn"]
+    assert [l["path"] for l in stage.light_lists] == ["/World", "/Lists", "/Bare"]
+    out = tmp_path / "e.npy"
+    np.save(tmp_path / "d.npy", sphere_dirs(8))
+    p = run_cli(cli, "emission", UNAPPLIED, "--dirs", tmp_path / "d.npy", "-o", out, "--device", "cpu")
+    assert stage.unapplied is not None
+    assert f"warning: {UNAPPLIED}: {stage.unapplied}" in p.stderr.splitlines()
+    assert luxeval.Stage(STUDIO).unapplied is None and luxeval.Stage(STUDIO).light_lists == []

@@ -217,12 +217,52 @@ pub(super) fn convert(
             p.stray_inputs.join(", ")
         ));
     }
+    caveats.extend(unapplied_caveats(p));
     let caveat = (!caveats.is_empty()).then(|| caveats.join("; "));
     let mut light = Light::new(kind).with_path(path.clone());
     light.inputs = inputs;
     light.shaping = shaping;
     light.texture = texture;
     Ok((light.with_usd_matrix(p.world).with_stage_up(up), caveat))
+}
+
+/// What the light authors that a renderer applies and luxeval does not, each said once
+/// (the paths are in [`super::StageLight`]'s typed fields, listed by `luxeval lights`).
+fn unapplied_caveats(p: &usd::LightPrim) -> Vec<String> {
+    let path = &p.path;
+    let x = &p.extras;
+    let mut out = Vec::new();
+    if !x.shaping_without_api.is_empty() {
+        // ShapingAPI's inputs belong to the prims it is applied to (spec/003 "API classes";
+        // DESIGN.md §2 "ShapingAPI not applied: no shaping").
+        out.push(format!(
+            "{path}: {} authored, but ShapingAPI is not applied, so they are not part of the \
+             light; evaluated unshaped (apply ShapingAPI to shape it)",
+            x.shaping_without_api.join(", ")
+        ));
+    }
+    let mut unapplied = Vec::new();
+    match x.filters.len() {
+        0 => {}
+        1 => unapplied.push("1 light filter (light:filters)".to_string()),
+        n => unapplied.push(format!("{n} light filters (light:filters)")),
+    }
+    for c in &x.link_collections {
+        let what = match c.name.as_str() {
+            "lightLink" => "light linking",
+            _ => "shadow linking",
+        };
+        unapplied.push(format!("{what} (collection:{})", c.name));
+    }
+    if !unapplied.is_empty() {
+        // luxeval lights every receiver with every light, unfiltered, and computes no shadows
+        // (DESIGN.md §2: lights do not occlude); a renderer applies these.
+        out.push(format!(
+            "{path}: not applied by luxeval: {}",
+            unapplied.join(", ")
+        ));
+    }
+    out
 }
 
 /// `inputs:texture:file`, `inputs:texture:format` (domes) and `poleAxis` (DomeLight_1), where
@@ -289,6 +329,7 @@ pub(super) mod tests {
             ],
             inputs,
             stray_inputs: Vec::new(),
+            extras: Default::default(),
         }
     }
 

@@ -12,6 +12,7 @@ use serde::Serialize;
 
 use super::light::{NotEvaluated, RefusedInput, convert};
 use super::stage::{self as usd, UsdStage};
+use super::unapplied::{LightList, LinkCollection};
 use crate::error::{LuxError, Result};
 use crate::model::{Input, Light, UpAxis};
 
@@ -50,6 +51,17 @@ pub struct StageLight {
     /// queries refuse the light (exit 2), naming the prim and the attribute, rather than skip it.
     #[serde(skip)]
     pub refusal: Option<RefusedInput>,
+    /// The targets of `light:filters`, as composed (spec/001 "light:filters"). luxeval does
+    /// not apply light filters: the light is evaluated unfiltered.
+    pub light_filters: Vec<String>,
+    /// The light-link and shadow-link collections that restrict the light (spec/000
+    /// "Linking"): those that name paths, exclude the root or author a membership expression.
+    /// luxeval does not apply them: every receiver is lit, and nothing casts shadows.
+    pub link_collections: Vec<LinkCollection>,
+    /// `inputs:shaping:*` authored on a light without ShapingAPI: not part of the light (its
+    /// schema does not have them), so luxeval evaluates it unshaped, as the schema says a
+    /// renderer must (DESIGN.md §2). Empty where ShapingAPI is applied.
+    pub shaping_without_api: Vec<String>,
 }
 
 fn serialize_is_some<S: serde::Serializer>(
@@ -73,6 +85,9 @@ pub struct Stage {
     /// What reading the stage says out loud ([`UsdStage::warnings`]): layers left out of the
     /// composition, values read differently from how they were written.
     pub stage_warnings: Vec<String>,
+    /// The light lists the stage authors (ListAPI / LightListAPI, spec/003), in traversal
+    /// order. luxeval does not read them: it traverses the whole stage.
+    pub light_lists: Vec<LightList>,
     /// Every file read to compose the stage (its layers and the packages holding them), the
     /// root layer first: what a command must never write over (DESIGN.md §4).
     #[serde(skip)]
@@ -165,6 +180,52 @@ impl Stage {
             });
         self.stage_warnings.iter().cloned().chain(lights).collect()
     }
+
+    /// One line saying what the lights a query evaluates (visible, evaluable, `select`ed as
+    /// [`Stage::evaluable`] selects them) and the stage author that a renderer applies and
+    /// luxeval does not (light filters, light-link and shadow-link collections, shaping inputs
+    /// without ShapingAPI, light lists), e.g. `2 lights have light filters, 1 has light-link
+    /// collections: not applied by luxeval (see `luxeval lights`)`; `None` when there is
+    /// nothing to say. The same text for the same stage on every run.
+    pub fn unapplied(&self, select: &[String]) -> Option<String> {
+        let evaluated: Vec<&StageLight> = self
+            .lights
+            .iter()
+            .filter(|l| select.is_empty() || select.contains(&l.path))
+            .filter(|l| l.visible && l.light.is_some())
+            .collect();
+        let count = |f: &dyn Fn(&StageLight) -> bool| evaluated.iter().filter(|l| f(l)).count();
+        let link = |l: &StageLight, name: &str| l.link_collections.iter().any(|c| c.name == name);
+        let counts = [
+            (count(&|l| !l.light_filters.is_empty()), "light filters"),
+            (count(&|l| link(l, "lightLink")), "light-link collections"),
+            (count(&|l| link(l, "shadowLink")), "shadow-link collections"),
+            (
+                count(&|l| !l.shaping_without_api.is_empty()),
+                "shaping inputs without ShapingAPI (evaluated unshaped)",
+            ),
+        ];
+        let mut parts: Vec<String> = Vec::new();
+        for (n, what) in counts.into_iter().filter(|(n, _)| *n > 0) {
+            parts.push(match (n, parts.is_empty()) {
+                (1, true) => format!("1 light has {what}"),
+                (n, true) => format!("{n} lights have {what}"),
+                (1, false) => format!("1 has {what}"),
+                (n, false) => format!("{n} have {what}"),
+            });
+        }
+        match self.light_lists.len() {
+            0 => {}
+            1 => parts.push("the stage has a light list (lightList)".to_string()),
+            n => parts.push(format!("the stage has {n} light lists (lightList)")),
+        }
+        (!parts.is_empty()).then(|| {
+            format!(
+                "{}: not applied by luxeval (see `luxeval lights`)",
+                parts.join(", ")
+            )
+        })
+    }
 }
 
 impl UsdStage {
@@ -209,6 +270,7 @@ impl UsdStage {
             time: rule,
             lights,
             stage_warnings: self.warnings().to_vec(),
+            light_lists: self.light_lists_at(at)?,
             files_read: self.files_read().to_vec(),
         })
     }
@@ -300,6 +362,9 @@ impl StageLight {
             light,
             warning,
             refusal,
+            light_filters: p.extras.filters,
+            link_collections: p.extras.link_collections,
+            shaping_without_api: p.extras.shaping_without_api,
         }
     }
 
@@ -330,6 +395,7 @@ mod tests {
                 hidden,
             ],
             stage_warnings: Vec::new(),
+            light_lists: Vec::new(),
             files_read: vec!["x.usda".into()],
         };
         let all = scene.evaluable(&[]).unwrap();
@@ -347,6 +413,49 @@ mod tests {
         assert_eq!(w.len(), 2, "{w:?}");
         assert!(w[0].contains("/Lights/PortalLight"));
         assert!(w[1].contains("/Lights/Hidden") && w[1].contains("invisible"));
+    }
+
+    /// The query warning counts the lights a query evaluates (not a skipped or invisible one),
+    /// says nothing when there is nothing, and adds the stage's light lists.
+    #[test]
+    fn unapplied_counts_the_evaluated_lights() {
+        let with_filter = |ty: &str, visible: bool| {
+            let mut l = StageLight::from_prim(prim(ty, &[]), UpAxis::Y);
+            l.light_filters = vec!["/F".into()];
+            l.visible = visible;
+            l
+        };
+        let mut scene = Stage {
+            file: "x.usda".into(),
+            up_axis: "Y".into(),
+            meters_per_unit: 0.01,
+            time: TimeRule::Earliest,
+            lights: vec![
+                StageLight::from_prim(prim("DiskLight", &[]), UpAxis::Y),
+                with_filter("PortalLight", true),
+                with_filter("SphereLight", false),
+            ],
+            light_lists: Vec::new(),
+            files_read: vec!["x.usda".into()],
+        };
+        assert_eq!(scene.unapplied(&[]), None);
+        scene.lights.push(with_filter("RectLight", true));
+        let tail = ": not applied by luxeval (see `luxeval lights`)";
+        assert_eq!(
+            scene.unapplied(&[]).unwrap(),
+            format!("1 light has light filters{tail}")
+        );
+        assert_eq!(scene.unapplied(&["/Lights/DiskLight".into()]), None);
+        scene.light_lists.push(LightList {
+            path: "/".into(),
+            api: None,
+            targets: Vec::new(),
+            cache_behavior: None,
+        });
+        assert_eq!(
+            scene.unapplied(&["/Lights/DiskLight".into()]).unwrap(),
+            format!("the stage has a light list (lightList){tail}")
+        );
     }
 
     #[test]

@@ -9,6 +9,7 @@ use openusd_schemas::geom::{XformCache, Xformable, XformableExt};
 use super::arcs::preflight;
 use super::diagnostics::{check_composition, open_error, stage_error};
 use super::resolver::LimitedResolver;
+use super::unapplied::{self, LightExtras, LightList, ListSite};
 use super::values::{convert, reject_spline, value_at, visible_at};
 use super::xform::{needs_own_xform, world_as_usd_core, xform_error};
 use crate::error::{LuxError, Result};
@@ -90,6 +91,8 @@ pub(crate) struct LightPrim {
     /// Authored inputs of another light schema that this light's schema does not have (e.g.
     /// `inputs:texture:file` on a SphereLight): not read, and said so.
     pub stray_inputs: Vec<String>,
+    /// Filters, link collections, shaping inputs without ShapingAPI: read, not applied, said so.
+    pub extras: LightExtras,
 }
 
 /// What does not change with time: found once at open.
@@ -102,6 +105,8 @@ struct LightSite {
     attrs: Vec<schema::SchemaAttr>,
     /// See [`LightPrim::stray_inputs`].
     stray_inputs: Vec<String>,
+    /// See [`LightPrim::extras`].
+    extras: LightExtras,
     /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
     /// usd-core between samples (see [`needs_own_xform`]); its world matrix is composed here.
     own_xform_chain: bool,
@@ -117,6 +122,8 @@ pub struct UsdStage {
     /// What was read differently from how it was written, or left out (see
     /// [`UsdStage::warnings`]).
     warnings: Vec<String>,
+    /// The prims that author a `lightList`, in traversal order.
+    light_lists: Vec<ListSite>,
     // Keeps the composed stage alive for the prim handles above.
     _stage: ousd::Stage,
 }
@@ -223,6 +230,7 @@ impl UsdStage {
         let mut warnings = check_composition(path, &stage)?;
 
         let mut lights = Vec::new();
+        let mut light_lists = Vec::new();
         let mut own_xform: HashMap<String, bool> = HashMap::new();
         for p in paths {
             let prim = stage.prim(&p).map_err(|err| e(err.into()))?;
@@ -237,6 +245,9 @@ impl UsdStage {
                 .iter()
                 .map(|t| t.as_str().to_string())
                 .collect();
+            if let Some(site) = unapplied::list_site(&prim, &applied_schemas).map_err(e)? {
+                light_lists.push(site);
+            }
             let light_api = if LIGHT_TYPES.contains(&usd_type.as_str()) {
                 None
             } else {
@@ -269,6 +280,10 @@ impl UsdStage {
                 })
                 .map(str::to_string)
                 .collect();
+            // Filters, link collections, shaping inputs without ShapingAPI (those are said on
+            // their own, not as stray inputs).
+            let extras = unapplied::light_extras(&prim, &applied_schemas).map_err(e)?;
+            let stray_inputs = extras.not_shaping(stray_inputs);
             let mut own_xform_chain = false;
             let mut cur = Some(prim.clone());
             while let Some(q) = cur.filter(|q| !q.path().is_abs_root()) {
@@ -299,6 +314,7 @@ impl UsdStage {
                 light_api,
                 attrs,
                 stray_inputs,
+                extras,
                 own_xform_chain,
             });
         }
@@ -319,6 +335,7 @@ impl UsdStage {
             info,
             lights,
             warnings,
+            light_lists,
             _stage: stage,
         })
     }
@@ -383,9 +400,20 @@ impl UsdStage {
                 transform_error,
                 inputs,
                 stray_inputs: site.stray_inputs.clone(),
+                extras: site.extras.clone(),
             });
         }
         Ok(out)
+    }
+
+    /// The light lists the stage authors (ListAPI / LightListAPI), in traversal order, read
+    /// at `time`.
+    pub(crate) fn light_lists_at(&self, time: Time) -> Result<Vec<LightList>> {
+        let tc = time.code();
+        self.light_lists
+            .iter()
+            .map(|s| unapplied::light_list(s, tc).map_err(|err| stage_error(&self.file, err)))
+            .collect()
     }
 
     /// One attribute at `tc`: its authored value converted to the kind of its table fallback,
