@@ -435,6 +435,7 @@ mod tests {
                 with_filter("PortalLight", true),
                 with_filter("SphereLight", false),
             ],
+            stage_warnings: Vec::new(),
             light_lists: Vec::new(),
             files_read: vec!["x.usda".into()],
         };
