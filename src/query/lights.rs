@@ -18,8 +18,13 @@ pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
             match Reference::new(light, TemperatureMode::default()) {
                 Ok(r) => {
                     json["power"] = serde_json::to_value(r.power())?;
-                    if let (Some(w), true) = (r.warning(), json["warning"].is_null()) {
-                        json["warning"] = w.into();
+                    // The light's own caveat (a filter it has, an input it lacks) and the
+                    // power's (a zero-size light evaluated as a point) are both said.
+                    if let Some(w) = r.warning() {
+                        json["warning"] = match json["warning"].as_str() {
+                            Some(own) if !own.is_empty() => format!("{own}; {w}").into(),
+                            _ => w.into(),
+                        };
                     }
                 }
                 Err(e) => json["power_error"] = e.to_string().into(),
