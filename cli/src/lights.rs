@@ -3,6 +3,7 @@
 //! filters, light-link and shadow-link collections, shaping inputs without ShapingAPI, the
 //! stage's light lists), said out loud.
 
+use std::fmt::Write;
 use std::path::Path;
 
 use luxeval::{Power, Reference, StageLight, TemperatureMode};
@@ -56,17 +57,26 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
         );
     }
     for l in &scene.lights {
+        // One write per light, not per line: stdout is line-buffered, and a stage of 100,000
+        // lights is 2.5 million lines.
+        let mut block = String::new();
+        // Writing to a String cannot fail.
+        macro_rules! put {
+            ($($arg:tt)*) => {{
+                let _ = writeln!(block, $($arg)*);
+            }};
+        }
         let status = match (&l.light, l.visible) {
             (Some(_), true) => "evaluated",
             (_, false) => "invisible: skipped",
             (None, true) => "not evaluated",
         };
-        outln!("\n{} ({}) [{}]", l.path, l.usd_type, status);
+        put!("\n{} ({}) [{}]", l.path, l.usd_type, status);
         if !l.applied_schemas.is_empty() {
-            outln!("  apiSchemas: {}", l.applied_schemas.join(", "));
+            put!("  apiSchemas: {}", l.applied_schemas.join(", "));
         }
         if let Some(w) = &l.warning {
-            outln!("  warning: {w}");
+            put!("  warning: {w}");
         }
         if !l.light_filters.is_empty() {
             outln!(
@@ -85,10 +95,10 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
         }
         let power = power(l);
         if let Ok((_, Some(w))) = &power {
-            outln!("  warning: {w}");
+            put!("  warning: {w}");
         }
         match power.map(|(p, _)| p) {
-            Ok(Some(p)) => outln!(
+            Ok(Some(p)) => put!(
                 "  power  {:.6} lm ({:.6} W at 683 lm/W; RGB flux ({:.6}, {:.6}, {:.6}))",
                 p.lumens,
                 p.watts,
@@ -97,10 +107,10 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
                 p.rgb[2]
             ),
             Ok(None) => {}
-            Err(e) => outln!("  power  cannot be computed: {e}"),
+            Err(e) => put!("  power  cannot be computed: {e}"),
         }
         for row in &l.world {
-            outln!(
+            put!(
                 "  world  {:>12.6} {:>12.6} {:>12.6} {:>12.6}",
                 row[0],
                 row[1],
@@ -109,13 +119,15 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
             );
         }
         for i in &l.inputs {
-            outln!(
+            put!(
                 "  {:<34} {}{}",
                 i.name,
                 i.value,
                 if i.authored { "" } else { "  (fallback)" }
             );
         }
+        block.pop();
+        outln!("{block}");
     }
     Ok(())
 }

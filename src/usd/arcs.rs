@@ -10,13 +10,20 @@
 //! Every file read (here and by openusd, layers and packages alike) goes through
 //! [`LimitedResolver`], which refuses what is not a regular file or exceeds the size limit.
 //!
+//! The stage is opened before the walk: opening only reads the root layer stack (the root and
+//! its sublayers, through that resolver, whose brace-depth check guards the text parser) and
+//! composes nothing, so the walk takes those layers from the stage instead of parsing them a
+//! second time (on a 100,000-light layer, parsing and freeing it again was most of the
+//! walk's time). Layers the stack does not hold (references, payloads) are read here.
+//!
 //! The walk is an upper bound, not a second composition engine: every variant of every variant
 //! set counts, arcs to the same prim are counted once per arc, implied inherits are ignored.
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 use openusd::ar::{self, Resolver};
 use openusd::sdf;
+use openusd::usd as ousd;
 
 use super::resolver::LimitedResolver;
 use crate::error::{LuxError, Result};
@@ -61,7 +68,15 @@ struct Metrics {
 /// walks the prims and arcs; refuses a cycle, a chain of arcs deeper than openusd composes, a
 /// namespace deeper than [`Limits::max_prim_depth`] and more prims than [`Limits::max_prims`].
 /// A layer that cannot be read is left for openusd to report when it composes.
-pub(super) fn preflight(file: &Path, resolver: &LimitedResolver, limits: &Limits) -> Result<()> {
+///
+/// `stage` is the stage opened from `file` and not yet composed (nothing traversed, no prim
+/// asked for): the layers it already holds are read from it.
+pub(super) fn preflight(
+    file: &Path,
+    resolver: &LimitedResolver,
+    limits: &Limits,
+    stage: &ousd::Stage,
+) -> Result<()> {
     let Some(root) = file.to_str() else {
         return Ok(());
     };
@@ -73,14 +88,19 @@ pub(super) fn preflight(file: &Path, resolver: &LimitedResolver, limits: &Limits
         if ids.contains_key(&id) {
             continue;
         }
-        let Ok(layer) = sdf::Layer::open_with(resolver.clone(), &id) else {
-            // openusd reports it (with its line) when it composes.
-            if layers.is_empty() {
-                return Ok(());
-            }
-            continue;
+        let specs = match stage.layer(&id) {
+            Some(layer) => read_specs(&layer, resolver),
+            None => match sdf::Layer::open_with(resolver.clone(), &id) {
+                Ok(layer) => read_specs(&layer, resolver),
+                Err(_) => {
+                    // openusd reports it (with its line) when it composes.
+                    if layers.is_empty() {
+                        return Ok(());
+                    }
+                    continue;
+                }
+            },
         };
-        let specs = read_specs(&layer, resolver);
         ids.insert(id.clone(), layers.len());
         for a in specs.arcs.values().flatten() {
             queue.push(a.stack.clone());
@@ -93,9 +113,12 @@ pub(super) fn preflight(file: &Path, resolver: &LimitedResolver, limits: &Limits
     // A layer stack by its root layer: the layer and its sublayers, strongest first.
     let stack_layers = |stack: usize| -> Vec<usize> {
         let mut out = Vec::new();
+        // A set sized by the stack, not by every layer read: a stage referencing thousands of
+        // asset layers computes one stack per layer.
+        let mut seen = HashSet::new();
         let mut todo = vec![stack];
         while let Some(l) = todo.pop() {
-            if out.contains(&l) {
+            if !seen.insert(l) {
                 continue;
             }
             out.push(l);
@@ -137,6 +160,10 @@ fn read_specs(layer: &sdf::Layer, resolver: &LimitedResolver) -> LayerSpecs {
             .and_then(|t| sdf::default_prim_path(t.as_str()));
     }
     let me = layer.identifier().to_string();
+    // Prims already listed as a child: the variant specs of one prim (`/A{v=x}B`, `/A{v=y}B`)
+    // strip to the same path. A set, not a scan of the parent's list, so that a parent with k
+    // children costs k, not k² (100,000 lights under one prim took minutes).
+    let mut listed: HashSet<sdf::Path> = HashSet::new();
     for p in data.spec_paths() {
         let kind = data.spec_type(&p);
         if !matches!(kind, Some(sdf::SpecType::Prim | sdf::SpecType::Variant)) {
@@ -145,11 +172,10 @@ fn read_specs(layer: &sdf::Layer, resolver: &LimitedResolver) -> LayerSpecs {
         let prim = p.strip_all_variant_selections();
         if kind == Some(sdf::SpecType::Prim)
             && let Some(parent) = prim.parent()
+            && !listed.contains(&prim)
         {
-            let kids = specs.children.entry(parent).or_default();
-            if !kids.contains(&prim) {
-                kids.push(prim.clone());
-            }
+            listed.insert(prim.clone());
+            specs.children.entry(parent).or_default().push(prim.clone());
         }
         let mut arcs = Vec::new();
         let field = |name: &str| data.try_field(&p, name).ok().flatten();
@@ -281,13 +307,15 @@ enum Edge {
 impl Walk<'_> {
     fn edges(&self, (stack, path): &Site) -> Vec<Edge> {
         let mut out: Vec<Edge> = Vec::new();
-        for &l in &self.stacks[*stack] {
+        let layers = &self.stacks[*stack];
+        // A child authored in several layers of the stack is one edge. Within one layer the
+        // children are already distinct, so a single-layer stack (the common case) needs no
+        // set; a set rather than a scan of `out` keeps a prim with k children at k, not k².
+        let mut seen: HashSet<&sdf::Path> = HashSet::new();
+        for &l in layers {
             let specs = &self.layers[l];
             for c in specs.children.get(path).into_iter().flatten() {
-                if !out
-                    .iter()
-                    .any(|e| matches!(e, Edge::Child((_, p)) if p == c))
-                {
+                if layers.len() == 1 || seen.insert(c) {
                     out.push(Edge::Child((*stack, c.clone())));
                 }
             }

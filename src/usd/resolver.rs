@@ -28,6 +28,7 @@ pub(super) struct LimitedResolver {
     /// What the text reader read differently from how it was written, each once, naming the
     /// layer and line.
     notes: Rc<RefCell<Vec<String>>>,
+    noted: Rc<RefCell<std::collections::HashSet<String>>>,
 }
 
 /// Text luxeval's reader cannot read: rendered as openusd renders its parse errors
@@ -61,6 +62,7 @@ impl LimitedResolver {
             max_braces: limits.max_prim_depth.saturating_mul(2).saturating_add(64),
             opened: Rc::default(),
             notes: Rc::default(),
+            noted: Rc::default(),
         }
     }
 
@@ -156,10 +158,12 @@ impl ar::Resolver for LimitedResolver {
                     },
                 )
             })?;
-            let mut notes = self.notes.borrow_mut();
+            // A layer read twice (the safety checks, then composition) notes the same once;
+            // a set keeps that linear in the notes.
+            let (mut notes, mut seen) = (self.notes.borrow_mut(), self.noted.borrow_mut());
             for n in read.notes {
                 let n = format!("{resolved_path}, {n}");
-                if !notes.contains(&n) {
+                if seen.insert(n.clone()) {
                     notes.push(n);
                 }
             }

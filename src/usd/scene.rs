@@ -111,10 +111,15 @@ impl Stage {
     ///
     /// The stage is read on a thread of its own with a large stack (512 MiB reserved, touched
     /// only as deep as the stage goes), so that a legal deep stage does not overflow the
-    /// caller's stack.
+    /// caller's stack. That thread frees the composed stage after handing the lights back.
     pub fn load(path: &Path, time: Option<f64>) -> Result<Stage> {
         check_time(time)?;
-        on_large_stack(path, || UsdStage::open(path)?.read(time))
+        let owned = path.to_path_buf();
+        on_large_stack(path, move || {
+            let usd = UsdStage::open(&owned)?;
+            let stage = usd.read(time)?;
+            Ok((stage, usd))
+        })
     }
 
     /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
@@ -285,39 +290,60 @@ impl UsdStage {
 /// the stack grows.
 pub const STACK_BYTES: usize = 512 << 20;
 
-/// Runs `f` on a scoped thread with a [`STACK_BYTES`] stack and returns what it returns. A
-/// panic on that thread becomes an error naming the stage: openusd 0.8 has debug assertions
-/// that malformed files reach (found by fuzz/: a `.usdc` whose path table builds an invalid
-/// variant path asserts in `sdf::Path::from_str_unchecked`), and a stage must never abort the
-/// process.
-fn on_large_stack<T: Send>(path: &Path, f: impl FnOnce() -> Result<T> + Send) -> Result<T> {
-    std::thread::scope(|s| {
-        let handle = std::thread::Builder::new()
-            .name("luxeval-stage".into())
-            .stack_size(STACK_BYTES)
-            .spawn_scoped(s, f);
-        match handle {
-            Ok(h) => match h.join() {
-                Ok(r) => r,
-                Err(panic) => {
-                    let msg = panic
-                        .downcast_ref::<String>()
-                        .map(String::as_str)
-                        .or_else(|| panic.downcast_ref::<&str>().copied())
-                        .unwrap_or("no message");
-                    Err(LuxError::input(
-                        path.display().to_string(),
-                        format!("the USD reader failed on this file (it panicked: {msg})"),
-                    ))
-                }
-            },
-            // No thread (out of memory or address space): read on this one.
-            Err(_) => Err(LuxError::input(
-                "stage",
-                "cannot start the thread that reads the stage (out of memory?)",
-            )),
-        }
-    })
+/// Runs `f` on a thread with a [`STACK_BYTES`] stack and returns the first of what it returns.
+/// The second, what `f` built to get there (the composed stage), is dropped on that thread
+/// after the first is handed back, while the caller goes on: freeing openusd's structures is
+/// about a second of CPU for a 100,000-light stage, which would otherwise be spent before the
+/// caller sees a light. The thread is not joined once it has answered.
+///
+/// A panic on that thread before it answers becomes an error naming the stage: openusd 0.8 has
+/// debug assertions that malformed files reach (found by fuzz/: a `.usdc` whose path table
+/// builds an invalid variant path asserts in `sdf::Path::from_str_unchecked`), and a stage must
+/// never abort the process.
+fn on_large_stack<T: Send + 'static, L>(
+    path: &Path,
+    f: impl FnOnce() -> Result<(T, L)> + Send + 'static,
+) -> Result<T> {
+    let (tx, rx) = std::sync::mpsc::sync_channel(1);
+    let handle = std::thread::Builder::new()
+        .name("luxeval-stage".into())
+        .stack_size(STACK_BYTES)
+        .spawn(move || match f() {
+            Ok((value, rest)) => {
+                // The receiver is gone only if the caller panicked; nothing is left to tell.
+                let _ = tx.send(Ok(value));
+                drop(rest);
+            }
+            Err(e) => {
+                let _ = tx.send(Err(e));
+            }
+        });
+    match handle {
+        Ok(h) => match rx.recv() {
+            Ok(r) => r,
+            // No answer: the thread panicked (its sender dropped while unwinding).
+            Err(_) => {
+                let panic = match h.join() {
+                    Err(panic) => panic,
+                    Ok(()) => Box::new("the reading thread ended without an answer"),
+                };
+                let msg = panic
+                    .downcast_ref::<String>()
+                    .map(String::as_str)
+                    .or_else(|| panic.downcast_ref::<&str>().copied())
+                    .unwrap_or("no message");
+                Err(LuxError::input(
+                    path.display().to_string(),
+                    format!("the USD reader failed on this file (it panicked: {msg})"),
+                ))
+            }
+        },
+        // No thread (out of memory or address space).
+        Err(_) => Err(LuxError::input(
+            "stage",
+            "cannot start the thread that reads the stage (out of memory?)",
+        )),
+    }
 }
 
 fn check_time(time: Option<f64>) -> Result<()> {

@@ -2,16 +2,18 @@
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
+use openusd::sdf;
 use openusd::usd::{self as ousd, PrimPredicate, TimeCode};
-use openusd_schemas::geom::{XformCache, Xformable, XformableExt};
+use openusd_schemas::geom::{Xformable, XformableExt};
 
 use super::arcs::preflight;
 use super::diagnostics::{check_composition, open_error, stage_error};
 use super::resolver::LimitedResolver;
 use super::unapplied::{self, LightExtras, LightList, ListSite};
 use super::values::{convert, reject_spline, value_at, visible_at};
-use super::xform::{needs_own_xform, world_as_usd_core, xform_error};
+use super::xform::{WorldCache, ops_need_own_xform, world_as_usd_core, xform_error};
 use crate::error::{LuxError, Result};
 use crate::limits::{ENV_MAX_FILE_BYTES, Limits, raise_hint};
 use crate::model::schema;
@@ -102,13 +104,19 @@ struct LightSite {
     usd_type: String,
     applied_schemas: Vec<String>,
     light_api: Option<String>,
-    attrs: Vec<schema::SchemaAttr>,
+    /// Shared by the lights of one type and set of applied schemas.
+    attrs: Rc<[schema::SchemaAttr]>,
+    /// Per attribute of `attrs`: whether a layer authors it (the prim's authored property
+    /// names hold it). One that none does has no value and no spline, and is read as its
+    /// fallback without asking openusd.
+    has_spec: Vec<bool>,
     /// See [`LightPrim::stray_inputs`].
     stray_inputs: Vec<String>,
     /// See [`LightPrim::extras`].
     extras: LightExtras,
     /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
-    /// usd-core between samples (see [`needs_own_xform`]); its world matrix is composed here.
+    /// usd-core between samples (see [`super::xform::needs_own_xform`]); its world matrix is
+    /// composed here.
     own_xform_chain: bool,
 }
 
@@ -175,13 +183,15 @@ impl UsdStage {
             reason: "the path is not valid UTF-8, which openusd requires".into(),
         })?;
         let resolver = LimitedResolver::new(&limits);
-        preflight(path, &resolver, &limits)?;
+        // Opening reads the root layer stack and composes nothing; the checks of `preflight`
+        // run before anything is composed, on the layers the stage has read.
         let stage = ousd::Stage::builder()
             .registry(openusd::sdf::LayerRegistry::new(Box::new(resolver.clone())))
             .schema_registry(openusd_schemas::schema_registry())
             .load(ousd::InitialLoadSet::LoadAll)
             .open(name)
             .map_err(|e| open_error(path, e))?;
+        preflight(path, &resolver, &limits, &stage)?;
         let e = |e: openusd::Error| stage_error(path, e);
 
         let up_axis = stage
@@ -231,7 +241,11 @@ impl UsdStage {
 
         let mut lights = Vec::new();
         let mut light_lists = Vec::new();
-        let mut own_xform: HashMap<String, bool> = HashMap::new();
+        // Per prim already walked: whether it or an ancestor has an op of `needs_own_xform`.
+        // A light's walk up stops at the first prim known, so each prim's ops are read once
+        // however many lights it holds.
+        let mut own_xform_chain_of: HashMap<sdf::Path, bool> = HashMap::new();
+        let mut attrs_of: HashMap<(String, Vec<String>), Rc<[schema::SchemaAttr]>> = HashMap::new();
         for p in paths {
             let prim = stage.prim(&p).map_err(|err| e(err.into()))?;
             let usd_type = prim
@@ -263,15 +277,24 @@ impl UsdStage {
                 }
             };
             let applied: Vec<&str> = applied_schemas.iter().map(String::as_str).collect();
-            let attrs = schema::attrs_for(&usd_type, &applied);
-            for a in &attrs {
+            let attrs = attrs_of
+                .entry((usd_type.clone(), applied_schemas.clone()))
+                .or_insert_with(|| schema::attrs_for(&usd_type, &applied).into())
+                .clone();
+            let authored = prim.authored_property_names().map_err(e)?;
+            // Only an attribute some layer authors can hold a value or a spline (openusd finds
+            // neither without a spec): the others are not asked about, which spares a typical
+            // light most of its per-attribute queries and the indexes openusd caches for them.
+            let has_spec: Vec<bool> = attrs
+                .iter()
+                .map(|a| authored.iter().any(|n| n.as_str() == a.name))
+                .collect();
+            for (a, _) in attrs.iter().zip(&has_spec).filter(|(_, s)| **s) {
                 reject_spline(&p, &prim.attribute(a.name))?;
             }
             // Inputs of the schema table that this light's schema lacks (a renderer's own
             // namespaced inputs are not the table's, so they pass without a word).
-            let stray_inputs: Vec<String> = prim
-                .authored_property_names()
-                .map_err(e)?
+            let stray_inputs: Vec<String> = authored
                 .iter()
                 .map(|t| t.as_str())
                 .filter(|n| {
@@ -284,27 +307,33 @@ impl UsdStage {
             // their own, not as stray inputs).
             let extras = unapplied::light_extras(&prim, &applied_schemas).map_err(e)?;
             let stray_inputs = extras.not_shaping(stray_inputs);
-            let mut own_xform_chain = false;
+            // The prims from the light up to the first one known, each with whether it has
+            // such an op itself; its ops are checked for splines on the way.
+            let mut walked: Vec<(sdf::Path, bool)> = Vec::new();
+            let mut above = false;
             let mut cur = Some(prim.clone());
             while let Some(q) = cur.filter(|q| !q.path().is_abs_root()) {
-                let key = q.path().to_string();
-                let own = match own_xform.get(&key) {
-                    Some(own) => *own,
-                    None => {
-                        if let Some(x) = Xformable::from_prim(q.clone()).map_err(e)? {
-                            let (ops, _) =
-                                x.ordered_xform_ops().map_err(|err| xform_error(&p, err))?;
-                            for op in &ops {
-                                reject_spline(&p, op.attribute())?;
-                            }
+                if let Some(&chain) = own_xform_chain_of.get(q.path()) {
+                    above = chain;
+                    break;
+                }
+                let own = match Xformable::from_prim(q.clone()).map_err(e)? {
+                    Some(x) => {
+                        let (ops, _) = x.ordered_xform_ops().map_err(|err| xform_error(&p, err))?;
+                        for op in &ops {
+                            reject_spline(&p, op.attribute())?;
                         }
-                        let own = needs_own_xform(&q).map_err(|err| xform_error(&p, err))?;
-                        own_xform.insert(key, own);
-                        own
+                        ops_need_own_xform(&ops).map_err(|err| xform_error(&p, err))?
                     }
+                    None => false,
                 };
-                own_xform_chain |= own;
+                walked.push((q.path().clone(), own));
                 cur = q.parent();
+            }
+            let mut own_xform_chain = above;
+            for (path, own) in walked.into_iter().rev() {
+                own_xform_chain |= own;
+                own_xform_chain_of.insert(path, own_xform_chain);
             }
             lights.push(LightSite {
                 path: p.to_string(),
@@ -313,6 +342,7 @@ impl UsdStage {
                 applied_schemas,
                 light_api,
                 attrs,
+                has_spec,
                 stray_inputs,
                 extras,
                 own_xform_chain,
@@ -366,13 +396,14 @@ impl UsdStage {
     pub(crate) fn lights_at(&self, time: Time) -> Result<Vec<LightPrim>> {
         let tc = time.code();
         let e = |err: openusd::Error| stage_error(&self.file, err);
-        let mut cache = XformCache::new(tc);
+        let mut cache = WorldCache::new(tc);
+        let mut visible_of = HashMap::new();
         let mut out = Vec::with_capacity(self.lights.len());
         for site in &self.lights {
-            let visible = visible_at(&site.prim, tc).map_err(e)?;
+            let visible = visible_at(&site.prim, tc, &mut visible_of).map_err(e)?;
             let world = match site.own_xform_chain {
-                false => cache.local_to_world_transform(&site.prim),
-                true => world_as_usd_core(&mut cache, &site.prim, tc),
+                false => cache.local_to_world(&site.prim),
+                true => world_as_usd_core(&cache, &site.prim, tc),
             };
             // One broken transform must not hide the stage's other lights: it is reported
             // with the light instead of failing the load.
@@ -387,8 +418,15 @@ impl UsdStage {
                 ),
             };
             let mut inputs = Vec::with_capacity(site.attrs.len());
-            for a in &site.attrs {
-                inputs.push(self.input(site, a, tc)?);
+            for (a, &has_spec) in site.attrs.iter().zip(&site.has_spec) {
+                inputs.push(match has_spec {
+                    true => self.input(site, a, tc)?,
+                    false => Input {
+                        name: a.name.to_string(),
+                        value: Value::fallback(a.fallback),
+                        authored: false,
+                    },
+                });
             }
             out.push(LightPrim {
                 path: site.path.clone(),

@@ -1,6 +1,8 @@
 //! Attribute values as usd-core resolves them: openusd's, except where openusd 0.8 gives other
 //! numbers (a sample held before a block), and refusing what it cannot evaluate (splines).
 
+use std::collections::HashMap;
+
 use openusd::sdf;
 use openusd::usd::{self as ousd, TimeCode};
 use openusd_schemas::geom::Imageable;
@@ -78,19 +80,41 @@ pub(super) fn held_before_block(samples: &sdf::TimeSampleMap, tc: TimeCode) -> O
 /// `visibility` as usd-core's `UsdGeomImageable::ComputeVisibility` resolves it: invisible when
 /// the prim or any imageable ancestor reads `invisible` at `tc` (values read with
 /// [`value_at`], so a sample held before a block counts as usd-core counts it).
-pub(super) fn visible_at(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<bool> {
+///
+/// `known` holds the answers found so far at `tc`, by prim path: the walk up from `prim` stops at
+/// the first prim already answered, so lights sharing ancestors read each ancestor's
+/// visibility once (a stage of n lights costs n walks of one or two steps, not n walks to the
+/// root). Every prim walked is answered: a prim is visible when it is and the prim the walk
+/// stopped at is. The prims are asked in the same order, bottom-up, as without `known`, and
+/// a prim answered visible was asked without error, so errors and answers are the same.
+pub(super) fn visible_at(
+    prim: &ousd::Prim,
+    tc: TimeCode,
+    known: &mut HashMap<sdf::Path, bool>,
+) -> openusd::Result<bool> {
+    let mut walked: Vec<sdf::Path> = Vec::new();
+    let mut visible = true;
     let mut cur = Some(prim.clone());
     while let Some(p) = cur.filter(|p| !p.path().is_abs_root()) {
+        if let Some(&v) = known.get(p.path()) {
+            visible = v;
+            break;
+        }
+        walked.push(p.path().clone());
         // An opinion on a prim that is not imageable (an untyped prim) is ignored, as in C++.
         if Imageable::from_prim(p.clone())?.is_some()
             && let Some(v) = value_at(&p.attribute("visibility"), tc)?
             && v.as_str() == Some("invisible")
         {
-            return Ok(false);
+            visible = false;
+            break;
         }
         cur = p.parent();
     }
-    Ok(true)
+    for path in walked {
+        known.insert(path, visible);
+    }
+    Ok(visible)
 }
 
 /// Converts an authored value to the kind the schema table gives the attribute. USD files do

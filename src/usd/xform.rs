@@ -2,10 +2,77 @@
 //! numbers: a time-sampled `orient` between samples ([`usd_slerp`], usd-core's `GfSlerp`) and an
 //! op held before a blocked sample ([`super::values::held_before_block`]).
 
+use std::collections::HashMap;
+
 use openusd::usd::{self as ousd, TimeCode};
 use openusd::{gf, sdf};
 use openusd_schemas::SchemaError;
-use openusd_schemas::geom::{XformCache, XformOp, XformOpKind, Xformable, XformableExt};
+use openusd_schemas::geom::{XformOp, XformOpKind, XformQuery, Xformable, XformableExt};
+
+/// Local-to-world matrices at one time, computed as openusd's `XformCache` computes them (its
+/// `ctm`: climb from the prim to the first ancestor whose matrix is known, one that resets the
+/// transform stack, or the pseudo-root, then fold `local * parent` back down), with the same
+/// products in the same order, so the same numbers. What differs is what is kept: only the
+/// matrices of the ancestors climbed through, by path. openusd's cache keeps every prim's ops
+/// as well (about 1 KiB a prim), though each light's own ops are needed once.
+pub(super) struct WorldCache {
+    time: TimeCode,
+    ancestors: HashMap<sdf::Path, gf::Matrix4d>,
+}
+
+impl WorldCache {
+    pub(super) fn new(time: TimeCode) -> Self {
+        WorldCache {
+            time,
+            ancestors: HashMap::new(),
+        }
+    }
+
+    /// `prim`'s local transform and whether it resets the transform stack (an identity that
+    /// does not reset for a prim that is not Xformable).
+    pub(super) fn local_transformation(
+        &self,
+        prim: &ousd::Prim,
+    ) -> std::result::Result<(gf::Matrix4d, bool), SchemaError> {
+        let query = XformQuery::for_prim(prim)?;
+        Ok((
+            query.local_transformation(self.time)?,
+            query.resets_xform_stack(),
+        ))
+    }
+
+    /// `prim`'s local-to-world transform, USD row-vector convention.
+    pub(super) fn local_to_world(
+        &mut self,
+        prim: &ousd::Prim,
+    ) -> std::result::Result<gf::Matrix4d, SchemaError> {
+        let mut base = gf::Matrix4d::IDENTITY;
+        let mut chain = Vec::new();
+        let mut current = Some(prim.clone());
+        while let Some(p) = current.filter(|p| !p.path().is_abs_root()) {
+            if let Some(ctm) = self.ancestors.get(p.path()) {
+                base = *ctm;
+                break;
+            }
+            let (local, resets) = self.local_transformation(&p)?;
+            // A prim that resets the stack ends the climb: its matrix is its local transform
+            // alone.
+            current = match resets {
+                true => None,
+                false => p.parent(),
+            };
+            chain.push((local, p));
+        }
+        for (i, (local, p)) in chain.into_iter().enumerate().rev() {
+            base = local * base;
+            // `prim` itself (i = 0) is not kept: a light is asked for once.
+            if i > 0 {
+                self.ancestors.insert(p.path().clone(), base);
+            }
+        }
+        Ok(base)
+    }
+}
 
 use super::values::{held_before_block, is_blocked};
 use crate::error::LuxError;
@@ -18,7 +85,12 @@ pub(super) fn needs_own_xform(prim: &ousd::Prim) -> std::result::Result<bool, Sc
         return Ok(false);
     };
     let (ops, _) = x.ordered_xform_ops()?;
-    for op in &ops {
+    ops_need_own_xform(&ops)
+}
+
+/// [`needs_own_xform`] of a prim whose ordered ops the caller has already read.
+pub(super) fn ops_need_own_xform(ops: &[XformOp]) -> std::result::Result<bool, SchemaError> {
+    for op in ops {
         let Some(samples) = op.attribute().time_samples()? else {
             continue;
         };
@@ -42,7 +114,7 @@ pub(super) fn xform_error(path: &sdf::Path, err: impl std::fmt::Display) -> LuxE
 /// openusd's XformCache does (row-vector, `local * parent`, stopping at `!resetXformStack!`),
 /// with the prims that own such an op evaluated by [`local_as_usd_core`].
 pub(super) fn world_as_usd_core(
-    cache: &mut XformCache,
+    cache: &WorldCache,
     prim: &ousd::Prim,
     tc: TimeCode,
 ) -> std::result::Result<gf::Matrix4d, SchemaError> {

@@ -1,0 +1,87 @@
+#!/usr/bin/env python3
+"""Writes a big light stage for the scaling measurements of BENCHMARKS.md ("Big stages", issue 24
+item 5): N plain SphereLights, PER_GROUP (default 4, or K) to an Xform, every Xform a child of one /World, so
+that both the number of prims and the number of siblings under one parent grow with N (the
+shape that made the reader quadratic).
+
+    python3 tools/gen_big_stage.py N OUT.usda [--instanced] [--per-group K]
+
+Plain (default): every light is authored in OUT.usda with its own intensity, color and radius.
+
+--instanced: the lights live in one asset layer (OUT's name with `_asset.usda`), PER_GROUP
+lights under its defaultPrim; each of the N / PER_GROUP Xforms of OUT.usda references it and is
+instanceable, so luxeval reads the lights as instance proxies. N must then be a multiple of
+PER_GROUP.
+
+Plain text, no usd-core needed; the output is deterministic. usd-core opens both (check with
+`python3 -c 'from pxr import Usd; Usd.Stage.Open("OUT.usda")'`)."""
+import os
+import sys
+
+PER_GROUP = 4  # set by --per-group
+
+
+def light(name, i, indent):
+    pad = " " * indent
+    return (
+        f'{pad}def SphereLight "{name}"\n'
+        f"{pad}{{\n"
+        f"{pad}    color3f inputs:color = ({0.5 + (i % 7) / 14:.4f}, 0.8, {1 - (i % 5) / 10:.4f})\n"
+        f"{pad}    float inputs:intensity = {1 + i % 100}\n"
+        f"{pad}    float inputs:radius = {0.05 + (i % 3) * 0.05:.2f}\n"
+        f"{pad}    double3 xformOp:translate = (0, {(i % PER_GROUP) * 0.5}, 0)\n"
+        f'{pad}    uniform token[] xformOpOrder = ["xformOp:translate"]\n'
+        f"{pad}}}\n"
+    )
+
+
+def group_open(g, meta=""):
+    x, z = g % 100, g // 100
+    return (
+        f'    def Xform "G{g}"{meta}\n'
+        "    {\n"
+        f"        double3 xformOp:translate = ({x * 2}, 0, {z * 2})\n"
+        '        uniform token[] xformOpOrder = ["xformOp:translate"]\n'
+    )
+
+
+def main():
+    global PER_GROUP
+    argv = sys.argv[1:]
+    if "--per-group" in argv:
+        k = argv.index("--per-group")
+        PER_GROUP = int(argv[k + 1])
+        del argv[k : k + 2]
+    args = [a for a in argv if not a.startswith("--")]
+    instanced = "--instanced" in argv
+    if len(args) != 2:
+        sys.exit(__doc__)
+    n, out = int(args[0]), args[1]
+    header = '#usda 1.0\n(\n    defaultPrim = "World"\n    metersPerUnit = 1\n    upAxis = "Y"\n)\n\n'
+    with open(out, "w") as f:
+        f.write(header)
+        f.write('def Xform "World"\n{\n')
+        if instanced:
+            if n % PER_GROUP:
+                sys.exit(f"--instanced: N must be a multiple of {PER_GROUP}")
+            asset = os.path.splitext(out)[0] + "_asset.usda"
+            with open(asset, "w") as a:
+                a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
+                for k in range(PER_GROUP):
+                    a.write(light(f"L{k}", k, 4))
+                a.write("}\n")
+            ref = os.path.basename(asset)
+            for g in range(n // PER_GROUP):
+                meta = f" (\n        instanceable = true\n        references = @./{ref}@\n    )"
+                f.write(group_open(g, meta) + "    }\n")
+        else:
+            for g in range((n + PER_GROUP - 1) // PER_GROUP):
+                f.write(group_open(g))
+                for k in range(min(PER_GROUP, n - g * PER_GROUP)):
+                    f.write(light(f"L{k}", g * PER_GROUP + k, 8))
+                f.write("    }\n")
+        f.write("}\n")
+
+
+if __name__ == "__main__":
+    main()
