@@ -79,16 +79,16 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
             put!("  warning: {w}");
         }
         if !l.light_filters.is_empty() {
-            outln!(
+            put!(
                 "  light:filters  {}  (not applied)",
                 l.light_filters.join(", ")
             );
         }
         for c in &l.link_collections {
-            outln!("  collection:{}  {}  (not applied)", c.name, c.describe());
+            put!("  collection:{}  {}  (not applied)", c.name, c.describe());
         }
         if !l.shaping_without_api.is_empty() {
-            outln!(
+            put!(
                 "  without ShapingAPI  {}  (not part of the light: evaluated unshaped)",
                 l.shaping_without_api.join(", ")
             );
