@@ -54,16 +54,18 @@ pub fn line_integral<R: Rule>(
         bps.extend(axis_approach(ctx.p.axis, a, e1).map(|xa| (xa, false)));
     }
     if let Some(ies) = &ctx.p.ies {
-        // The profile's grid lines, in the light's frame: the line maps to a line there.
+        // The profile's grid lines, in the light's frame: the line maps to a line there (only
+        // those that can meet the chart, when the chart has listed them).
+        let kinks = ctx.ies_kinks.as_ref().unwrap_or(&ies.kinks);
         let (al, el) = (ctx.p.to_local * a, ctx.p.to_local * e1);
-        for &(axis, cos) in &ies.kinks.cones {
+        for &(axis, cos) in &kinks.cones {
             bps.extend(
                 cone_roots_on_line(axis, cos, al, el)
                     .into_iter()
                     .map(|x| (x, false)),
             );
         }
-        for &m in &ies.kinks.planes {
+        for &m in &kinks.planes {
             let den = m.dot(el);
             if den != 0.0 {
                 bps.push((-m.dot(al) / den, false));

@@ -12,11 +12,12 @@
 
 use glam::DVec3;
 
-use super::chart::Chart;
+use super::chart::{Chart, Region};
 use super::line::line_integral;
 use super::pieces::{map_eval, piece_map, span, span_count};
 use super::{Ctx, Rule};
 use crate::prepare::Prepared;
+use crate::prepare::ies_kinks::IesKinks;
 
 /// The nearest singularity `y_foot ± i·width` of the outer integrand on the piece [y0, y1].
 ///
@@ -40,6 +41,60 @@ fn outer_pole(chart: &Chart, y0: f64, y1: f64) -> (f64, f64) {
     (y_foot, (h * h + (d * e1l).powi(2)).sqrt() * e1l / vv.sqrt())
 }
 
+/// The IES kink surfaces (cones and planes of light-space emission directions) that can meet a
+/// direction of the chart's region; None when the light has no profile or the region's
+/// directions are not bounded away from all directions.
+///
+/// In the light's frame the region's vectors are `w0 + X e1 + Y e2` with `|X e1 + Y e2| ≤ R`,
+/// so every direction lies within `α = asin(R/|w0|)` of `ŵ0`. A cone `−ŵ·axis = cos` whose
+/// angle differs from that of `−ŵ0` by more than α, or a plane whose angle with `ŵ0` exceeds
+/// α, has no point inside the region: its roots on every line of the chart lie outside the
+/// line's interval, where `line_integral` drops them. Dropping them here (with a margin of
+/// 1e-6 rad for rounding) spares the line integrals solving for them and changes no
+/// breakpoint: a small or distant light meets few of a profile's grid lines.
+pub fn chart_ies_kinks(p: &Prepared, chart: &Chart) -> Option<IesKinks> {
+    let ies = p.ies.as_ref()?;
+    let (w0, e1, e2) = (
+        p.to_local * chart.w0,
+        p.to_local * chart.e1,
+        p.to_local * chart.e2,
+    );
+    let r = match &chart.region {
+        Region::Square => e1.length() + e2.length(),
+        Region::Disk => (e1.length_squared() + e2.length_squared()).sqrt(),
+        Region::Cylinder(c) => {
+            // The X-interval is widest at Y = 0 (`Chart::x_interval`).
+            let (x0, x1) = chart.x_interval(0.0)?;
+            x0.abs().max(x1.abs()) * e1.length() + c.yg * e2.length()
+        }
+    };
+    let d = w0.length();
+    if !(r < 0.5 * d) || !r.is_finite() {
+        return None;
+    }
+    const MARGIN: f64 = 1e-6;
+    let alpha = (r / d).asin() + MARGIN;
+    let c = -w0 / d;
+    let cones = ies
+        .kinks
+        .cones
+        .iter()
+        .filter(|(axis, cos)| {
+            let theta_c = c.cross(*axis).length().atan2(c.dot(*axis));
+            (theta_c - cos.clamp(-1.0, 1.0).acos()).abs() <= alpha
+        })
+        .copied()
+        .collect();
+    let planes = ies
+        .kinks
+        .planes
+        .iter()
+        .filter(|m| (m.normalize().dot(c).abs().min(1.0)).asin() <= alpha)
+        .copied()
+        .collect();
+    Some(IesKinks { cones, planes })
+}
+
 /// `∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY` over the chart's region, split at `ys` (the critical
 /// Ys of `critical::critical_ys`, which include the ends of the region's Y-range).
 pub fn chart_integral<R: Rule>(
@@ -59,6 +114,7 @@ pub fn chart_integral<R: Rule>(
         unshaped: p.shaping.is_none() && tex.is_none(),
         rule,
         tex,
+        ies_kinks: chart_ies_kinks(p, chart),
     };
     let mut total = DVec3::ZERO;
     for w in ys.windows(2) {
@@ -110,6 +166,7 @@ pub fn line_irradiance<R: Rule>(
         unshaped: p.shaping.is_none(),
         rule,
         tex: None,
+        ies_kinks: None,
     };
     p.base * line_integral(&ctx, p.origin - x, m * DVec3::X, -hl, hl, 0.0) * weight
 }
