@@ -37,10 +37,10 @@ use std::f64::consts::PI;
 
 use super::quadrature::{Pair, Tolerance, integrate_with};
 use crate::model::LightType;
-use crate::prepare::Prepared;
+use crate::prepare::{Prepared, Profile};
 use chart::{Chart, Region, cylinder_chart, plane_chart, sphere_chart};
 use closed::{cap_irradiance, point_irradiance, rect_lambert, sphere_cap};
-use outer::{chart_integral, line_irradiance};
+use outer::{chart_integral, chart_integral_as, line_irradiance};
 
 /// irradiance at `x` for a receiver with unit normal `n`, `diffuse` applied, by the reference
 /// rule.
@@ -85,6 +85,12 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
         } => point_irradiance(p, x, n, radius),
         LightType::Sphere { radius, .. } => match (&p.shaping, p.similarity) {
             (None, Some(scale)) => p.base * sphere_cap(p.origin, radius * scale, x, n),
+            (Some(_), Some(scale))
+                if rule.shortcuts()
+                    && let Some(k) = sphere_uniform(p, x, radius * scale) =>
+            {
+                p.base * (k * sphere_cap(p.origin, radius * scale, x, n))
+            }
             _ => match sphere_chart(p, x, radius) {
                 Some(c) => chart_irradiance(p, &c, n, rule),
                 None => DVec3::ZERO,
@@ -96,6 +102,15 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
                 DVec3::ZERO
             } else if p.shaping.is_none() && p.rect_texture().is_none() {
                 p.base * rect_lambert(p, x, n, width / 2.0, height / 2.0)
+            } else if let Some(k) = (rule.shortcuts() && p.rect_texture().is_none())
+                .then(|| {
+                    let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
+                    outer::direction_cone(&c, c.w0, c.e1, c.e2)
+                        .and_then(|(d, alpha)| uniform_shaping(p, d, alpha))
+                })
+                .flatten()
+            {
+                p.base * (k * rect_lambert(p, x, n, width / 2.0, height / 2.0))
             } else {
                 let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
                 chart_irradiance(p, &c, n, rule)
@@ -125,6 +140,17 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
     e * p.light.inputs.diffuse
 }
 
+/// [`uniform_shaping`] for a sphere of world radius `r` (under a similarity) seen from x: its
+/// directions fill the cone of half-angle asin(r/d) around the centre's.
+fn sphere_uniform(p: &Prepared, x: DVec3, r: f64) -> Option<f64> {
+    let w = p.origin - x;
+    let d = w.length();
+    if !(d > r) {
+        return None;
+    }
+    uniform_shaping(p, w / d, (r / d).asin())
+}
+
 /// The chart integral times the base radiance.
 pub fn chart_irradiance<R: Rule>(p: &Prepared, chart: &Chart, n: DVec3, rule: &R) -> DVec3 {
     p.base * rule.chart(p, chart, n)
@@ -146,6 +172,10 @@ pub trait Rule {
     fn unshaped_closed_form(&self, tan_mapped: bool) -> bool {
         let _ = tan_mapped;
         true
+    }
+    /// Whether the exact per-receiver shortcuts of [`uniform_shaping`] are taken.
+    fn shortcuts(&self) -> bool {
+        false
     }
     /// The whole chart integral (the base radiance not applied).
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3
@@ -174,6 +204,10 @@ pub struct Adaptive {
     pub inner_pair: Pair,
     /// How the whole irradiance is estimated for `scale_fraction`.
     pub coarse: Coarse,
+    /// Take the exact per-receiver shortcuts of [`uniform_shaping`] (a shaping factor that is
+    /// exactly 0 or 1 on every direction the light is seen in): the value changes by rounding
+    /// only, but not bit for bit, so the reference does not.
+    pub shortcuts: bool,
 }
 
 /// The first, cheap pass that estimates the scale of the whole irradiance (only to set
@@ -208,6 +242,7 @@ impl Adaptive {
         outer_pair: Pair::Gk15,
         inner_pair: Pair::Gk15,
         coarse: Coarse::Adaptive,
+        shortcuts: false,
     };
 
     /// The rule for a relative tolerance `rel` of the whole irradiance (`luxeval irradiance
@@ -238,6 +273,7 @@ impl Adaptive {
             } else {
                 Coarse::Adaptive
             },
+            shortcuts: true,
         }
     }
 
@@ -257,6 +293,7 @@ impl Adaptive {
         outer_pair: Pair::Gk15,
         inner_pair: Pair::Gk15,
         coarse: Coarse::Adaptive,
+        shortcuts: false,
     };
 }
 
@@ -302,11 +339,30 @@ impl Rule for Adaptive {
         integrate_with(f, &[0.0, 1.0], self.inner, self.inner_pair)
     }
 
+    fn shortcuts(&self) -> bool {
+        self.shortcuts
+    }
+
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3 {
         if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
             return DVec3::ZERO;
         }
-        let ys = critical::critical_ys(p, chart, n);
+        let uniform = self.shortcuts
+            && p.rect_texture().is_none()
+            && match outer::direction_cone(chart, chart.w0, chart.e1, chart.e2) {
+                Some((c, alpha)) => match uniform_shaping(p, c, alpha) {
+                    Some(0.0) => return DVec3::ZERO,
+                    Some(_) => true,
+                    None => false,
+                },
+                None => false,
+            };
+        let unshaped_profile = Profile::new(None, p.axis);
+        let ys = if uniform {
+            critical::critical_ys_with(p, &unshaped_profile, chart, n)
+        } else {
+            critical::critical_ys(p, chart, n)
+        };
         let mut rule = *self;
         if p.ies.is_some() {
             // An IES profile's grid lines are breakpoints of every line but not of the outer
@@ -319,8 +375,8 @@ impl Rule for Adaptive {
             // The scale of the answer from a coarse pass; an inner error δ on every line moves
             // the outer integral by δ·jac·(Y extent).
             let scale = match self.coarse {
-                Coarse::Adaptive => chart_integral(p, chart, n, &ys, &Self::COARSE),
-                Coarse::Gauss3 => chart_integral(p, chart, n, &ys, &Gauss3),
+                Coarse::Adaptive => chart_integral_as(p, chart, n, &ys, &Self::COARSE, uniform),
+                Coarse::Gauss3 => chart_integral_as(p, chart, n, &ys, &Gauss3, uniform),
             };
             let scale = scale.abs().max_element();
             let extent = chart.jac * (ys[ys.len() - 1] - ys[0]);
@@ -329,8 +385,31 @@ impl Rule for Adaptive {
                 rule.inner.abs = self.scale_fraction * scale / extent;
             }
         }
-        chart_integral(p, chart, n, &ys, &rule)
+        chart_integral_as(p, chart, n, &ys, &rule, uniform)
     }
+}
+
+/// The shaping factor's value when it is exactly the same, 0 or 1, on every emission
+/// direction of a light seen from x within the cone of directions (unit `c` toward the light,
+/// half-angle `alpha`), else None. The emission directions are then within `alpha` of `−c`, so
+/// their angles θ off the primary axis lie within `alpha` of `−c`'s. With no IES profile and an
+/// inactive focus (focus ≤ 0 or a white tint: `lerp` gives exactly 1) the factor is the cone's
+/// `1 − smoothstep(θ; start, cone)`: exactly 1 for θ ≤ start and exactly 0 for θ > cone
+/// (`cpu::shaping`). A margin of 1e-9 rad covers the rounding of θ. The irradiance is then that
+/// of the unshaped light (closed forms, or the unshaped lines) or 0: exact, not a far-field
+/// approximation.
+pub fn uniform_shaping(p: &Prepared, c: DVec3, alpha: f64) -> Option<f64> {
+    const MARGIN: f64 = 1e-9;
+    let s = p.shaping.as_ref()?;
+    if p.ies.is_some() || !(alpha >= 0.0) {
+        return None;
+    }
+    let theta = crate::cpu::shaping::off_axis_angle(p.axis, -c);
+    if theta - alpha > s.cone + MARGIN {
+        return Some(0.0);
+    }
+    let focus_inactive = !(s.focus > 0.0) || s.focus_tint == DVec3::ONE;
+    (focus_inactive && theta + alpha + MARGIN < s.start && s.start <= s.cone).then_some(1.0)
 }
 
 /// Everything one line integral needs.

@@ -26,7 +26,7 @@ use super::chart::{Arc, Chart, Region, arc_at};
 use crate::cpu::roots::{
     bracket_roots, cone_roots_on_line, lin_trig_roots, plane_cone_dirs, wrap_into,
 };
-use crate::prepare::{Kink, Prepared};
+use crate::prepare::{Kink, Prepared, Profile};
 
 /// Samples per arc when bracketing the roots of a degree-2 trigonometric polynomial (the
 /// kernel uses `rules::IRR_ARC_SAMPLES`, fewer, for speed).
@@ -90,7 +90,12 @@ fn arc_f(arc: &Arc, axis: DVec3, cos: f64, t: f64) -> (f64, f64) {
 /// The Y values where the inner structure of the chart integral changes (see the module docs),
 /// sorted, within and including the region's Y-range.
 pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
-    let prof = &p.profile;
+    critical_ys_with(p, &p.profile, chart, n)
+}
+
+/// [`critical_ys`] for the shaping kinks of `prof` (an empty profile: a shaping factor that is
+/// uniform over the chart).
+pub fn critical_ys_with(p: &Prepared, prof: &Profile, chart: &Chart, n: DVec3) -> Vec<f64> {
     let axis = p.axis;
     let (ya, yb) = chart.y_range();
     let mut ys = vec![ya, yb];

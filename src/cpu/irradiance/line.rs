@@ -35,7 +35,13 @@ pub fn line_integral<R: Rule>(
     };
     // Breakpoints with their grading flag.
     let mut bps: Vec<(f64, bool)> = vec![(lo, false), (hi, false)];
-    for k in &ctx.p.profile.kinks {
+    // (An unshaped line has no shaping kinks; one whose factor is uniformly 1 ignores them.)
+    let kinks: &[Kink] = if ctx.unshaped {
+        &[]
+    } else {
+        &ctx.p.profile.kinks
+    };
+    for k in kinks {
         match *k {
             Kink::Cone { cos } => {
                 for xk in cone_roots_on_line(ctx.p.axis, cos, a, e1) {
@@ -50,7 +56,7 @@ pub fn line_integral<R: Rule>(
             }
         }
     }
-    if ctx.p.profile.axis_singular {
+    if ctx.p.profile.axis_singular && !ctx.unshaped {
         bps.extend(axis_approach(ctx.p.axis, a, e1).map(|xa| (xa, false)));
     }
     if let Some(ies) = &ctx.p.ies {

@@ -41,24 +41,12 @@ fn outer_pole(chart: &Chart, y0: f64, y1: f64) -> (f64, f64) {
     (y_foot, (h * h + (d * e1l).powi(2)).sqrt() * e1l / vv.sqrt())
 }
 
-/// The IES kink surfaces (cones and planes of light-space emission directions) that can meet a
-/// direction of the chart's region; None when the light has no profile or the region's
-/// directions are not bounded away from all directions.
-///
-/// In the light's frame the region's vectors are `w0 + X e1 + Y e2` with `|X e1 + Y e2| ≤ R`,
-/// so every direction lies within `α = asin(R/|w0|)` of `ŵ0`. A cone `−ŵ·axis = cos` whose
-/// angle differs from that of `−ŵ0` by more than α, or a plane whose angle with `ŵ0` exceeds
-/// α, has no point inside the region: its roots on every line of the chart lie outside the
-/// line's interval, where `line_integral` drops them. Dropping them here (with a margin of
-/// 1e-6 rad for rounding) spares the line integrals solving for them and changes no
-/// breakpoint: a small or distant light meets few of a profile's grid lines.
-pub fn chart_ies_kinks(p: &Prepared, chart: &Chart) -> Option<IesKinks> {
-    let ies = p.ies.as_ref()?;
-    let (w0, e1, e2) = (
-        p.to_local * chart.w0,
-        p.to_local * chart.e1,
-        p.to_local * chart.e2,
-    );
+/// A cone of directions that holds every direction of the chart's region, written with the
+/// vectors `w0, e1, e2` of the chart (world) or of its image under a linear map (the light's
+/// frame): (unit ŵ0, half-angle α). The region's vectors are `w0 + X e1 + Y e2` with
+/// `|X e1 + Y e2| ≤ R`, so every direction lies within `α = asin(R/|w0|)` of `ŵ0`. None when
+/// R is not below |w0|/2 (a bound that wide filters nothing).
+pub fn direction_cone(chart: &Chart, w0: DVec3, e1: DVec3, e2: DVec3) -> Option<(DVec3, f64)> {
     let r = match &chart.region {
         Region::Square => e1.length() + e2.length(),
         Region::Disk => (e1.length_squared() + e2.length_squared()).sqrt(),
@@ -72,9 +60,31 @@ pub fn chart_ies_kinks(p: &Prepared, chart: &Chart) -> Option<IesKinks> {
     if !(r < 0.5 * d) || !r.is_finite() {
         return None;
     }
+    Some((w0 / d, (r / d).asin()))
+}
+
+/// The IES kink surfaces (cones and planes of light-space emission directions) that can meet a
+/// direction of the chart's region; None when the light has no profile or the region's
+/// directions are not bounded away from all directions.
+///
+/// In the light's frame the region's vectors are `w0 + X e1 + Y e2` with `|X e1 + Y e2| ≤ R`,
+/// so every direction lies within `α = asin(R/|w0|)` of `ŵ0`. A cone `−ŵ·axis = cos` whose
+/// angle differs from that of `−ŵ0` by more than α, or a plane whose angle with `ŵ0` exceeds
+/// α, has no point inside the region: its roots on every line of the chart lie outside the
+/// line's interval, where `line_integral` drops them. Dropping them here (with a margin of
+/// 1e-6 rad for rounding) spares the line integrals solving for them and changes no
+/// breakpoint: a small or distant light meets few of a profile's grid lines.
+pub fn chart_ies_kinks(p: &Prepared, chart: &Chart) -> Option<IesKinks> {
+    let ies = p.ies.as_ref()?;
+    let (w0, alpha) = direction_cone(
+        chart,
+        p.to_local * chart.w0,
+        p.to_local * chart.e1,
+        p.to_local * chart.e2,
+    )?;
     const MARGIN: f64 = 1e-6;
-    let alpha = (r / d).asin() + MARGIN;
-    let c = -w0 / d;
+    let alpha = alpha + MARGIN;
+    let c = -w0;
     let cones = ies
         .kinks
         .cones
@@ -104,6 +114,20 @@ pub fn chart_integral<R: Rule>(
     ys: &[f64],
     rule: &R,
 ) -> DVec3 {
+    chart_integral_as(p, chart, n, ys, rule, false)
+}
+
+/// [`chart_integral`]; `uniform`: the caller has shown that the shaping factor is exactly 1 on
+/// every direction of the chart (`super::uniform_shaping`), so each line takes the unshaped
+/// closed form.
+pub fn chart_integral_as<R: Rule>(
+    p: &Prepared,
+    chart: &Chart,
+    n: DVec3,
+    ys: &[f64],
+    rule: &R,
+    uniform: bool,
+) -> DVec3 {
     if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
         return DVec3::ZERO;
     }
@@ -111,7 +135,7 @@ pub fn chart_integral<R: Rule>(
     let ctx = Ctx {
         p,
         n,
-        unshaped: p.shaping.is_none() && tex.is_none(),
+        unshaped: (p.shaping.is_none() || uniform) && tex.is_none(),
         rule,
         tex,
         ies_kinks: chart_ies_kinks(p, chart),
