@@ -358,18 +358,34 @@ impl Rule for Adaptive {
                 None => false,
             };
         let unshaped_profile = Profile::new(None, p.axis);
-        let ys = if uniform {
-            critical::critical_ys_with(p, &unshaped_profile, chart, n)
+        let arc_samples = if self.shortcuts {
+            critical::LOOSE_ARC_SAMPLES
         } else {
-            critical::critical_ys(p, chart, n)
+            critical::ARC_SAMPLES
         };
+        let prof = if uniform {
+            &unshaped_profile
+        } else {
+            &p.profile
+        };
+        let mut ys = critical::critical_ys_with(p, prof, chart, n, arc_samples);
         let mut rule = *self;
-        if p.ies.is_some() {
-            // An IES profile's grid lines are breakpoints of every line but not of the outer
-            // integral (`critical_ys` lists the shaping's kinks only): across lines the
-            // integrand has kinks (where a line meets a grid cone first) that the 7-point
-            // pair's estimate can miss (measured: 1.4e-2 on a 1e-2 map of luxtest iesTest).
-            rule.outer_pair = Pair::Gk15;
+        if let Some(ies) = &p.ies
+            && self.outer_pair == Pair::Gk7
+        {
+            // An IES profile's grid lines are breakpoints of every line but not of the
+            // reference's outer integral (`critical_ys` lists the shaping's kinks only): across
+            // lines the integrand has kinks (where a line first meets a grid cone) that the
+            // 7-point pair's estimate can miss (measured: 1.4e-2 on a 1e-2 map of luxtest
+            // iesTest). The loose rules split there too.
+            let local = outer::chart_ies_kinks(p, chart);
+            let extra = critical::ies_ys(p, chart, n, local.as_ref().unwrap_or(&ies.kinks));
+            if !extra.is_empty() {
+                ys.extend(extra);
+                ys.sort_by(f64::total_cmp);
+                let span = ys[ys.len() - 1] - ys[0];
+                ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+            }
         }
         if self.outer.abs == 0.0 && self.scale_fraction > 0.0 {
             // The scale of the answer from a coarse pass; an inner error δ on every line moves
