@@ -18,7 +18,9 @@
 //!
 //! How each smooth piece is integrated is a [`Rule`]: the reference's [`Adaptive`] rule
 //! (globally adaptive Gauss–Kronrod to ~1e-9 relative, stopping on its own error estimates),
-//! or, for tests, the WGSL kernel's rule replayed in f64 (`testkit`).
+//! the same driver for a looser `--tolerance` ([`Adaptive::for_tolerance`]: cheaper pairs and
+//! exact per-receiver shortcuts), or, for tests, the WGSL kernel's rule replayed in f64
+//! (`testkit`).
 
 // `!(a > b)` is deliberate throughout: a NaN fails the test and takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -252,6 +254,13 @@ impl Adaptive {
     /// its estimate is below `rel/8` of the coarse estimate of the whole (pieces that contribute
     /// nothing measurable). Gauss–Kronrod's estimates are themselves pessimistic, and the test
     /// `tolerance_maps_hold_the_reference` measures the result against the reference.
+    ///
+    /// What a loose tolerance buys (issue 24; BENCHMARKS.md "The jobs people run"): every rule
+    /// here takes the exact shortcuts of [`uniform_shaping`]; from [`LOOSE`] on, the 3-point
+    /// Gauss / 7-point Kronrod pair ([`crate::rules::gk7`]: 7 evaluations a piece where
+    /// Gauss–Kronrod 15 takes 15, 49 instead of 225 for a piece of the nested integral), the
+    /// [`Coarse::Gauss3`] scale, the IES profile's grid surfaces as outer breakpoints
+    /// (`critical::ies_ys`) and the GPU kernel's 24 samples per arc for the arcs' roots.
     pub fn for_tolerance(rel: f64) -> Adaptive {
         if !(rel > Self::REFERENCE.outer.rel) {
             return Self::REFERENCE;
@@ -358,7 +367,7 @@ impl Rule for Adaptive {
                 None => false,
             };
         let unshaped_profile = Profile::new(None, p.axis);
-        let arc_samples = if self.shortcuts {
+        let arc_samples = if self.outer_pair == Pair::Gk7 {
             critical::LOOSE_ARC_SAMPLES
         } else {
             critical::ARC_SAMPLES
