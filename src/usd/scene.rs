@@ -436,6 +436,7 @@ mod tests {
                 with_filter("SphereLight", false),
             ],
             light_lists: Vec::new(),
+            stage_warnings: Vec::new(),
             files_read: vec!["x.usda".into()],
         };
         assert_eq!(scene.unapplied(&[]), None);
