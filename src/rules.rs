@@ -3,6 +3,8 @@
 //!
 //! - [`gk15`]: the 7-point Gauss / 15-point Kronrod pair (QUADPACK `qk15` nodes and weights);
 //!   [`gk15_unit`] gives the same pair on [0, 1] as arrays for the WGSL prelude.
+//! - [`gk7`]: the 3-point Gauss / 7-point Kronrod pair (Kronrod's tables), the CPU's rule for
+//!   loose `--tolerance`s.
 //! - [`gauss_legendre`]: n-point Gauss–Legendre nodes and weights on [0, 1], computed in f64 by
 //!   Newton's method on Pₙ.
 //! - `IRR_*`, [`TAN_MAP_RHO`], [`MAX_U_SPAN`]: how the kernel's rule refines; the CPU reference
@@ -48,8 +50,57 @@ const WG: [f64; 4] = [
     0.417_959_183_673_469_387_755_102_040_816_327,
 ];
 
+/// Kronrod nodes of the 3-point Gauss / 7-point Kronrod pair on [−1, 1] (the positive half;
+/// the last is the centre; XGK7[1] = √(3/5) and the centre are the Gauss nodes).
+///
+/// Source: Kronrod's tables (A. S. Kronrod, *Nodes and Weights of Quadrature Formulas*,
+/// Consultants Bureau, 1965), the n = 3 extension, 33 digits, as computed by Piessens and
+/// Branders' algorithm (Math. Comp. 28 (1974) 135–139, routine `KRONROD`) and listed by
+/// Boost.Math's `gauss_kronrod<double, 7>`; QUADPACK itself starts at 15 points. The unit test
+/// `gk7_is_exact_to_its_degree` checks them: the Kronrod rule is exact for polynomials up to
+/// degree 3·3 + 2 = 11 (and not 12), the Gauss rule up to 5, each weight set sums to the
+/// interval's length.
+const XGK7: [f64; 4] = [
+    0.960_491_268_708_020_283_423_507_092_629_080,
+    0.774_596_669_241_483_377_035_853_079_956_480,
+    0.434_243_749_346_802_558_002_071_502_844_628,
+    0.0,
+];
+/// Kronrod weights for [`XGK7`].
+const WGK7: [f64; 4] = [
+    0.104_656_226_026_467_265_193_823_857_192_073,
+    0.268_488_089_868_333_440_728_569_280_666_710,
+    0.401_397_414_775_962_222_905_051_818_618_432,
+    0.450_916_538_658_474_142_345_110_087_045_571,
+];
+/// Gauss weights for XGK7[1] (5/9) and the centre (8/9).
+const WG3: [f64; 2] = [
+    0.555_555_555_555_555_555_555_555_555_555_556,
+    0.888_888_888_888_888_888_888_888_888_888_889,
+];
+
 fn norm(v: DVec3) -> f64 {
     v.abs().max_element()
+}
+
+/// The 7-point Kronrod estimate of ∫ₐᵇ f and |Kronrod − Gauss(3)| (largest channel): the
+/// loose tolerances' pair (`cpu::irradiance::Adaptive::for_tolerance`). Like [`gk15`], the
+/// difference measures the Gauss rule's error, a pessimistic bound on Kronrod's.
+pub fn gk7(f: &mut impl FnMut(f64) -> DVec3, a: f64, b: f64) -> (DVec3, f64) {
+    let c = 0.5 * (a + b);
+    let h = 0.5 * (b - a);
+    let fc = f(c);
+    let mut k = fc * WGK7[3];
+    let mut g = fc * WG3[1];
+    for j in 0..3 {
+        let dx = h * XGK7[j];
+        let s = f(c - dx) + f(c + dx);
+        k += s * WGK7[j];
+        if j == 1 {
+            g += s * WG3[0];
+        }
+    }
+    (k * h, norm((k - g) * h))
 }
 
 /// The Kronrod estimate of ∫ₐᵇ f and |Kronrod − Gauss| (largest channel).
@@ -249,6 +300,45 @@ mod tests {
             }
             assert!(x.windows(2).all(|p| p[0] < p[1]));
         }
+    }
+
+    /// The 7-point pair on [a, b] for f(x) = xᵏ: (Kronrod value, |Kronrod − Gauss|).
+    fn gk7_on_monomial(k: i32, a: f64, b: f64) -> (f64, f64) {
+        let (v, e) = gk7(&mut |x: f64| DVec3::new(x.powi(k), 0.0, 0.0), a, b);
+        // The error is |K − G| in the largest channel, here the first.
+        (v.x, e)
+    }
+
+    #[test]
+    fn gk7_is_exact_to_its_degree() {
+        for (a, b) in [(-1.0, 1.0), (0.0, 1.0), (0.3, 2.2)] {
+            // Weights sum to the interval's length: both rules integrate 1 exactly.
+            let (k0, e0) = gk7_on_monomial(0, a, b);
+            assert!((k0 - (b - a)).abs() < 1e-15 && e0 < 1e-15, "{a} {b}");
+            for k in 0..=12 {
+                let exact = (b.powi(k + 1) - a.powi(k + 1)) / (k + 1) as f64;
+                let (kr, e) = gk7_on_monomial(k, a, b);
+                let scale = exact.abs().max(1.0);
+                if k <= 11 {
+                    assert!((kr - exact).abs() < 4e-15 * scale, "K7 x^{k} on [{a}, {b}]");
+                } else if (a, b) == (-1.0, 1.0) {
+                    // Degree 12 is the first the Kronrod rule misses.
+                    assert!((kr - exact).abs() > 1e-6, "K7 x^12");
+                }
+                // Gauss(3) = K − (K − G): exact to degree 5, not 6.
+                let gauss_err = (e - (kr - exact).abs()).abs();
+                if k <= 5 {
+                    assert!(e < 4e-15 * scale, "G3 x^{k} on [{a}, {b}]: {e}");
+                } else if k == 6 && (a, b) == (-1.0, 1.0) {
+                    assert!(gauss_err > 1e-3, "G3 x^6");
+                }
+            }
+        }
+        // The same pair against QUADPACK's 15-point pair on a smooth function.
+        let f = |t: f64| DVec3::splat((3.0 * t).sin() + t * t);
+        let (k7, _) = gk7(&mut |t| f(t), 0.0, 1.0);
+        let (k15, _) = gk15(&mut |t| f(t), 0.0, 1.0);
+        assert!((k7.x - k15.x).abs() < 1e-9);
     }
 
     #[test]

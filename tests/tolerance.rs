@@ -1,8 +1,11 @@
 //! `--tolerance`: irradiance computed to a relative tolerance instead of the
-//! reference's 1e-9. The luxtest floor maps of the shaped rect and the spot sphere at frame 31
-//! (the scenes BENCHMARKS.md compares with Cycles), computed by the CPU at tolerances 1e-3 and 1e-4,
+//! reference's 1e-9. Every luxtest floor map (the scenes and frames BENCHMARKS.md times: the
+//! shaped rect, spot sphere, disk and cylinder at frame 31, distant at 12, iesTest at 15, dome
+//! at 1), computed by the CPU at tolerances 1e-2, 1e-3 and 1e-4,
 //! must lie within that tolerance of the 1e-9 reference at every pixel (relative to the pixel;
-//! a pixel that is 0 in one must be 0 in the other). The GPU, whose f32 rule is fixed, takes no
+//! a pixel that is 0 in one must be 0 in the other). Loose tolerances take other rules than the
+//! reference (`Adaptive::for_tolerance`: the 7-point Gauss–Kronrod pair, a 3-point coarse
+//! scale), which this test holds to their promise. The GPU, whose f32 rule is fixed, takes no
 //! tolerance below 1e-4 (its conformance bound).
 #![cfg(feature = "usd")]
 
@@ -56,19 +59,32 @@ fn worst(got: &[[f32; 3]], want: &[[f32; 3]]) -> f64 {
     worst
 }
 
+/// The luxtest floors and their frames. Left out: iesUp (its floor is dark), iesDown (its lit
+/// patch falls between these 24 × 24 samples), iesLibPreview (its profile is not in the test
+/// data), visibleRect (its textured rect's 1e-9 reference takes minutes).
+const FLOORS: [(&str, f64); 7] = [
+    ("rect", 31.0),
+    ("sphere", 31.0),
+    ("disk", 31.0),
+    ("cylinder", 31.0),
+    ("distant", 12.0),
+    ("iesTest", 15.0),
+    ("dome", 1.0),
+];
+
 #[test]
 fn tolerance_maps_hold_the_reference() {
-    for scene in ["rect", "sphere"] {
-        let reference = map(&Evaluator::cpu(), scene, 31.0);
+    for (scene, frame) in FLOORS {
+        let reference = map(&Evaluator::cpu(), scene, frame);
         assert!(
             reference.iter().any(|p| p[1] > 0.0),
             "{scene}: the floor is dark; the test would compare nothing"
         );
-        for tol in [1e-3, 1e-4] {
+        for tol in [1e-2, 1e-3, 1e-4] {
             let eval = Evaluator::cpu().with_irradiance_tolerance(tol).unwrap();
-            let got = map(&eval, scene, 31.0);
+            let got = map(&eval, scene, frame);
             let err = worst(&got, &reference);
-            eprintln!("{scene} frame 31, tolerance {tol:e}: worst relative error {err:.3e}");
+            eprintln!("{scene} frame {frame}, tolerance {tol:e}: worst relative error {err:.3e}");
             // f32 output rounding (6e-8) is far below either tolerance.
             assert!(
                 err <= tol,

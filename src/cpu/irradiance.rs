@@ -18,7 +18,9 @@
 //!
 //! How each smooth piece is integrated is a [`Rule`]: the reference's [`Adaptive`] rule
 //! (globally adaptive Gauss–Kronrod to ~1e-9 relative, stopping on its own error estimates),
-//! or, for tests, the WGSL kernel's rule replayed in f64 (`testkit`).
+//! the same driver for a looser `--tolerance` ([`Adaptive::for_tolerance`]: cheaper pairs and
+//! exact per-receiver shortcuts), or, for tests, the WGSL kernel's rule replayed in f64
+//! (`testkit`).
 
 // `!(a > b)` is deliberate throughout: a NaN fails the test and takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -35,12 +37,12 @@ pub mod rect_texture;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use super::quadrature::{Tolerance, integrate};
+use super::quadrature::{Pair, Tolerance, integrate_with};
 use crate::model::LightType;
-use crate::prepare::Prepared;
+use crate::prepare::{Prepared, Profile};
 use chart::{Chart, Region, cylinder_chart, plane_chart, sphere_chart};
 use closed::{cap_irradiance, point_irradiance, rect_lambert, sphere_cap};
-use outer::{chart_integral, line_irradiance};
+use outer::{chart_integral, chart_integral_as, line_irradiance};
 
 /// irradiance at `x` for a receiver with unit normal `n`, `diffuse` applied, by the reference
 /// rule.
@@ -85,6 +87,12 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
         } => point_irradiance(p, x, n, radius),
         LightType::Sphere { radius, .. } => match (&p.shaping, p.similarity) {
             (None, Some(scale)) => p.base * sphere_cap(p.origin, radius * scale, x, n),
+            (Some(_), Some(scale))
+                if rule.shortcuts()
+                    && let Some(k) = sphere_uniform(p, x, radius * scale) =>
+            {
+                p.base * (k * sphere_cap(p.origin, radius * scale, x, n))
+            }
             _ => match sphere_chart(p, x, radius) {
                 Some(c) => chart_irradiance(p, &c, n, rule),
                 None => DVec3::ZERO,
@@ -96,6 +104,15 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
                 DVec3::ZERO
             } else if p.shaping.is_none() && p.rect_texture().is_none() {
                 p.base * rect_lambert(p, x, n, width / 2.0, height / 2.0)
+            } else if let Some(k) = (rule.shortcuts() && p.rect_texture().is_none())
+                .then(|| {
+                    let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
+                    outer::direction_cone(&c, c.w0, c.e1, c.e2)
+                        .and_then(|(d, alpha)| uniform_shaping(p, d, alpha))
+                })
+                .flatten()
+            {
+                p.base * (k * rect_lambert(p, x, n, width / 2.0, height / 2.0))
             } else {
                 let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
                 chart_irradiance(p, &c, n, rule)
@@ -125,6 +142,17 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
     e * p.light.inputs.diffuse
 }
 
+/// [`uniform_shaping`] for a sphere of world radius `r` (under a similarity) seen from x: its
+/// directions fill the cone of half-angle asin(r/d) around the centre's.
+fn sphere_uniform(p: &Prepared, x: DVec3, r: f64) -> Option<f64> {
+    let w = p.origin - x;
+    let d = w.length();
+    if !(d > r) {
+        return None;
+    }
+    uniform_shaping(p, w / d, (r / d).asin())
+}
+
 /// The chart integral times the base radiance.
 pub fn chart_irradiance<R: Rule>(p: &Prepared, chart: &Chart, n: DVec3, rule: &R) -> DVec3 {
     p.base * rule.chart(p, chart, n)
@@ -147,6 +175,10 @@ pub trait Rule {
         let _ = tan_mapped;
         true
     }
+    /// Whether the exact per-receiver shortcuts of [`uniform_shaping`] are taken.
+    fn shortcuts(&self) -> bool {
+        false
+    }
     /// The whole chart integral (the base radiance not applied).
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3
     where
@@ -166,8 +198,32 @@ pub struct Adaptive {
     pub outer: Tolerance,
     pub inner: Tolerance,
     /// The rule also stops once its error estimate is below this fraction of the whole
-    /// irradiance, estimated first by [`Adaptive::COARSE`] (see [`ABS_FRACTION`]); 0: never.
+    /// irradiance, estimated first by the [`Coarse`] pass (see [`ABS_FRACTION`]); 0: never.
     pub scale_fraction: f64,
+    /// The Gauss–Kronrod pair of every interval across lines ...
+    pub outer_pair: Pair,
+    /// ... and along them.
+    pub inner_pair: Pair,
+    /// How the whole irradiance is estimated for `scale_fraction`.
+    pub coarse: Coarse,
+    /// Take the exact per-receiver shortcuts of [`uniform_shaping`] (a shaping factor that is
+    /// exactly 0 or 1 on every direction the light is seen in): the value changes by rounding
+    /// only, but not bit for bit, so the reference does not.
+    pub shortcuts: bool,
+}
+
+/// The first, cheap pass that estimates the scale of the whole irradiance (only to set
+/// [`Adaptive`]'s absolute thresholds).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coarse {
+    /// [`Adaptive::COARSE`]: the reference's (Gauss–Kronrod 15 with small interval caps).
+    Adaptive,
+    /// The 3-point Gauss–Legendre rule once per outer piece and once per line piece
+    /// ([`Gauss3`]): 9 evaluations per pair of pieces instead of Gauss–Kronrod 15's 225 or
+    /// more. What a rough estimate costs the accuracy is bounded by how `scale_fraction` uses
+    /// it: a scale over by a factor k loosens the absolute thresholds by k, which the loose
+    /// tolerances' budget (`rel/8` against `rel`) absorbs for k < 2.
+    Gauss3,
 }
 
 impl Adaptive {
@@ -185,6 +241,10 @@ impl Adaptive {
             max_intervals: 400,
         },
         scale_fraction: ABS_FRACTION,
+        outer_pair: Pair::Gk15,
+        inner_pair: Pair::Gk15,
+        coarse: Coarse::Adaptive,
+        shortcuts: false,
     };
 
     /// The rule for a relative tolerance `rel` of the whole irradiance (`luxeval irradiance
@@ -194,6 +254,13 @@ impl Adaptive {
     /// its estimate is below `rel/8` of the coarse estimate of the whole (pieces that contribute
     /// nothing measurable). Gauss–Kronrod's estimates are themselves pessimistic, and the test
     /// `tolerance_maps_hold_the_reference` measures the result against the reference.
+    ///
+    /// What a loose tolerance buys (issue 24; BENCHMARKS.md "The jobs people run"): every rule
+    /// here takes the exact shortcuts of [`uniform_shaping`]; from [`LOOSE`] on, the 3-point
+    /// Gauss / 7-point Kronrod pair ([`crate::rules::gk7`]: 7 evaluations a piece where
+    /// Gauss–Kronrod 15 takes 15, 49 instead of 225 for a piece of the nested integral), the
+    /// [`Coarse::Gauss3`] scale, the IES profile's grid surfaces as outer breakpoints
+    /// (`critical::ies_ys`) and the GPU kernel's 24 samples per arc for the arcs' roots.
     pub fn for_tolerance(rel: f64) -> Adaptive {
         if !(rel > Self::REFERENCE.outer.rel) {
             return Self::REFERENCE;
@@ -208,6 +275,14 @@ impl Adaptive {
                 ..Self::REFERENCE.inner
             },
             scale_fraction: rel / 8.0,
+            outer_pair: if rel >= LOOSE { Pair::Gk7 } else { Pair::Gk15 },
+            inner_pair: if rel >= LOOSE { Pair::Gk7 } else { Pair::Gk15 },
+            coarse: if rel >= LOOSE {
+                Coarse::Gauss3
+            } else {
+                Coarse::Adaptive
+            },
+            shortcuts: true,
         }
     }
 
@@ -224,7 +299,37 @@ impl Adaptive {
             max_intervals: 8,
         },
         scale_fraction: 0.0,
+        outer_pair: Pair::Gk15,
+        inner_pair: Pair::Gk15,
+        coarse: Coarse::Adaptive,
+        shortcuts: false,
     };
+}
+
+/// From this relative tolerance on, [`Adaptive::for_tolerance`] takes the 7-point pair and the
+/// [`Coarse::Gauss3`] scale.
+pub const LOOSE: f64 = 1e-5;
+
+/// The 3-point Gauss–Legendre rule on [0, 1] for outer and inner pieces alike, no error
+/// estimate: [`Coarse::Gauss3`].
+pub struct Gauss3;
+
+impl Gauss3 {
+    fn apply(f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
+        // Nodes (1 ± √(3/5))/2 and 1/2, weights 5/18, 8/18 (A&S 25.4.29 mapped to [0, 1]).
+        const D: f64 = 0.387_298_334_620_741_688_517_926_539_978;
+        (f(0.5 - D) + f(0.5 + D)) * (5.0 / 18.0) + f(0.5) * (8.0 / 18.0)
+    }
+}
+
+impl Rule for Gauss3 {
+    fn outer(&self, f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
+        Self::apply(f)
+    }
+
+    fn inner(&self, f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
+        Self::apply(f)
+    }
 }
 
 /// The reference also stops once its error estimate is below this fraction of the whole
@@ -236,33 +341,100 @@ pub const ABS_FRACTION: f64 = 1e-12;
 
 impl Rule for Adaptive {
     fn outer(&self, f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
-        integrate(f, &[0.0, 1.0], self.outer)
+        integrate_with(f, &[0.0, 1.0], self.outer, self.outer_pair)
     }
 
     fn inner(&self, f: &mut impl FnMut(f64) -> DVec3) -> DVec3 {
-        integrate(f, &[0.0, 1.0], self.inner)
+        integrate_with(f, &[0.0, 1.0], self.inner, self.inner_pair)
+    }
+
+    fn shortcuts(&self) -> bool {
+        self.shortcuts
     }
 
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3 {
         if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
             return DVec3::ZERO;
         }
-        let ys = critical::critical_ys(p, chart, n);
+        let uniform = self.shortcuts
+            && p.rect_texture().is_none()
+            && match outer::direction_cone(chart, chart.w0, chart.e1, chart.e2) {
+                Some((c, alpha)) => match uniform_shaping(p, c, alpha) {
+                    Some(0.0) => return DVec3::ZERO,
+                    Some(_) => true,
+                    None => false,
+                },
+                None => false,
+            };
+        let unshaped_profile = Profile::new(None, p.axis);
+        let arc_samples = if self.outer_pair == Pair::Gk7 {
+            critical::LOOSE_ARC_SAMPLES
+        } else {
+            critical::ARC_SAMPLES
+        };
+        let prof = if uniform {
+            &unshaped_profile
+        } else {
+            &p.profile
+        };
+        let mut ys = critical::critical_ys_with(p, prof, chart, n, arc_samples);
         let mut rule = *self;
+        if let Some(ies) = &p.ies
+            && self.outer_pair == Pair::Gk7
+        {
+            // An IES profile's grid lines are breakpoints of every line but not of the
+            // reference's outer integral (`critical_ys` lists the shaping's kinks only): across
+            // lines the integrand has kinks (where a line first meets a grid cone) that the
+            // 7-point pair's estimate can miss (measured: 1.4e-2 on a 1e-2 map of luxtest
+            // iesTest). The loose rules split there too.
+            let local = outer::chart_ies_kinks(p, chart);
+            let extra = critical::ies_ys(p, chart, n, local.as_ref().unwrap_or(&ies.kinks));
+            if !extra.is_empty() {
+                ys.extend(extra);
+                ys.sort_by(f64::total_cmp);
+                let span = ys[ys.len() - 1] - ys[0];
+                ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+            }
+        }
         if self.outer.abs == 0.0 && self.scale_fraction > 0.0 {
             // The scale of the answer from a coarse pass; an inner error δ on every line moves
             // the outer integral by δ·jac·(Y extent).
-            let scale = chart_integral(p, chart, n, &ys, &Self::COARSE)
-                .abs()
-                .max_element();
+            let scale = match self.coarse {
+                Coarse::Adaptive => chart_integral_as(p, chart, n, &ys, &Self::COARSE, uniform),
+                Coarse::Gauss3 => chart_integral_as(p, chart, n, &ys, &Gauss3, uniform),
+            };
+            let scale = scale.abs().max_element();
             let extent = chart.jac * (ys[ys.len() - 1] - ys[0]);
             if scale > 0.0 && scale.is_finite() && extent > 0.0 && extent.is_finite() {
                 rule.outer.abs = self.scale_fraction * scale;
                 rule.inner.abs = self.scale_fraction * scale / extent;
             }
         }
-        chart_integral(p, chart, n, &ys, &rule)
+        chart_integral_as(p, chart, n, &ys, &rule, uniform)
     }
+}
+
+/// The shaping factor's value when it is exactly the same, 0 or 1, on every emission
+/// direction of a light seen from x within the cone of directions (unit `c` toward the light,
+/// half-angle `alpha`), else None. The emission directions are then within `alpha` of `−c`, so
+/// their angles θ off the primary axis lie within `alpha` of `−c`'s. With no IES profile and an
+/// inactive focus (focus ≤ 0 or a white tint: `lerp` gives exactly 1) the factor is the cone's
+/// `1 − smoothstep(θ; start, cone)`: exactly 1 for θ ≤ start and exactly 0 for θ > cone
+/// (`cpu::shaping`). A margin of 1e-9 rad covers the rounding of θ. The irradiance is then that
+/// of the unshaped light (closed forms, or the unshaped lines) or 0: exact, not a far-field
+/// approximation.
+pub fn uniform_shaping(p: &Prepared, c: DVec3, alpha: f64) -> Option<f64> {
+    const MARGIN: f64 = 1e-9;
+    let s = p.shaping.as_ref()?;
+    if p.ies.is_some() || !(alpha >= 0.0) {
+        return None;
+    }
+    let theta = crate::cpu::shaping::off_axis_angle(p.axis, -c);
+    if theta - alpha > s.cone + MARGIN {
+        return Some(0.0);
+    }
+    let focus_inactive = !(s.focus > 0.0) || s.focus_tint == DVec3::ONE;
+    (focus_inactive && theta + alpha + MARGIN < s.start && s.start <= s.cone).then_some(1.0)
 }
 
 /// Everything one line integral needs.
@@ -275,6 +447,9 @@ pub struct Ctx<'a, R> {
     /// A textured rect's texture (rect_texture.rs): one more factor of the integrand, and its
     /// break lines.
     pub tex: Option<rect_texture::ChartTexture<'a>>,
+    /// The IES profile's kink surfaces that can meet the chart's directions
+    /// ([`outer::chart_ies_kinks`]); None: all of the profile's (or no profile).
+    pub ies_kinks: Option<crate::prepare::ies_kinks::IesKinks>,
 }
 
 #[cfg(test)]

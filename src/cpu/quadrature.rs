@@ -1,12 +1,13 @@
 //! The CPU reference's adaptive quadrature: [`integrate`], a global adaptive driver over the
 //! Gauss–Kronrod pair of [`crate::rules::gk15`] (bisect the interval with the largest estimate
-//! until the sum of estimates meets the tolerance), as in QUADPACK's `qag`.
+//! until the sum of estimates meets the tolerance), as in QUADPACK's `qag`;
+//! [`integrate_with`] the same driver over a chosen [`Pair`].
 //!
 //! Values are RGB ([`DVec3`]); an error is measured in the largest channel.
 
 use glam::DVec3;
 
-use crate::rules::gk15;
+use crate::rules::{gk7, gk15};
 
 fn norm(v: DVec3) -> f64 {
     v.abs().max_element()
@@ -24,13 +25,42 @@ pub struct Tolerance {
     pub max_intervals: usize,
 }
 
+/// The embedded Gauss–Kronrod pair an [`integrate_with`] applies to each interval.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pair {
+    /// 7-point Gauss / 15-point Kronrod (QUADPACK `qk15`): the reference's.
+    Gk15,
+    /// 3-point Gauss / 7-point Kronrod: a third of the evaluations for loose tolerances.
+    Gk7,
+}
+
+impl Pair {
+    /// (Kronrod estimate, |Kronrod − Gauss|) on [a, b].
+    pub fn apply(self, f: &mut impl FnMut(f64) -> DVec3, a: f64, b: f64) -> (DVec3, f64) {
+        match self {
+            Pair::Gk15 => gk15(f, a, b),
+            Pair::Gk7 => gk7(f, a, b),
+        }
+    }
+}
+
 /// ∫ f over the union of consecutive intervals `breaks[i]..breaks[i+1]`, globally adaptive.
 /// Breaks are where f is not smooth; f is never evaluated at a break.
 pub fn integrate(f: &mut impl FnMut(f64) -> DVec3, breaks: &[f64], tol: Tolerance) -> DVec3 {
+    integrate_with(f, breaks, tol, Pair::Gk15)
+}
+
+/// [`integrate`] with each interval's pair chosen.
+pub fn integrate_with(
+    f: &mut impl FnMut(f64) -> DVec3,
+    breaks: &[f64],
+    tol: Tolerance,
+    pair: Pair,
+) -> DVec3 {
     let mut parts: Vec<(f64, f64, DVec3, f64)> = Vec::with_capacity(breaks.len() + 16);
     for w in breaks.windows(2) {
         if w[1] > w[0] {
-            let (v, e) = gk15(f, w[0], w[1]);
+            let (v, e) = pair.apply(f, w[0], w[1]);
             parts.push((w[0], w[1], v, e));
         }
     }
@@ -52,8 +82,8 @@ pub fn integrate(f: &mut impl FnMut(f64) -> DVec3, breaks: &[f64], tol: Toleranc
             parts[i].3 = 0.0;
             continue;
         }
-        let (v1, e1) = gk15(f, a, m);
-        let (v2, e2) = gk15(f, m, b);
+        let (v1, e1) = pair.apply(f, a, m);
+        let (v2, e2) = pair.apply(f, m, b);
         parts[i] = (a, m, v1, e1);
         parts.push((m, b, v2, e2));
     }

@@ -98,6 +98,12 @@ pub fn bracket_roots(f: &impl Fn(f64) -> (f64, f64), t0: f64, t1: f64, samples: 
         let glo = g(lo);
         for _ in 0..80 {
             let mid = 0.5 * (lo + hi);
+            if mid == lo || mid == hi {
+                // lo and hi are adjacent doubles: every further step leaves 0.5·(lo + hi) at
+                // this mid (it keeps lo and hi, or makes them equal to it), so stopping here
+                // returns what the 80 steps return, bit for bit.
+                return mid;
+            }
             if (g(mid) > 0.0) == (glo > 0.0) {
                 lo = mid;
             } else {
@@ -108,9 +114,12 @@ pub fn bracket_roots(f: &impl Fn(f64) -> (f64, f64), t0: f64, t1: f64, samples: 
     };
     let val = |t: f64| f(t).0;
     let der = |t: f64| f(t).1;
+    // Each sample is evaluated once (the next interval's start is this one's end).
+    let mut fb = f(t0);
     for i in 0..samples {
         let (a, b) = (t0 + h * i as f64, t0 + h * (i + 1) as f64);
-        let (fa, fb) = (f(a), f(b));
+        let fa = fb;
+        fb = f(b);
         if fa.0 == 0.0 {
             out.push(a);
         }

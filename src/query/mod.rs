@@ -140,10 +140,11 @@ impl Evaluator {
 
     /// Computes irradiance to relative tolerance `rel` rather than to the reference's 1e-9
     /// (`luxeval irradiance --tolerance`, whose default is 1e-4): the CPU's adaptive rules stop
-    /// there (the CPU's `Adaptive::for_tolerance`; closed forms stay exact): at 1e-4 a shaped
-    /// light's map costs about half the reference's time (BENCHMARKS.md; each smooth piece
-    /// still costs one 15-point rule). The GPU's f32 rule is fixed and held to 1e-4 by the
-    /// conformance tests (the tolerance of `luxeval check`), so a GPU evaluator accepts no
+    /// there (the CPU's `Adaptive::for_tolerance`; closed forms stay exact). It also takes
+    /// exact per-receiver shortcuts (a shaping factor uniformly 0 or 1 over the light), and
+    /// from 1e-5 on a 7-point Gauss–Kronrod pair and a 3-point coarse scale: the luxtest floor
+    /// maps cost 2.7–17× less than before at 1e-2 (BENCHMARKS.md, "The jobs people run").
+    /// The GPU's f32 rule is fixed and held to 1e-4 by the conformance tests (the tolerance of `luxeval check`), so a GPU evaluator accepts no
     /// tighter `rel`. Errors: `rel` not in [1e-9, 0.1], or below the GPU's bound on
     /// a GPU evaluator.
     pub fn with_irradiance_tolerance(mut self, rel: f64) -> Result<Self> {

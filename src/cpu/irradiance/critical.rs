@@ -22,15 +22,21 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use super::chart::{Arc, Chart, Region, arc_at};
+use super::chart::{Arc, Chart, Region, arc_at, make_chart};
 use crate::cpu::roots::{
     bracket_roots, cone_roots_on_line, lin_trig_roots, plane_cone_dirs, wrap_into,
 };
-use crate::prepare::{Kink, Prepared};
+use crate::prepare::ies_kinks::IesKinks;
+use crate::prepare::{Kink, Prepared, Profile};
 
 /// Samples per arc when bracketing the roots of a degree-2 trigonometric polynomial (the
 /// kernel uses `rules::IRR_ARC_SAMPLES`, fewer, for speed).
-const ARC_SAMPLES: usize = 64;
+pub const ARC_SAMPLES: usize = 64;
+
+/// Samples per arc for the loose `--tolerance` rules: the GPU kernel's count
+/// (`rules::IRR_ARC_SAMPLES`, held to 1e-4 by the conformance tests). A pair of roots closer
+/// than a sample spacing can go unlisted; the adaptive rule then still sees the kink.
+pub const LOOSE_ARC_SAMPLES: usize = crate::rules::IRR_ARC_SAMPLES as usize;
 
 /// Keeps `y` when it lies in the chart's Y-range.
 fn push_y(ys: &mut Vec<f64>, y: f64, chart: &Chart) {
@@ -48,9 +54,16 @@ fn push_dir(ys: &mut Vec<f64>, w: DVec3, chart: &Chart) {
 }
 
 /// Crossings of the cone −ŵ·axis = cos with an elliptic arc (correct nappe).
-fn arc_cone_crossings(ys: &mut Vec<f64>, chart: &Chart, arc: &Arc, axis: DVec3, cos: f64) {
+fn arc_cone_crossings(
+    ys: &mut Vec<f64>,
+    chart: &Chart,
+    arc: &Arc,
+    axis: DVec3,
+    cos: f64,
+    samples: usize,
+) {
     let f = |t: f64| arc_f(arc, axis, cos, t);
-    for t in bracket_roots(&f, arc.t0, arc.t1, ARC_SAMPLES) {
+    for t in bracket_roots(&f, arc.t0, arc.t1, samples) {
         let w = arc_at(arc, t);
         if -w.dot(axis) * cos > 0.0 {
             push_dir(ys, w, chart);
@@ -59,9 +72,9 @@ fn arc_cone_crossings(ys: &mut Vec<f64>, chart: &Chart, arc: &Arc, axis: DVec3, 
 }
 
 /// The local minima of |w(t)|² on the arc: its points nearest to x.
-fn arc_nearest(ys: &mut Vec<f64>, chart: &Chart, arc: &Arc) {
+fn arc_nearest(ys: &mut Vec<f64>, chart: &Chart, arc: &Arc, samples: usize) {
     let d = |t: f64| arc_d(arc, t);
-    for t in bracket_roots(&d, arc.t0, arc.t1, ARC_SAMPLES) {
+    for t in bracket_roots(&d, arc.t0, arc.t1, samples) {
         if d(t).1 > 0.0 {
             push_dir(ys, arc_at(arc, t), chart);
         }
@@ -90,7 +103,19 @@ fn arc_f(arc: &Arc, axis: DVec3, cos: f64, t: f64) -> (f64, f64) {
 /// The Y values where the inner structure of the chart integral changes (see the module docs),
 /// sorted, within and including the region's Y-range.
 pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
-    let prof = &p.profile;
+    critical_ys_with(p, &p.profile, chart, n, ARC_SAMPLES)
+}
+
+/// [`critical_ys`] for the shaping kinks of `prof` (an empty profile: a shaping factor that is
+/// uniform over the chart), bracketing arc roots with `arc_samples` samples per arc (the loose
+/// `--tolerance` rules take [`LOOSE_ARC_SAMPLES`]).
+pub fn critical_ys_with(
+    p: &Prepared,
+    prof: &Profile,
+    chart: &Chart,
+    n: DVec3,
+    arc_samples: usize,
+) -> Vec<f64> {
     let axis = p.axis;
     let (ya, yb) = chart.y_range();
     let mut ys = vec![ya, yb];
@@ -185,7 +210,7 @@ pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
         }
         // Cone ∩ elliptic arcs.
         for arc in &arcs {
-            arc_cone_crossings(&mut ys, chart, arc, axis, c);
+            arc_cone_crossings(&mut ys, chart, arc, axis, c, arc_samples);
         }
     }
     // The outer integrand peaks where a curve bounding the inner intervals (a region edge, a
@@ -198,7 +223,7 @@ pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
         );
     }
     for arc in &arcs {
-        arc_nearest(&mut ys, chart, arc);
+        arc_nearest(&mut ys, chart, arc, arc_samples);
     }
     let nrm = e1.cross(e2).normalize() * w0.dot(e1.cross(e2)).signum();
     for &c in &cones {
@@ -232,5 +257,118 @@ pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
     ys.sort_by(f64::total_cmp);
     let span = yb - ya;
     ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+    ys
+}
+
+/// The Ys where an IES profile's grid lines change the inner structure (used by the loose
+/// `--tolerance` rules, whose 7-point pair across lines needs the outer integrand smooth on each
+/// piece; the reference leaves these kinks to its 15-point adaptive rule, bit for bit as
+/// before). `kinks` are the profile's kink surfaces in the light's frame
+/// (`outer::chart_ies_kinks`). The chart is mapped to the light's frame by M⁻¹: a linear map
+/// keeps the chart's parameters (X, Y), so Ys found there are Ys of the chart. There the
+/// profile's surfaces are circular cones and planes through x, and the same constructions as
+/// [`critical_ys`] apply: each surface tangent to a line of the pencil, crossing the region's
+/// edges and arcs, and crossing the horizon, the focus plane and the profile's other surfaces.
+/// (Not listed: a profile cone crossing the shaping's cone, a circular cone of the world frame
+/// only; the adaptive rule still sees it.)
+pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f64> {
+    let l = p.to_local;
+    let region = match &chart.region {
+        Region::Cylinder(c) => {
+            let mut c = (**c).clone();
+            for a in c.arcs.iter_mut() {
+                (a.c, a.u, a.v) = (l * a.c, l * a.u, l * a.v);
+            }
+            Region::Cylinder(Box::new(c))
+        }
+        r => r.clone(),
+    };
+    let lc = make_chart(l * chart.w0, l * chart.e1, l * chart.e2, region);
+    let (w0, e1, e2) = (lc.w0, lc.e1, lc.e2);
+    // Planes through x in the light's frame: a world normal m becomes Mᵀm.
+    let mt = p.linear.transpose();
+    let mut fixed: Vec<DVec3> = vec![mt * n];
+    for k in &p.profile.kinks {
+        if let Kink::Plane { m, .. } = *k {
+            fixed.push(mt * m);
+        }
+    }
+    let segs: Vec<f64> = match &lc.region {
+        Region::Square => vec![-1.0, 1.0],
+        _ => vec![],
+    };
+    let arcs: Vec<Arc> = match &lc.region {
+        Region::Square => vec![],
+        Region::Disk => vec![Arc {
+            c: w0,
+            u: e1,
+            v: e2,
+            t0: 0.0,
+            t1: 2.0 * PI,
+        }],
+        Region::Cylinder(c) => c.arcs.to_vec(),
+    };
+    let mut ys = Vec::new();
+    for &m in &kinks.planes {
+        let (me1, me2, mw0) = (m.dot(e1), m.dot(e2), m.dot(w0));
+        if me1.abs() <= 1e-12 * m.length() * e1.length() && me2 != 0.0 {
+            push_y(&mut ys, -mw0 / me2, &lc);
+        }
+        if me2 != 0.0 {
+            for &xs in &segs {
+                push_y(&mut ys, -(mw0 + xs * me1) / me2, &lc);
+            }
+        }
+        for arc in &arcs {
+            for t in lin_trig_roots(m.dot(arc.u), m.dot(arc.v), -m.dot(arc.c)) {
+                let t = wrap_into(t, arc.t0);
+                if t <= arc.t1 {
+                    push_dir(&mut ys, arc_at(arc, t), &lc);
+                }
+            }
+        }
+        for &m2 in fixed.iter().chain(&kinks.planes) {
+            let d = m.cross(m2);
+            if d.length_squared() > 0.0 {
+                push_dir(&mut ys, d, &lc);
+                push_dir(&mut ys, -d, &lc);
+            }
+        }
+        for &(axis, c) in &kinks.cones {
+            for w in plane_cone_dirs(m, axis, c) {
+                push_dir(&mut ys, w, &lc);
+            }
+        }
+    }
+    for &(axis, c) in &kinks.cones {
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        let (m1, m2) = e1.normalize().any_orthonormal_pair();
+        let (pa, pb) = (m1.dot(axis), m2.dot(axis));
+        let ra = pa.hypot(pb);
+        if ra >= s && ra > 0.0 {
+            let t0 = pb.atan2(pa);
+            let d = (s / ra).clamp(-1.0, 1.0).acos();
+            for t in [t0 + d, t0 - d] {
+                let mm = m1 * t.cos() + m2 * t.sin();
+                let me2 = mm.dot(e2);
+                if me2 != 0.0 {
+                    push_y(&mut ys, -mm.dot(w0) / me2, &lc);
+                }
+            }
+        }
+        for &xs in &segs {
+            for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
+                push_y(&mut ys, y, &lc);
+            }
+        }
+        for arc in &arcs {
+            arc_cone_crossings(&mut ys, &lc, arc, axis, c, LOOSE_ARC_SAMPLES);
+        }
+        for &m in &fixed {
+            for w in plane_cone_dirs(m, axis, c) {
+                push_dir(&mut ys, w, &lc);
+            }
+        }
+    }
     ys
 }

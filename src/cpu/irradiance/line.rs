@@ -35,7 +35,13 @@ pub fn line_integral<R: Rule>(
     };
     // Breakpoints with their grading flag.
     let mut bps: Vec<(f64, bool)> = vec![(lo, false), (hi, false)];
-    for k in &ctx.p.profile.kinks {
+    // (An unshaped line has no shaping kinks; one whose factor is uniformly 1 ignores them.)
+    let kinks: &[Kink] = if ctx.unshaped {
+        &[]
+    } else {
+        &ctx.p.profile.kinks
+    };
+    for k in kinks {
         match *k {
             Kink::Cone { cos } => {
                 for xk in cone_roots_on_line(ctx.p.axis, cos, a, e1) {
@@ -50,20 +56,22 @@ pub fn line_integral<R: Rule>(
             }
         }
     }
-    if ctx.p.profile.axis_singular {
+    if ctx.p.profile.axis_singular && !ctx.unshaped {
         bps.extend(axis_approach(ctx.p.axis, a, e1).map(|xa| (xa, false)));
     }
     if let Some(ies) = &ctx.p.ies {
-        // The profile's grid lines, in the light's frame: the line maps to a line there.
+        // The profile's grid lines, in the light's frame: the line maps to a line there (only
+        // those that can meet the chart, when the chart has listed them).
+        let kinks = ctx.ies_kinks.as_ref().unwrap_or(&ies.kinks);
         let (al, el) = (ctx.p.to_local * a, ctx.p.to_local * e1);
-        for &(axis, cos) in &ies.kinks.cones {
+        for &(axis, cos) in &kinks.cones {
             bps.extend(
                 cone_roots_on_line(axis, cos, al, el)
                     .into_iter()
                     .map(|x| (x, false)),
             );
         }
-        for &m in &ies.kinks.planes {
+        for &m in &kinks.planes {
             let den = m.dot(el);
             if den != 0.0 {
                 bps.push((-m.dot(al) / den, false));
