@@ -463,7 +463,6 @@ mod tests {
             ],
             stage_warnings: Vec::new(),
             light_lists: Vec::new(),
-            stage_warnings: Vec::new(),
             files_read: vec!["x.usda".into()],
         };
         assert_eq!(scene.unapplied(&[]), None);
