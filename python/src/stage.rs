@@ -320,8 +320,10 @@ impl Stage {
         self.scene.unapplied(&[])
     }
 
-    /// One message per light that the queries skip (unsupported type or feature, invisible),
-    /// naming its prim; ``luxeval`` prints the same lines as ``warning:`` on stderr.
+    /// What reading the stage said out loud (a sublayer, reference or payload left out, a value
+    /// read differently from how it was written; each naming its layer), then one message per
+    /// light that the queries skip (unsupported type or feature, invisible), naming its prim;
+    /// ``luxeval`` prints the same lines as ``warning:`` on stderr.
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.scene.warnings()
