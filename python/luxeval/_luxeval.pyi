@@ -75,7 +75,9 @@ class Stage:
         and light lists luxeval does not apply, or ``None``: the query commands' warning."""
     @property
     def warnings(self) -> list[str]:
-        """One message per light the queries skip (unsupported, invisible), naming its prim."""
+        """What reading the stage said (layers left out, values read differently; each naming its
+        layer), then one message per light the queries skip (unsupported, invisible), naming its
+        prim."""
     @property
     def prepared(
         self,
