@@ -54,6 +54,33 @@ fn push_dir(ys: &mut Vec<f64>, w: DVec3, chart: &Chart) {
 }
 
 /// Crossings of the cone −ŵ·axis = cos with an elliptic arc (correct nappe).
+/// The lines where the planes of the pencil (through the receiver, containing the chart's
+/// `e1`) are tangent to the cone of `axis` and cosine `c`: unit normals m ⊥ e1 with
+/// |m·axis| = sin θ, each meeting the chart at Y = −m·w0 / m·e2.
+fn pencil_tangent_ys(
+    ys: &mut Vec<f64>,
+    chart: &Chart,
+    (w0, e1, e2): (DVec3, DVec3, DVec3),
+    axis: DVec3,
+    c: f64,
+) {
+    let s = (1.0 - c * c).max(0.0).sqrt();
+    let (m1, m2) = e1.normalize().any_orthonormal_pair();
+    let (pa, pb) = (m1.dot(axis), m2.dot(axis));
+    let ra = pa.hypot(pb);
+    if ra >= s && ra > 0.0 {
+        let t0 = pb.atan2(pa);
+        let d = (s / ra).clamp(-1.0, 1.0).acos();
+        for t in [t0 + d, t0 - d] {
+            let mm = m1 * t.cos() + m2 * t.sin();
+            let me2 = mm.dot(e2);
+            if me2 != 0.0 {
+                push_y(ys, -mm.dot(w0) / me2, chart);
+            }
+        }
+    }
+}
+
 fn arc_cone_crossings(
     ys: &mut Vec<f64>,
     chart: &Chart,
@@ -185,23 +212,7 @@ pub fn critical_ys_with(
         }
     }
     for &c in &cones {
-        // Planes of the pencil (through x, containing e1) tangent to the cone: unit normals
-        // m ⊥ e1 with |m·axis| = sin θ.
-        let s = (1.0 - c * c).max(0.0).sqrt();
-        let (m1, m2) = e1.normalize().any_orthonormal_pair();
-        let (pa, pb) = (m1.dot(axis), m2.dot(axis));
-        let ra = pa.hypot(pb);
-        if ra >= s && ra > 0.0 {
-            let t0 = pb.atan2(pa);
-            let d = (s / ra).clamp(-1.0, 1.0).acos();
-            for t in [t0 + d, t0 - d] {
-                let mm = m1 * t.cos() + m2 * t.sin();
-                let me2 = mm.dot(e2);
-                if me2 != 0.0 {
-                    push_y(&mut ys, -mm.dot(w0) / me2, chart);
-                }
-            }
-        }
+        pencil_tangent_ys(&mut ys, chart, (w0, e1, e2), axis, c);
         // Cone ∩ straight edges X = xs: quadratic in Y.
         for &xs in &segs {
             for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
@@ -341,21 +352,7 @@ pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f6
         }
     }
     for &(axis, c) in &kinks.cones {
-        let s = (1.0 - c * c).max(0.0).sqrt();
-        let (m1, m2) = e1.normalize().any_orthonormal_pair();
-        let (pa, pb) = (m1.dot(axis), m2.dot(axis));
-        let ra = pa.hypot(pb);
-        if ra >= s && ra > 0.0 {
-            let t0 = pb.atan2(pa);
-            let d = (s / ra).clamp(-1.0, 1.0).acos();
-            for t in [t0 + d, t0 - d] {
-                let mm = m1 * t.cos() + m2 * t.sin();
-                let me2 = mm.dot(e2);
-                if me2 != 0.0 {
-                    push_y(&mut ys, -mm.dot(w0) / me2, &lc);
-                }
-            }
-        }
+        pencil_tangent_ys(&mut ys, &lc, (w0, e1, e2), axis, c);
         for &xs in &segs {
             for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
                 push_y(&mut ys, y, &lc);
