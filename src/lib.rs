@@ -89,7 +89,9 @@ pub use prepare::ies::{
 };
 #[cfg(feature = "usd")]
 pub use query::lights_json;
-pub use query::{Accumulate, Evaluator, Power, PreparedScene, Reference};
+pub use query::{
+    Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, Samples, Selection,
+};
 pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]
 pub use usd::{

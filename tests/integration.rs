@@ -36,6 +36,7 @@ mod math;
 mod rect_conformance;
 mod resident;
 mod robustness;
+mod sampling;
 mod tolerance;
 mod twins;
 mod usd_fixtures;

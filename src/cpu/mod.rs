@@ -18,6 +18,7 @@ pub mod power;
 pub mod quadrature;
 pub mod radiance;
 pub mod roots;
+pub mod sample;
 pub mod shapes;
 pub mod shaping;
 pub mod texture;

@@ -107,8 +107,9 @@ const KNOTS: [[f64; 3]; 22] = [
     [0.609681, 0.695588, 1.000000], // 10000 K (repeated)
 ];
 
-/// Rec.709 luma weights as UsdLux uses them (rounded, not derived from the primaries).
-const REC709_LUMA: DVec3 = DVec3::new(0.2126, 0.7152, 0.0722);
+/// Rec.709 luma weights as UsdLux uses them (rounded, not derived from the primaries); also the
+/// luminance that light sampling weighs and reports variances in (DESIGN.md §9 S1).
+pub const REC709_LUMA: DVec3 = DVec3::new(0.2126, 0.7152, 0.0722);
 
 /// UsdLuxBlackbodyTemperatureAsRgb in f64 (reference/openusd-reference.md §2.3 (a)).
 pub fn usdlux_blackbody(kelvin: f64) -> DVec3 {

@@ -5,8 +5,10 @@
 //! evaluates these in f64; the GPU packer rounds them once into its record. Nothing here
 //! depends on either backend.
 
+pub mod alias;
 pub mod assets;
 pub mod blackbody;
+pub mod env_table;
 pub mod ies;
 pub mod ies_kinks;
 pub mod normalize;

@@ -6,6 +6,7 @@
 mod ies;
 mod reference;
 mod resident;
+mod sample;
 mod scene;
 
 use std::sync::Arc;
@@ -20,6 +21,7 @@ mod lights;
 #[cfg(feature = "usd")]
 pub use lights::lights_json;
 pub use reference::{Power, Reference};
+pub use sample::{SampleOptions, Samples, Selection};
 pub use scene::PreparedScene;
 
 /// Where queries run.

@@ -28,7 +28,7 @@ pub struct PreparedScene {
     /// reduced), which the conformance check cannot compare.
     device_warnings: Vec<String>,
     /// The CPU's irradiance rule (the reference's, or one for a requested tolerance).
-    rule: Adaptive,
+    pub(super) rule: Adaptive,
 }
 
 impl std::fmt::Debug for PreparedScene {

@@ -1,0 +1,545 @@
+//! Light sampling on the CPU (f64), DESIGN.md §9: for a receiver point x (and optionally its
+//! normal n), a direction ω toward a light with its density per unit solid angle at x and the
+//! radiance along it, exactly as `radiance` gives it; the density of any direction; and the
+//! scene-level choice of a light.
+//!
+//! Each light's strategy (S2), set up once per (light, receiver) by [`LightAt::new`]:
+//! - sphere seen from outside: uniform in the cone it subtends ([`cone`]); a shaped sphere
+//!   under a similarity takes the smaller of that cone and the spot cone's cap (both contain
+//!   every lit direction; of two uniform densities over supersets of the support, the smaller
+//!   has the smaller variance); under a non-uniform scale (an ellipsoid) the local cone carried
+//!   to world ([`area`]);
+//! - rect: uniform in solid angle, Ureña's spherical rectangle or Arvo's two triangles for a
+//!   sheared rect ([`rect`]);
+//! - disk: uniform by area; cylinder: uniform over the visible band ([`area`]);
+//! - distant with angle > 0: uniform in its cone; dome: the filtered texture's alias table, or
+//!   cosine-weighted about n ([`dome`]);
+//! - delta lights (distant with angle 0, `treatAsPoint`, `treatAsLine`): one direction, density
+//!   +∞, and `L` such that `L · max(0, n·ω)` is (on average over u, for a line) the
+//!   irradiance without `diffuse` (S1).
+//!
+//! IES-shaped, shaped rects, disks and cylinders, and textured rects are sampled by their
+//! geometry (S2 "other shapes by their geometry"); their radiance carries the shaping.
+
+pub mod area;
+pub mod cone;
+pub mod dome;
+pub mod rect;
+pub mod rng;
+
+use glam::DVec3;
+
+use super::irradiance::{Adaptive, irradiance_with};
+use super::radiance::radiance;
+use super::shaping::shaping;
+use crate::model::LightType;
+use crate::prepare::Prepared;
+use crate::prepare::blackbody::REC709_LUMA;
+use crate::prepare::env_table::EnvTable;
+use area::{cylinder_pdf, cylinder_sample, disk_pdf, disk_sample, ellipsoid_pdf, ellipsoid_sample};
+use cone::Cone;
+use rect::RectSampler;
+
+/// One drawn direction: unit `dir` from x toward the light, its density per unit solid angle
+/// (`+∞` for a delta light, 0 where the light delivers nothing at x), and the RGB radiance
+/// along it (DESIGN.md §9 S1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    pub dir: DVec3,
+    pub pdf: f64,
+    pub radiance: DVec3,
+}
+
+/// Rec. 709 luminance (S1: variances and weights are of luminance).
+pub fn luminance(c: DVec3) -> f64 {
+    c.dot(REC709_LUMA)
+}
+
+/// A light's strategy set up for one receiver.
+#[derive(Clone, Copy)]
+pub enum LightAt<'a> {
+    /// The light delivers nothing at x (inside a sphere, behind a one-sided shape, dark): any
+    /// unit direction, density 0.
+    Nothing(DVec3),
+    /// A delta light: its one direction and `L` (a line light draws its point in `sample`).
+    Delta(DVec3, DVec3),
+    /// `treatAsLine`: the segment from `a` along `e` (world, X ∈ [−hl, hl]) and the constant
+    /// `base · 2r·|det M|·ρ · 2hl` of its L (outer.rs `line_irradiance`).
+    Line {
+        a: DVec3,
+        e: DVec3,
+        hl: f64,
+        k: DVec3,
+    },
+    /// Uniform in a world cone.
+    Cone(Cone),
+    Ellipsoid {
+        xl: DVec3,
+        r: f64,
+    },
+    Rect(RectSampler),
+    Disk {
+        xl: DVec3,
+        r: f64,
+    },
+    Cylinder {
+        xl: DVec3,
+        hl: f64,
+        r: f64,
+    },
+    Dome {
+        env: Option<&'a EnvTable>,
+        n: Option<DVec3>,
+    },
+}
+
+impl<'a> LightAt<'a> {
+    /// Sets up light `p`'s strategy for the receiver at `x` (normal `n`, where given); `env` is
+    /// the light's alias table if it is a textured dome.
+    pub fn new(p: &Prepared, env: Option<&'a EnvTable>, x: DVec3, n: Option<DVec3>) -> LightAt<'a> {
+        let toward = (p.origin - x).try_normalize().or(n).unwrap_or(DVec3::Y);
+        if p.profile.dark {
+            return LightAt::Nothing(toward);
+        }
+        let xl = p.to_local * (x - p.origin);
+        match p.light.kind {
+            LightType::Dome => LightAt::Dome { env, n },
+            LightType::Distant { .. } => {
+                let theta = p.distant_half_angle();
+                if theta == 0.0 {
+                    LightAt::Delta(-p.axis, p.base)
+                } else {
+                    LightAt::Cone(Cone::with_angle(-p.axis, theta))
+                }
+            }
+            LightType::Sphere {
+                radius,
+                treat_as_point: true,
+            } => {
+                // closed.rs `point_irradiance`: E = base·S(e)·A_proj·cos/d², A_proj the
+                // projected area of the ellipsoid along e, π r² |det M| |M⁻¹ e|.
+                let w = p.origin - x;
+                let d = w.length();
+                if !(d > 0.0) {
+                    return LightAt::Nothing(toward);
+                }
+                let area = std::f64::consts::PI * radius * radius * p.det * xl.length() / d;
+                LightAt::Delta(w / d, p.base * shaping(p, -w / d) * (area / (d * d)))
+            }
+            LightType::Sphere { radius, .. } => {
+                if !(xl.length() > radius) {
+                    return LightAt::Nothing(toward);
+                }
+                match (p.similarity, &p.shaping) {
+                    (Some(s), Some(sh)) => {
+                        let w = p.origin - x;
+                        let d = w.length();
+                        let ball = Cone::subtended(w / d, radius * s, d);
+                        let spot = Cone::with_angle(-p.axis, sh.cone);
+                        LightAt::Cone(if spot.solid_angle() < ball.solid_angle() {
+                            spot
+                        } else {
+                            ball
+                        })
+                    }
+                    _ => LightAt::Ellipsoid { xl, r: radius },
+                }
+            }
+            LightType::Rect { width, height } => {
+                if !(xl.z < 0.0) {
+                    return LightAt::Nothing(toward);
+                }
+                let corner = p.origin + p.linear * DVec3::new(-width / 2.0, -height / 2.0, 0.0);
+                let e1 = p.linear * DVec3::new(width, 0.0, 0.0);
+                let e2 = p.linear * DVec3::new(0.0, height, 0.0);
+                match RectSampler::new(x, corner, e1, e2) {
+                    Some(r) => LightAt::Rect(r),
+                    None => LightAt::Nothing(toward),
+                }
+            }
+            LightType::Disk { radius } => {
+                if !(xl.z < 0.0) {
+                    return LightAt::Nothing(toward);
+                }
+                LightAt::Disk { xl, r: radius }
+            }
+            LightType::Cylinder {
+                length,
+                radius,
+                treat_as_line: true,
+            } => {
+                let hl = length / 2.0;
+                let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+                let weight = 2.0 * radius * p.det * rho;
+                if !(weight > 0.0) || !(hl > 0.0) {
+                    return LightAt::Nothing(toward);
+                }
+                LightAt::Line {
+                    a: p.origin - x,
+                    e: p.linear * DVec3::X,
+                    hl,
+                    k: p.base * (weight * 2.0 * hl),
+                }
+            }
+            LightType::Cylinder { length, radius, .. } => {
+                let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+                if !(rho > radius) {
+                    return LightAt::Nothing(toward);
+                }
+                LightAt::Cylinder {
+                    xl,
+                    hl: length / 2.0,
+                    r: radius,
+                }
+            }
+        }
+    }
+
+    /// Whether this is a delta light (its density is +∞).
+    #[cfg(test)]
+    pub fn is_delta(&self) -> bool {
+        matches!(self, LightAt::Delta(..) | LightAt::Line { .. })
+    }
+
+    /// Draws a direction for `u ∈ [0,1)⁴` (u[0], u[1] the point; u[2], u[3] an environment
+    /// map's texel, u[2] with 53 bits): `(ω, pdf)`, and for delta lights their `L`.
+    fn draw(&self, p: &Prepared, x: DVec3, u: [f64; 4]) -> (DVec3, f64, Option<DVec3>) {
+        let uv = [u[0], u[1]];
+        match *self {
+            LightAt::Nothing(w) => (w, 0.0, Some(DVec3::ZERO)),
+            LightAt::Delta(w, l) => (w, f64::INFINITY, Some(l)),
+            LightAt::Line { a, e, hl, k } => {
+                // A point uniform by length: density 1/(2hl) in X, so L·cos is the line
+                // integrand of outer.rs times 2hl: `L = k · S(−ω) / |w|³` (S1 "treatAsLine").
+                let w = a + e * (hl * (2.0 * u[0] - 1.0));
+                let d = w.length();
+                if !(d > 0.0) {
+                    return (e.normalize(), f64::INFINITY, Some(DVec3::ZERO));
+                }
+                let dir = w / d;
+                (dir, f64::INFINITY, Some(k * shaping(p, -dir) / (d * d * d)))
+            }
+            LightAt::Cone(c) => (c.sample(uv), 1.0 / c.solid_angle(), None),
+            LightAt::Ellipsoid { xl, r } => match ellipsoid_sample(p, xl, r, uv) {
+                Some((w, pdf)) => (w, pdf, None),
+                None => (DVec3::Y, 0.0, Some(DVec3::ZERO)),
+            },
+            LightAt::Rect(r) => (r.sample(x, uv), 1.0 / r.solid_angle(), None),
+            LightAt::Disk { xl, r } => {
+                let (w, pdf) = disk_sample(p, xl, r, uv);
+                (w, pdf, None)
+            }
+            LightAt::Cylinder { xl, hl, r } => match cylinder_sample(p, xl, hl, r, uv) {
+                Some((w, pdf)) => (w, pdf, None),
+                None => (
+                    (p.origin - x).normalize_or(DVec3::Y),
+                    0.0,
+                    Some(DVec3::ZERO),
+                ),
+            },
+            LightAt::Dome { env, n } => {
+                let (w, pdf) = dome::sample_dome(p, env, n, u);
+                (w, pdf, None)
+            }
+        }
+    }
+
+    /// A direction toward the light for `u` (see `draw`), its density and the radiance along it.
+    pub fn sample(&self, p: &Prepared, x: DVec3, u: [f64; 4]) -> Sample {
+        let (dir, pdf, l) = self.draw(p, x, u);
+        let radiance = match l {
+            Some(l) => l,
+            None if pdf > 0.0 => radiance(p, x, dir),
+            None => DVec3::ZERO,
+        };
+        Sample { dir, pdf, radiance }
+    }
+
+    /// The density [`LightAt::sample`] draws the unit `w` with (0 for delta lights: a given
+    /// direction never hits them, S1).
+    pub fn pdf(&self, p: &Prepared, x: DVec3, w: DVec3) -> f64 {
+        match *self {
+            LightAt::Nothing(_) | LightAt::Delta(..) | LightAt::Line { .. } => 0.0,
+            LightAt::Cone(c) => c.pdf(w),
+            LightAt::Ellipsoid { xl, r } => ellipsoid_pdf(p, xl, r, w),
+            LightAt::Rect(r) => match p.light.kind {
+                LightType::Rect { width, height } => {
+                    let xl = p.to_local * (x - p.origin);
+                    if crate::cpu::shapes::rect_hit(xl, p.to_local * w, width / 2.0, height / 2.0) {
+                        1.0 / r.solid_angle()
+                    } else {
+                        0.0
+                    }
+                }
+                _ => 0.0,
+            },
+            LightAt::Disk { xl, r } => disk_pdf(p, xl, r, w),
+            LightAt::Cylinder { xl, hl, r } => cylinder_pdf(p, xl, hl, r, w),
+            LightAt::Dome { env, n } => dome::pdf_dome(p, env, n, w),
+        }
+    }
+}
+
+/// The strategy that samples `p`, in words (for `lights --json`, the sampler report and docs).
+pub fn strategy(p: &Prepared) -> &'static str {
+    match p.light.kind {
+        LightType::Dome if p.dome_texture().is_some() => "alias table over the filtered texture",
+        LightType::Dome => "cosine-weighted about the normal (uniform without one)",
+        LightType::Distant { .. } if p.distant_half_angle() == 0.0 => "delta (one direction)",
+        LightType::Distant { .. } => "uniform in its cone",
+        LightType::Sphere {
+            treat_as_point: true,
+            ..
+        } => "delta (treatAsPoint)",
+        LightType::Sphere { .. } if p.similarity.is_none() => {
+            "uniform in the local subtended cone (ellipsoid)"
+        }
+        LightType::Sphere { .. } if p.shaping.is_some() => {
+            "uniform in the smaller of the subtended cone and the spot cone"
+        }
+        LightType::Sphere { .. } => "uniform in the subtended cone",
+        LightType::Rect { .. } => "uniform in solid angle (spherical rectangle or triangles)",
+        LightType::Disk { .. } => "uniform by area",
+        LightType::Cylinder {
+            treat_as_line: true,
+            ..
+        } => "delta (treatAsLine, uniform by length)",
+        LightType::Cylinder { .. } => "uniform over the visible band by area",
+    }
+}
+
+/// How `sample_scene` chooses a light at a receiver (DESIGN.md §9 S1 "Scene level").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Selection {
+    /// By power (luminous flux; for a dome or distant light, its irradiance on a receiver
+    /// facing it), the same at every receiver.
+    Power,
+    /// By an estimate of what the light delivers at (x, n): luminance × solid angle (from a
+    /// bounding sphere) × the largest cosine the receiver can see it at, as light trees
+    /// bound a cluster (Conty Estevez & Kulla, "Importance Sampling of Many Lights with
+    /// Adaptive Tree Splitting", HPG 2018, §4.1).
+    #[default]
+    Bound,
+    /// By luxeval's exact irradiance of each light at (x, n) (needs normals).
+    Exact,
+}
+
+/// A weight that is positive whenever any channel is: the luminance, or where that is 0 (a
+/// colour with luminance 0 but a positive channel cannot occur for non-negative colours, but a
+/// tint can cancel), the largest channel.
+fn weight_of(c: DVec3) -> f64 {
+    let y = luminance(c);
+    if y > 0.0 { y } else { c.max_element().max(0.0) }
+}
+
+/// The bounding-sphere radius of a light's shape in world units: `Σ |half extent_i| |M e_i|`
+/// bounds `|M v|` over the local shape's box.
+fn world_bound_radius(p: &Prepared) -> f64 {
+    let ext = match p.light.kind {
+        LightType::Rect { width, height } => DVec3::new(width / 2.0, height / 2.0, 0.0),
+        LightType::Disk { radius } => DVec3::new(radius, radius, 0.0),
+        LightType::Sphere { radius, .. } => DVec3::splat(radius),
+        LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
+        LightType::Dome | LightType::Distant { .. } => DVec3::ZERO,
+    };
+    ext.x * p.linear.x_axis.length()
+        + ext.y * p.linear.y_axis.length()
+        + ext.z * p.linear.z_axis.length()
+}
+
+/// The per-light data of a scene's sampler: the dome tables and, for `Selection::Exact`, the
+/// lights with `diffuse` 1 (the estimator targets irradiance / diffuse, S1).
+pub struct SceneTables {
+    pub env: Vec<Option<EnvTable>>,
+    power: Vec<f64>,
+    undiffused: Vec<Prepared>,
+}
+
+impl SceneTables {
+    pub fn new(lights: &[Prepared], selection: Selection) -> SceneTables {
+        let env = lights
+            .iter()
+            .map(|p| p.dome_texture().and_then(EnvTable::new))
+            .collect();
+        let power = match selection {
+            Selection::Power => lights.iter().map(power_weight).collect(),
+            _ => Vec::new(),
+        };
+        let undiffused = match selection {
+            Selection::Exact => lights
+                .iter()
+                .map(|p| {
+                    let mut q = p.clone();
+                    q.light.inputs.diffuse = 1.0;
+                    q
+                })
+                .collect(),
+            _ => Vec::new(),
+        };
+        SceneTables {
+            env,
+            power,
+            undiffused,
+        }
+    }
+}
+
+/// Power as a selection weight (constant over receivers).
+fn power_weight(p: &Prepared) -> f64 {
+    let facing = match p.light.kind {
+        // A uniform dome's irradiance on a receiver facing anywhere: π L.
+        LightType::Dome => Some(std::f64::consts::PI),
+        // A distant cone facing the receiver: π sin²θ (closed.rs `cap_irradiance`); delta: 1.
+        LightType::Distant { .. } => {
+            let t = p.distant_half_angle();
+            Some(if t == 0.0 {
+                1.0
+            } else {
+                std::f64::consts::PI * t.sin().powi(2)
+            })
+        }
+        _ => None,
+    };
+    match facing {
+        Some(k) => weight_of(p.base * k),
+        None => super::power::flux(p).map_or(0.0, weight_of),
+    }
+}
+
+/// The unnormalised selection weights of every light at (x, n).
+pub fn selection_weights(
+    lights: &[Prepared],
+    tables: &SceneTables,
+    x: DVec3,
+    n: Option<DVec3>,
+    selection: Selection,
+    rule: &Adaptive,
+    out: &mut Vec<f64>,
+) {
+    out.clear();
+    for (k, p) in lights.iter().enumerate() {
+        let w = match selection {
+            Selection::Power => tables.power[k],
+            Selection::Exact => match n {
+                Some(n) => weight_of(irradiance_with(&tables.undiffused[k], x, n, rule)),
+                None => 0.0,
+            },
+            Selection::Bound => bound_weight(p, x, n),
+        };
+        out.push(if w.is_finite() { w } else { 0.0 });
+    }
+}
+
+/// [`Selection::Bound`]'s estimate: `Y(base) · Ω̃ · cos_bound`, with Ω̃ the solid angle of the
+/// bounding sphere (2π from inside it) and cos_bound the cosine of the angle between n and the
+/// nearest direction of that sphere (1 without a normal). Positive wherever the light can
+/// deliver light to (x, n); zero behind a one-sided shape or below the receiver's horizon.
+fn bound_weight(p: &Prepared, x: DVec3, n: Option<DVec3>) -> f64 {
+    if p.profile.dark {
+        return 0.0;
+    }
+    let y = weight_of(p.base);
+    let (axis, alpha, omega) = match p.light.kind {
+        LightType::Dome => return y * std::f64::consts::PI,
+        LightType::Distant { .. } => {
+            let t = p.distant_half_angle();
+            (
+                -p.axis,
+                t,
+                if t == 0.0 {
+                    1.0
+                } else {
+                    Cone::with_angle(-p.axis, t).solid_angle()
+                },
+            )
+        }
+        _ => {
+            let xl = p.to_local * (x - p.origin);
+            let one_sided = matches!(
+                p.light.kind,
+                LightType::Rect { .. } | LightType::Disk { .. }
+            );
+            if one_sided && !(xl.z < 0.0) {
+                return 0.0;
+            }
+            let w = p.origin - x;
+            let d = w.length();
+            let r = world_bound_radius(p);
+            if !(d > r) {
+                (
+                    w.normalize_or(DVec3::Y),
+                    std::f64::consts::PI,
+                    2.0 * std::f64::consts::PI,
+                )
+            } else {
+                let c = Cone::subtended(w / d, r, d);
+                (
+                    (w / d),
+                    (r / d).asin(),
+                    c.solid_angle().max(f64::MIN_POSITIVE),
+                )
+            }
+        }
+    };
+    let cos = match n {
+        Some(n) => {
+            let theta = n.dot(axis).clamp(-1.0, 1.0).acos();
+            (theta - alpha).max(0.0).cos().max(0.0)
+        }
+        None => 1.0,
+    };
+    // A receiver grazing the bound still gets a positive weight when the sphere straddles its
+    // horizon (theta − alpha < π/2 strictly).
+    y * omega * cos
+}
+
+/// The light chosen for uniform `u` by the normalised weights' CDF, with its probability;
+/// never a light of weight 0.
+pub fn choose(weights: &[f64], total: f64, u: f64) -> Option<(usize, f64)> {
+    if !(total > 0.0) {
+        return None;
+    }
+    let target = u * total;
+    let mut acc = 0.0;
+    let mut last = None;
+    for (k, &w) in weights.iter().enumerate() {
+        if w > 0.0 {
+            acc += w;
+            last = Some(k);
+            if target < acc {
+                return Some((k, w / total));
+            }
+        }
+    }
+    last.map(|k| (k, weights[k] / total))
+}
+
+/// `P(l | x) · pdf_l(ω)` summed over lights (DESIGN.md §9 S1); with `per_light`, one value per
+/// light written to `rows`.
+pub fn scene_pdf(
+    lights: &[Prepared],
+    tables: &SceneTables,
+    weights: &[f64],
+    x: DVec3,
+    n: Option<DVec3>,
+    w: DVec3,
+    rows: &mut [f64],
+) -> f64 {
+    let total: f64 = weights.iter().sum();
+    let mut sum = 0.0;
+    for (k, p) in lights.iter().enumerate() {
+        let v = if total > 0.0 && weights[k] > 0.0 {
+            let at = LightAt::new(p, tables.env[k].as_ref(), x, n);
+            weights[k] / total * at.pdf(p, x, w)
+        } else {
+            0.0
+        };
+        if let Some(r) = rows.get_mut(k) {
+            *r = v;
+        }
+        sum += v;
+    }
+    sum
+}
+#[cfg(test)]
+mod tests;
