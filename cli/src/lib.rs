@@ -30,6 +30,7 @@ mod lights;
 mod open;
 pub mod plot;
 mod query;
+mod sample;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -136,6 +137,13 @@ enum Command {
         png: Option<PathBuf>,
     },
     Falloff(falloff::FalloffArgs),
+    /// Draw directions toward the lights with their densities (DESIGN.md §9): per point, a light
+    /// chosen by --selection, then a direction by its strategy; dirs, pdf, radiance, light_pdf
+    /// and light into an .npz. Runs on the CPU reference.
+    Sample(sample::SampleArgs),
+    /// The density with which `sample` draws each (point, direction) pair's direction:
+    /// Σ_l P(l | x) · pdf_l(ω) (delta lights 0), or per light with --per-light.
+    Pdf(sample::PdfArgs),
     /// Run every query on the CPU reference and on the GPU for randomised samples of every light
     /// in the stage, and print the largest relative errors per light and query. Exits 1 when any
     /// is over tolerance (1e-4 away from the documented excluded band).
@@ -237,6 +245,8 @@ fn run(cli: Cli) -> CliResult {
             &output,
         ),
         Command::Falloff(a) => falloff::run(&a),
+        Command::Sample(a) => sample::run_sample(&a),
+        Command::Pdf(a) => sample::run_pdf(&a),
         Command::Ies(a) => ies::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Bench(a) => bench::run(a),

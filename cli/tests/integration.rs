@@ -18,6 +18,7 @@ mod cli;
 mod maps;
 mod pipeline_cache;
 mod robustness;
+mod sample;
 mod stream;
 mod stream_refusals;
 mod support;

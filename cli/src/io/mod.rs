@@ -3,6 +3,7 @@
 
 pub mod exr;
 pub mod npy;
+pub mod npz;
 
 use std::io::Write;
 use std::path::Path;
