@@ -90,7 +90,8 @@ pub use prepare::ies::{
 #[cfg(feature = "usd")]
 pub use query::lights_json;
 pub use query::{
-    Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, Samples, Selection,
+    Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, SamplerCheck, Samples,
+    Selection, StrategyVariance,
 };
 pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]

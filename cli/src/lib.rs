@@ -144,6 +144,11 @@ enum Command {
     /// The density with which `sample` draws each (point, direction) pair's direction:
     /// Σ_l P(l | x) · pdf_l(ω) (delta lights 0), or per light with --per-light.
     Pdf(sample::PdfArgs),
+    /// The sampler report (DESIGN.md §9 S4): per light, the relative variance per sample of
+    /// luxeval's strategy and of the uniform-area and cosine baselines at the receivers, and
+    /// samples to 1 % noise, by deterministic cubature; or, with --check, a judgement of
+    /// another renderer's directions and pdfs (exit 1 when biased or inconsistent).
+    Sampling(sample::SamplingArgs),
     /// Run every query on the CPU reference and on the GPU for randomised samples of every light
     /// in the stage, and print the largest relative errors per light and query. Exits 1 when any
     /// is over tolerance (1e-4 away from the documented excluded band).
@@ -155,7 +160,7 @@ enum Command {
     Bench(bench::BenchArgs),
 }
 
-fn write_stdout(args: std::fmt::Arguments) {
+pub(crate) fn write_stdout(args: std::fmt::Arguments) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     if let Err(e) = out.write_fmt(args).and_then(|_| out.write_all(b"\n")) {
@@ -247,6 +252,7 @@ fn run(cli: Cli) -> CliResult {
         Command::Falloff(a) => falloff::run(&a),
         Command::Sample(a) => sample::run_sample(&a),
         Command::Pdf(a) => sample::run_pdf(&a),
+        Command::Sampling(a) => sample::run_sampling(&a),
         Command::Ies(a) => ies::run(&a),
         Command::Check(a) => check::run(&a),
         Command::Bench(a) => bench::run(a),

@@ -240,3 +240,178 @@ pub fn run_pdf(a: &PdfArgs) -> CliResult {
     out.finish()?;
     Ok(())
 }
+
+#[derive(Args)]
+pub struct SamplingArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Receiver points, float (N, 3).
+    #[arg(long, value_name = "P.npy")]
+    pub points: PathBuf,
+    /// Receiver normals, float (N, 3), paired with the points.
+    #[arg(long, value_name = "N.npy")]
+    pub normals: PathBuf,
+    /// Judge another renderer's sampler instead: its directions, float (N, K, 3), K per point
+    /// (point-major), and the densities it claims for them, float (N, K), per unit solid
+    /// angle, against the exact irradiance of the selected lights (--light for one).
+    #[arg(long, num_args = 2, value_names = ["DIRS.npy", "PDFS.npy"])]
+    pub check: Option<Vec<PathBuf>>,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The median of `v` (sorted in place), `None` when empty.
+fn median(v: &mut [f64]) -> Option<f64> {
+    v.sort_by(f64::total_cmp);
+    (!v.is_empty()).then(|| v[v.len() / 2])
+}
+
+/// Samples to 1 % noise: the relative variance per sample over 10⁻⁴, at least 1.
+fn samples_to_1pc(rv: f64) -> u64 {
+    (rv / 1e-4).ceil().max(1.0) as u64
+}
+
+pub fn run_sampling(a: &SamplingArgs) -> CliResult {
+    let points = npy::read_points(&a.points)?;
+    let normals = npy::read_directions(&a.normals)?;
+    if points.len() != normals.len() {
+        return Err(Failure::bad_input(format!(
+            "--points {} has {} rows but --normals {} has {}; they pair up row by row",
+            a.points.display(),
+            points.len(),
+            a.normals.display(),
+            normals.len()
+        )));
+    }
+    let scene = prepare(&a.scene, None, &[])?;
+    let paths: Vec<String> = scene.lights().map(|l| l.path.clone()).collect();
+    if let Some(files) = &a.check {
+        return run_check(a, &scene, &points, &normals, &files[0], &files[1]);
+    }
+    let report = scene.sampling_report(&points, &normals)?;
+    let n = points.len();
+    let mut json = Vec::new();
+    for (k, path) in paths.iter().enumerate() {
+        let rows = &report[k * n..(k + 1) * n];
+        let lit: Vec<_> = rows.iter().filter(|r| r.irradiance > 0.0).collect();
+        let pick = |f: &dyn Fn(&luxeval::StrategyVariance) -> Option<f64>| {
+            let mut v: Vec<f64> = lit.iter().filter_map(|r| f(r)).collect();
+            let max = v
+                .iter()
+                .copied()
+                .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+            (median(&mut v), max)
+        };
+        let lux = pick(&|r| r.luxeval);
+        let area = pick(&|r| r.area);
+        let cos = pick(&|r| r.cosine);
+        let strategy = scene.sampling_strategy(k).unwrap_or("");
+        if a.json {
+            json.push(serde_json::json!({
+                "light": path,
+                "strategy": strategy,
+                "receivers_lit": lit.len(),
+                "receivers": rows.iter().map(|r| serde_json::json!({
+                    "irradiance": r.irradiance,
+                    "luxeval": r.luxeval,
+                    "area": r.area,
+                    "cosine": r.cosine,
+                })).collect::<Vec<_>>(),
+            }));
+            continue;
+        }
+        crate::write_stdout(format_args!("{path}: {strategy}"));
+        crate::write_stdout(format_args!(
+            "  receivers lit: {} of {n}; relative variance per sample, median / max over them; samples to 1 % noise at the median",
+            lit.len()
+        ));
+        for (name, (med, max)) in [("luxeval", lux), ("uniform area", area), ("cosine", cos)] {
+            match (med, max) {
+                (Some(m), Some(x)) => crate::write_stdout(format_args!(
+                    "  {name:<13} {m:>12.4} / {x:<12.4} {:>10}",
+                    samples_to_1pc(m)
+                )),
+                _ => crate::write_stdout(format_args!("  {name:<13} {:>12}", "n/a")),
+            }
+        }
+    }
+    if a.json {
+        crate::write_stdout(format_args!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::Value::Array(json)).unwrap_or_default()
+        ));
+    }
+    Ok(())
+}
+
+fn run_check(
+    a: &SamplingArgs,
+    scene: &PreparedScene,
+    points: &[[f32; 3]],
+    normals: &[[f32; 3]],
+    dirs_path: &Path,
+    pdfs_path: &Path,
+) -> CliResult {
+    let (dshape, dvals) = npy::read_array(dirs_path)?;
+    let (pshape, pvals) = npy::read_array(pdfs_path)?;
+    let n = points.len() as u64;
+    let k = match (dshape.as_slice(), pshape.as_slice()) {
+        ([dn, dk, 3], [pn, pk]) if *dn == n && *pn == n && dk == pk => *dk as usize,
+        _ => {
+            return Err(Failure::bad_input(format!(
+                "--check: {} has shape {dshape:?} and {} has {pshape:?}; expected (N, K, 3) and (N, K) with N = {n} points",
+                dirs_path.display(),
+                pdfs_path.display()
+            )));
+        }
+    };
+    let dirs: Vec<[f32; 3]> = dvals
+        .chunks_exact(3)
+        .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32])
+        .collect();
+    let pdfs: Vec<f32> = pvals.iter().map(|&v| v as f32).collect();
+    let checks = scene.check_sampler(points, normals, &dirs, &pdfs, k)?;
+    let biased: Vec<usize> = (0..checks.len())
+        .filter(|&i| checks[i].z.abs() > 5.0)
+        .collect();
+    let worst = checks.iter().map(|c| c.z.abs()).fold(0.0, f64::max);
+    let worst_cell = checks.iter().map(|c| c.worst_cell_z).fold(0.0, f64::max);
+    let bad: u64 = checks.iter().map(|c| c.bad_pdf).sum();
+    if a.json {
+        crate::write_stdout(format_args!(
+            "{}",
+            serde_json::to_string_pretty(&serde_json::json!({
+                "samples_per_point": k,
+                "worst_abs_z": worst,
+                "points_over_5_sigma": biased.len(),
+                "worst_cell_z": worst_cell,
+                "bad_pdf": bad,
+                "points": checks.iter().map(|c| serde_json::json!({
+                    "exact": c.exact, "mean": c.mean, "stderr": c.stderr, "z": c.z,
+                    "worst_cell_z": c.worst_cell_z, "bad_pdf": c.bad_pdf,
+                })).collect::<Vec<_>>(),
+            }))
+            .unwrap_or_default()
+        ));
+    } else {
+        for (i, c) in checks.iter().enumerate() {
+            crate::write_stdout(format_args!(
+                "point {i}: mean of f/p {:.6} ± {:.6}, exact {:.6}, z = {:+.2}; worst cell z {:+.2}; {} samples with no usable pdf",
+                c.mean, c.stderr, c.exact, c.z, c.worst_cell_z, c.bad_pdf
+            ));
+        }
+        crate::write_stdout(format_args!(
+            "{} of {} points biased beyond 5 standard errors (worst |z| {worst:.2}); worst cell z {worst_cell:.2}; {bad} samples with no usable pdf",
+            biased.len(),
+            checks.len()
+        ));
+    }
+    if !biased.is_empty() || bad > 0 || worst_cell > 5.0 {
+        return Err(Failure::runtime(format!(
+            "the sampler is inconsistent: {} points biased beyond 5σ, worst cell z {worst_cell:.2}, {bad} samples with a pdf ≤ 0 where light arrives",
+            biased.len()
+        )));
+    }
+    Ok(())
+}

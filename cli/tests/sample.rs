@@ -7,6 +7,7 @@ use crate::support::*;
 
 use luxeval::{Evaluator, SampleOptions, Stage};
 use luxeval_cli::io::npy;
+use npyz::WriterBuilder;
 
 fn npz_array(path: &std::path::Path, name: &str) -> (Vec<u64>, Vec<u8>) {
     use std::io::Read;
@@ -168,5 +169,123 @@ fn sample_and_pdf_refuse_bad_input() {
         ],
         None,
     );
+    assert_eq!(r.status.code(), Some(2), "{}", stderr(&r));
+}
+
+/// `luxeval sampling`: the report names each light's strategy and its three figures; `--check`
+/// passes luxeval's own draws (their pdfs), and fails (exit 1) the same directions with every
+/// density halved (a sampler that claims half its true density is biased by 2×).
+#[test]
+fn sampling_report_and_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let pts: Vec<[f32; 3]> = vec![[0.0, 0.0, 0.0], [1.0, 0.0, -1.0]];
+    let nrm = vec![[0.0f32, 1.0, 0.0]; 2];
+    let (p, n) = (dir.path().join("p.npy"), dir.path().join("n.npy"));
+    npy::write_f32(&p, &[2, 3], &pts).unwrap();
+    npy::write_f32(&n, &[2, 3], &nrm).unwrap();
+    let scene = luxtest("sphere.usda");
+    let r = luxeval(
+        &[
+            "sampling",
+            &scene,
+            "--time",
+            "31",
+            "--points",
+            s(&p),
+            "--normals",
+            s(&n),
+        ],
+        None,
+    );
+    assert!(r.status.success(), "{}", stderr(&r));
+    let out = String::from_utf8_lossy(&r.stdout);
+    for word in [
+        "/lights/sphere_light",
+        "luxeval",
+        "uniform area",
+        "cosine",
+        "samples to 1 %",
+    ] {
+        assert!(out.contains(word), "{out}");
+    }
+    // luxeval's own samples, as another renderer would hand them over.
+    let o = dir.path().join("s.npz");
+    let r = luxeval(
+        &[
+            "sample",
+            &scene,
+            "--time",
+            "31",
+            "--points",
+            s(&p),
+            "--normals",
+            s(&n),
+            "--count",
+            "4000",
+            "-o",
+            s(&o),
+        ],
+        None,
+    );
+    assert!(r.status.success(), "{}", stderr(&r));
+    let (dshape, dbytes) = npz_array(&o, "dirs");
+    let (pshape, pbytes) = npz_array(&o, "pdf");
+    let write = |path: &std::path::Path, shape: &[u64], bytes: &[u8], scale: f32| {
+        let vals: Vec<f32> = bytes
+            .chunks(4)
+            .map(|b| f32::from_le_bytes(b.try_into().unwrap()) * scale)
+            .collect();
+        let mut w = npyz::WriteOptions::<f32>::new()
+            .default_dtype()
+            .shape(shape)
+            .writer(std::fs::File::create(path).unwrap())
+            .begin_nd()
+            .unwrap();
+        w.extend(vals).unwrap();
+        w.finish().unwrap();
+    };
+    let (d, good, half) = (
+        dir.path().join("d.npy"),
+        dir.path().join("pdf.npy"),
+        dir.path().join("half.npy"),
+    );
+    write(&d, &dshape, &dbytes, 1.0);
+    write(&good, &pshape, &pbytes, 1.0);
+    write(&half, &pshape, &pbytes, 0.5);
+    let check = |pdfs: &std::path::Path| {
+        luxeval(
+            &[
+                "sampling",
+                &scene,
+                "--time",
+                "31",
+                "--points",
+                s(&p),
+                "--normals",
+                s(&n),
+                "--check",
+                s(&d),
+                s(pdfs),
+            ],
+            None,
+        )
+    };
+    let r = check(&good);
+    assert!(
+        r.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&r.stdout),
+        stderr(&r)
+    );
+    let r = check(&half);
+    assert_eq!(
+        r.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&r.stdout)
+    );
+    assert!(stderr(&r).contains("biased"), "{}", stderr(&r));
+    // A shape that does not pair up: exit 2 naming the files.
+    let r = check(&d);
     assert_eq!(r.status.code(), Some(2), "{}", stderr(&r));
 }

@@ -21,7 +21,7 @@ mod lights;
 #[cfg(feature = "usd")]
 pub use lights::lights_json;
 pub use reference::{Power, Reference};
-pub use sample::{SampleOptions, Samples, Selection};
+pub use sample::{SampleOptions, SamplerCheck, Samples, Selection, StrategyVariance};
 pub use scene::PreparedScene;
 
 /// Where queries run.

@@ -14,6 +14,29 @@ use crate::cpu::sample::{
 use crate::error::{LuxError, Result};
 
 pub use crate::cpu::sample::Selection;
+pub use crate::cpu::sample::report::StrategyVariance;
+
+/// How another renderer's directions and densities at one receiver fare against luxeval's exact
+/// irradiance ([`PreparedScene::check_sampler`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SamplerCheck {
+    /// Σ over the lights of irradiance / diffuse (luminance): what the mean should be.
+    pub exact: f64,
+    /// The mean of `Y(L) · max(0, n·ω) / pdf` over the K samples.
+    pub mean: f64,
+    /// Its standard error (sample standard deviation / √K).
+    pub stderr: f64,
+    /// `(mean − exact) / stderr` (0 when both agree exactly).
+    pub z: f64,
+    /// The pdf's consistency (S4): over 8 × 16 cells B of equal solid angle about n, the mean
+    /// of `1_B(ω)/pdf(ω)` estimates B's solid angle where the sampler reaches all of B; the
+    /// largest z-score of an estimate *above* |B| (a density reported too small, which biases
+    /// the estimator; one below |B| may be support the sampler does not cover) among cells
+    /// with at least 30 draws.
+    pub worst_cell_z: f64,
+    /// Samples with a density ≤ 0 or not finite where `f > 0` (the estimator cannot be formed).
+    pub bad_pdf: u64,
+}
 
 /// Options of [`PreparedScene::sample`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -183,6 +206,145 @@ impl PreparedScene {
                 .flat_map(|k| rows.iter().map(move |r| r[k] as f32))
                 .collect(),
         })
+    }
+
+    /// The sampler report (DESIGN.md §9 S4): for every light and receiver, the relative
+    /// variance per sample of luxeval's strategy and of the uniform-area and cosine baselines,
+    /// by deterministic cubature; light-major (row `l·N + i`).
+    pub fn sampling_report(
+        &self,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+    ) -> Result<Vec<StrategyVariance>> {
+        check_pairs(points, "points", normals, "normals")?;
+        let tables = SceneTables::new(&self.lights, Selection::Bound);
+        let mut out = Vec::with_capacity(self.lights.len() * points.len());
+        for (k, p) in self.lights.iter().enumerate() {
+            let rows: Vec<StrategyVariance> = points
+                .par_iter()
+                .zip(normals)
+                .map(|(x, n)| {
+                    crate::cpu::sample::report::strategy_variance(
+                        p,
+                        tables.env[k].as_ref(),
+                        dvec(*x),
+                        dvec(*n).normalize(),
+                    )
+                })
+                .collect();
+            out.extend(rows);
+        }
+        Ok(out)
+    }
+
+    /// Judges another renderer's sampler at N receivers from its K directions per point
+    /// (`dirs`, point-major N·K) and the densities it claims for them (`pdfs`, per unit solid
+    /// angle): the bias of `f/p` against the exact irradiance of the scene's lights with its
+    /// standard error, and the density's consistency over cells (see [`SamplerCheck`]).
+    pub fn check_sampler(
+        &self,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        dirs: &[[f32; 3]],
+        pdfs: &[f32],
+        count: usize,
+    ) -> Result<Vec<SamplerCheck>> {
+        check_pairs(points, "points", normals, "normals")?;
+        check_directions("directions", dirs)?;
+        if count == 0 || dirs.len() != points.len() * count || pdfs.len() != dirs.len() {
+            return Err(LuxError::input(
+                "directions/pdfs",
+                format!(
+                    "{} points × {count} samples need as many directions and pdfs; got {} and {}",
+                    points.len(),
+                    dirs.len(),
+                    pdfs.len()
+                ),
+            ));
+        }
+        let per = crate::cpu::irradiance_batch(&self.lights, points, normals, true, &self.rule);
+        let diffuse: Vec<f64> = self.lights.iter().map(|p| p.light.inputs.diffuse).collect();
+        let n_points = points.len();
+        Ok((0..n_points)
+            .into_par_iter()
+            .map(|i| {
+                let x = dvec(points[i]);
+                let n = dvec(normals[i]).normalize();
+                let exact: f64 = (0..self.lights.len())
+                    .filter(|&l| diffuse[l] > 0.0)
+                    .map(|l| crate::cpu::sample::luminance(per[l * n_points + i]) / diffuse[l])
+                    .sum();
+                let (mut s1, mut s2, mut bad) = (0.0, 0.0, 0u64);
+                const NT: usize = 8;
+                const NP: usize = 16;
+                let mut cell = [[0.0f64; 2]; NT * NP];
+                let mut hits = [0u64; NT * NP];
+                let (ta, tb) = crate::cpu::sample::cone::basis(n);
+                for j in 0..count {
+                    let r = i * count + j;
+                    let w = dvec(dirs[r]).normalize();
+                    let pdf = pdfs[r] as f64;
+                    let l: DVec3 = self
+                        .lights
+                        .iter()
+                        .map(|p| crate::cpu::radiance::radiance(p, x, w))
+                        .sum();
+                    let f = crate::cpu::sample::luminance(l) * n.dot(w).max(0.0);
+                    let v = if pdf > 0.0 && pdf.is_finite() {
+                        f / pdf
+                    } else {
+                        if f > 0.0 {
+                            bad += 1;
+                        }
+                        0.0
+                    };
+                    s1 += v;
+                    s2 += v * v;
+                    // Cells of equal solid angle: 1 − cos θ about n in NT bands over [0, 2],
+                    // azimuth in NP.
+                    if pdf > 0.0 && pdf.is_finite() {
+                        let t = (1.0 - n.dot(w)).clamp(0.0, 2.0);
+                        let mut phi = w.dot(tb).atan2(w.dot(ta));
+                        if phi < 0.0 {
+                            phi += 2.0 * std::f64::consts::PI;
+                        }
+                        let c = ((t / 2.0 * NT as f64) as usize).min(NT - 1) * NP
+                            + ((phi / (2.0 * std::f64::consts::PI) * NP as f64) as usize)
+                                .min(NP - 1);
+                        cell[c][0] += 1.0 / pdf;
+                        cell[c][1] += 1.0 / (pdf * pdf);
+                        hits[c] += 1;
+                    }
+                }
+                let k = count as f64;
+                let mean = s1 / k;
+                let stderr = ((s2 / k - mean * mean).max(0.0) / k).sqrt();
+                let z = if stderr > 0.0 {
+                    (mean - exact) / stderr
+                } else if (mean - exact).abs() <= 1e-6 * exact.abs() {
+                    0.0
+                } else {
+                    f64::INFINITY.copysign(mean - exact)
+                };
+                let size = 4.0 * std::f64::consts::PI / (NT * NP) as f64;
+                let worst_cell_z = (0..NT * NP)
+                    .filter(|&c| hits[c] >= 30)
+                    .map(|c| {
+                        let m = cell[c][0] / k;
+                        let se = ((cell[c][1] / k - m * m).max(0.0) / k).sqrt();
+                        if se > 0.0 { (m - size) / se } else { 0.0 }
+                    })
+                    .fold(0.0, f64::max);
+                SamplerCheck {
+                    exact,
+                    mean,
+                    stderr,
+                    z,
+                    worst_cell_z,
+                    bad_pdf: bad,
+                }
+            })
+            .collect())
     }
 
     fn check_sampling_inputs(

@@ -23,8 +23,10 @@
 
 pub mod area;
 pub mod cone;
+pub mod cubature;
 pub mod dome;
 pub mod rect;
+pub mod report;
 pub mod rng;
 
 use glam::DVec3;

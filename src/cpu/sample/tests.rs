@@ -11,6 +11,7 @@ use glam::{DMat4, DQuat, DVec3};
 use std::f64::consts::PI;
 
 use super::cone::{Cone, basis};
+use super::cubature::integrate;
 use super::rng::{uniform, uniform53};
 use super::*;
 use crate::cpu::irradiance::irradiance;
@@ -128,101 +129,6 @@ fn dir_at(c: &Cone, t: f64, phi: f64) -> DVec3 {
     (a * (sin * phi.cos()) + b * (sin * phi.sin()) + c.axis * cos).normalize()
 }
 
-/// 4-point Gauss–Legendre nodes and weights on [0, 1].
-const GL4: [(f64, f64); 4] = [
-    (0.069_431_844_202_973_71, 0.173_927_422_568_726_93),
-    (0.330_009_478_207_571_9, 0.326_072_577_431_273_07),
-    (0.669_990_521_792_428_1, 0.326_072_577_431_273_07),
-    (0.930_568_155_797_026_3, 0.173_927_422_568_726_93),
-];
-
-/// `∫∫ g da db` over the panel [a0, a1] × [b0, b1], split `split` times regardless (so that a
-/// corner of the support poking into a cell is seen), then subdividing panels whose probes
-/// straddle the support's edge (some zero, some not) down to `depth`, and smooth ones until the
-/// rule on their quarters agrees with the rule on the whole. Returns the integral and an error
-/// bound for the panels left unresolved at the finest level (the integral over a mixed panel
-/// lies in [0, area · max g at its probes], charged in full).
-fn panel(
-    g: &impl Fn(f64, f64) -> f64,
-    a0: f64,
-    a1: f64,
-    b0: f64,
-    b1: f64,
-    depth: u32,
-    split: u32,
-) -> (f64, f64) {
-    let mut sum = 0.0;
-    let (mut zeros, mut probes) = (0, 0);
-    let (mut lo, mut hi) = (f64::MAX, 0f64);
-    let mut probe = |v: f64| {
-        probes += 1;
-        zeros += (v == 0.0) as usize;
-        (lo, hi) = (lo.min(v), hi.max(v));
-    };
-    for &(ua, wa) in &GL4 {
-        for &(ub, wb) in &GL4 {
-            let v = g(a0 + ua * (a1 - a0), b0 + ub * (b1 - b0));
-            probe(v);
-            sum += wa * wb * v;
-        }
-    }
-    // The Gauss nodes stay 7 % away from the panel's edges, where an edge running along it
-    // could hide: the corners and edge midpoints are probed too.
-    for (ua, ub) in [
-        (0.0, 0.0),
-        (0.5, 0.0),
-        (1.0, 0.0),
-        (0.0, 0.5),
-        (1.0, 0.5),
-        (0.0, 1.0),
-        (0.5, 1.0),
-        (1.0, 1.0),
-        (0.5, 0.5),
-    ] {
-        probe(g(a0 + ua * (a1 - a0), b0 + ub * (b1 - b0)));
-    }
-    let area = (a1 - a0) * (b1 - b0);
-    let mixed = zeros > 0 && zeros < probes;
-    let (am, bm) = (0.5 * (a0 + a1), 0.5 * (b0 + b1));
-    let quads = [
-        (a0, am, b0, bm),
-        (am, a1, b0, bm),
-        (a0, am, bm, b1),
-        (am, a1, bm, b1),
-    ];
-    let recurse = || {
-        let mut out = (0.0, 0.0);
-        for (w, x, y, z) in quads {
-            let r = panel(g, w, x, y, z, depth - 1, split.saturating_sub(1));
-            out = (out.0 + r.0, out.1 + r.1);
-        }
-        out
-    };
-    if depth > 0 && (mixed || split > 0) {
-        return recurse();
-    }
-    if mixed {
-        return (sum * area, area * hi);
-    }
-    // A smooth panel: the rule on its quarters is the estimate, their difference from the
-    // whole panel's the error indicator (refined until below 1e-10 of probability).
-    let quarter = |a0: f64, a1: f64, b0: f64, b1: f64| {
-        let mut s = 0.0;
-        for &(ua, wa) in &GL4 {
-            for &(ub, wb) in &GL4 {
-                s += wa * wb * g(a0 + ua * (a1 - a0), b0 + ub * (b1 - b0));
-            }
-        }
-        s * (a1 - a0) * (b1 - b0)
-    };
-    let fine: f64 = quads.iter().map(|&(w, x, y, z)| quarter(w, x, y, z)).sum();
-    let err = (fine - sum * area).abs();
-    if err > 1e-10 && depth > 0 {
-        return recurse();
-    }
-    (fine, if err > 1e-10 { err } else { 0.0 })
-}
-
 /// The cells of the χ² test: `na × nb` equal cells of a rectangle of parameters
 /// ([a0, a1] × [b0, b1]), with each cell's probability `∫_cell g` and the quadrature's bound.
 struct Cells {
@@ -248,7 +154,7 @@ impl Cells {
         for i in 0..na {
             for j in 0..nb {
                 let (a0, b0) = (a.0 + i as f64 * da, b.0 + j as f64 * db);
-                let (v, e) = panel(g, a0, a0 + da, b0, b0 + db, 10, 2);
+                let (v, e) = integrate(g, (a0, a0 + da), (b0, b0 + db), 10, 2, 1e-10);
                 prob[i * nb + j] = v;
                 bound += e;
             }

@@ -16,6 +16,22 @@ pub(super) struct Header {
 /// Parses NumPy's header, a Python dict literal with exactly the keys `descr`, `fortran_order`
 /// and `shape`, e.g. `{'descr': '<f4', 'fortran_order': False, 'shape': (4, 3), }`.
 pub(super) fn parse_header(text: &str) -> std::result::Result<Header, String> {
+    let (little_endian, item, fortran, shape) = parse_dict(text)?;
+    match shape.as_slice() {
+        [rows, 3] => Ok(Header {
+            little_endian,
+            item,
+            fortran,
+            rows: *rows,
+        }),
+        _ => Err(format!(
+            "shape {shape:?}: expected an array of shape (N, 3)"
+        )),
+    }
+}
+
+/// The dict's dtype (little-endian, item size), order and shape, of any float32/float64 array.
+pub(super) fn parse_dict(text: &str) -> std::result::Result<(bool, usize, bool, Vec<u64>), String> {
     let body = text
         .trim_end_matches(['\n', ' ', '\0'])
         .trim_start()
@@ -91,17 +107,7 @@ pub(super) fn parse_header(text: &str) -> std::result::Result<Header, String> {
             ));
         }
     };
-    match shape.as_slice() {
-        [rows, 3] => Ok(Header {
-            little_endian,
-            item,
-            fortran,
-            rows: *rows,
-        }),
-        _ => Err(format!(
-            "shape {shape:?}: expected an array of shape (N, 3)"
-        )),
-    }
+    Ok((little_endian, item, fortran, shape))
 }
 
 /// A Python string literal in single or double quotes (no escapes: NumPy writes none in these

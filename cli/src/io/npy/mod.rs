@@ -18,7 +18,7 @@ use std::path::Path;
 
 use luxeval::{Limits, LuxError, Result};
 
-pub use read::{Reader, RowKind, read_directions, read_points, read_vec3};
+pub use read::{Reader, RowKind, read_array, read_directions, read_points, read_vec3};
 pub use write::{Writer, write_f32};
 
 fn format_err(path: &Path, reason: impl Into<String>) -> LuxError {

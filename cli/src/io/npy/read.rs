@@ -59,6 +59,89 @@ enum Source {
     Whole(Vec<u8>),
 }
 
+/// A whole float32/float64 `.npy` array of any shape in C order (`luxeval sampling --check`'s
+/// directions (N, K, 3) and densities (N, K)), with its shape: held in memory, so the file is
+/// bounded by [`Limits`]' file size; NaN refused (naming the flat index); ±inf kept (a delta
+/// light's density).
+pub fn read_array(path: &Path) -> Result<(Vec<u64>, Vec<f64>)> {
+    let limits = Limits::from_env()?;
+    let io_err = |source| LuxError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io_err)?;
+    if meta.len() > limits.max_file_bytes {
+        return Err(format_err(
+            path,
+            format!(
+                "{} bytes exceed the limit of {} bytes ({})",
+                meta.len(),
+                limits.max_file_bytes,
+                Limits::raise_hint(Limits::ENV_MAX_FILE_BYTES)
+            ),
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(io_err)?;
+    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
+        return Err(format_err(
+            path,
+            "not a .npy file (it does not start with \\x93NUMPY)",
+        ));
+    }
+    let (header_len, start): (usize, usize) = match bytes[6] {
+        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
+        2 | 3 if bytes.len() >= 12 => (
+            u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
+            12,
+        ),
+        v => return Err(format_err(path, format!("unknown .npy version {v}"))),
+    };
+    let text = bytes
+        .get(start..start.saturating_add(header_len))
+        .and_then(|t| std::str::from_utf8(t).ok())
+        .ok_or_else(|| format_err(path, "the header is cut short or not text"))?;
+    let (little, item, fortran, shape) =
+        super::header::parse_dict(text).map_err(|why| format_err(path, format!("header {why}")))?;
+    if fortran && shape.len() > 1 {
+        return Err(format_err(
+            path,
+            "a Fortran-order array: save it in C order (np.ascontiguousarray)",
+        ));
+    }
+    let count = shape
+        .iter()
+        .try_fold(1u64, |a, &d| a.checked_mul(d))
+        .filter(|c| {
+            c.checked_mul(item as u64)
+                .is_some_and(|b| b <= limits.max_file_bytes)
+        })
+        .ok_or_else(|| format_err(path, format!("shape {shape:?} is too large")))?;
+    let data = &bytes[start + header_len..];
+    if data.len() as u64 != count * item as u64 {
+        return Err(format_err(
+            path,
+            format!(
+                "shape {shape:?} needs {} data bytes, the file holds {}",
+                count * item as u64,
+                data.len()
+            ),
+        ));
+    }
+    let values: Vec<f64> = data
+        .chunks_exact(item)
+        .map(|b| match (item, little) {
+            (4, true) => f32::from_le_bytes(b.try_into().unwrap_or_default()) as f64,
+            (4, false) => f32::from_be_bytes(b.try_into().unwrap_or_default()) as f64,
+            (_, true) => f64::from_le_bytes(b.try_into().unwrap_or_default()),
+            (_, false) => f64::from_be_bytes(b.try_into().unwrap_or_default()),
+        })
+        .collect();
+    if let Some(i) = values.iter().position(|v| v.is_nan()) {
+        return Err(format_err(path, format!("value {i} (flat index) is NaN")));
+    }
+    Ok((shape, values))
+}
+
 /// A streaming reader of an (N, 3) `.npy` input: the header is parsed and checked (dtype, shape,
 /// sizes against the file and [`Limits`]) by [`Reader::open`], then rows come chunk by chunk
 /// from [`Reader::next_chunk`], each row checked as its [`RowKind`] says, errors naming the file
