@@ -10,7 +10,7 @@
 //!   has the smaller variance); under a non-uniform scale (an ellipsoid) the local cone carried
 //!   to world ([`area`]);
 //! - rect: uniform in solid angle, Ureña's spherical rectangle or Arvo's two triangles for a
-//!   sheared rect ([`rect`]);
+//!   sheared rect ([`rect`]); a shaped rect takes the spot cone's cap where it is the smaller;
 //! - disk: uniform by area; cylinder: uniform over the visible band ([`area`]);
 //! - distant with angle > 0: uniform in its cone; dome: the filtered texture's alias table, or
 //!   cosine-weighted about n ([`dome`]);
@@ -132,12 +132,11 @@ impl<'a> LightAt<'a> {
                 if !(xl.length() > radius) {
                     return LightAt::Nothing(toward);
                 }
-                match (p.similarity, &p.shaping) {
-                    (Some(s), Some(sh)) => {
+                match (p.similarity, spot_cap(p)) {
+                    (Some(s), Some(spot)) => {
                         let w = p.origin - x;
                         let d = w.length();
                         let ball = Cone::subtended(w / d, radius * s, d);
-                        let spot = Cone::with_angle(-p.axis, sh.cone);
                         LightAt::Cone(if spot.solid_angle() < ball.solid_angle() {
                             spot
                         } else {
@@ -155,7 +154,13 @@ impl<'a> LightAt<'a> {
                 let e1 = p.linear * DVec3::new(width, 0.0, 0.0);
                 let e2 = p.linear * DVec3::new(0.0, height, 0.0);
                 match RectSampler::new(x, corner, e1, e2) {
-                    Some(r) => LightAt::Rect(r),
+                    // Both densities are uniform over a set holding every lit direction, so
+                    // the smaller set is never worse (module docs): a spot cone narrower than
+                    // the rect seen from x is sampled instead.
+                    Some(r) => match spot_cap(p) {
+                        Some(cap) if cap.solid_angle() < r.solid_angle() => LightAt::Cone(cap),
+                        _ => LightAt::Rect(r),
+                    },
                     None => LightAt::Nothing(toward),
                 }
             }
@@ -282,6 +287,13 @@ impl<'a> LightAt<'a> {
     }
 }
 
+/// The directions ω toward a shaped light whose emission direction −ω lies inside its spot
+/// cone (`shaping:cone:angle` about the axis; the shaping factor is 0 beyond it, DESIGN.md §2):
+/// the cap about −axis. `None` for an unshaped light.
+fn spot_cap(p: &Prepared) -> Option<Cone> {
+    p.shaping.as_ref().map(|sh| Cone::with_angle(-p.axis, sh.cone))
+}
+
 /// The strategy that samples `p`, in words (for `lights --json`, the sampler report and docs).
 pub fn strategy(p: &Prepared) -> &'static str {
     match p.light.kind {
@@ -300,6 +312,9 @@ pub fn strategy(p: &Prepared) -> &'static str {
             "uniform in the smaller of the subtended cone and the spot cone"
         }
         LightType::Sphere { .. } => "uniform in the subtended cone",
+        LightType::Rect { .. } if p.shaping.is_some() => {
+            "uniform in solid angle over the smaller of the rect (spherical rectangle or triangles) and the spot cone"
+        }
         LightType::Rect { .. } => "uniform in solid angle (spherical rectangle or triangles)",
         LightType::Disk { .. } => "uniform by area",
         LightType::Cylinder {

@@ -41,7 +41,9 @@ pub struct StrategyVariance {
 }
 
 /// Where the surface's points along the world direction `w` from `x` are (the parameters t > 0
-/// of `x + t w`, world distance since `w` is unit) and their unit world normals.
+/// of `x + t w`, world distance since `w` is unit) and their unit world normals. `w` comes from
+/// a point of the surface, so a quadric's discriminant is clamped at 0 (a ray to a rim point is
+/// tangent, and rounding must not lose the point it was aimed at).
 fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
     out.clear();
     let xl = p.to_local * (x - p.origin);
@@ -75,8 +77,8 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
         }
         LightType::Sphere { radius: r, .. } => {
             let (a, b, c) = (dl.length_squared(), xl.dot(dl), xl.length_squared() - r * r);
-            let disc = b * b - a * c;
-            if disc >= 0.0 {
+            let disc = (b * b - a * c).max(0.0);
+            {
                 for t in [(-b - disc.sqrt()) / a, (-b + disc.sqrt()) / a] {
                     let y = xl + t * dl;
                     push(t, y, y / r, true);
@@ -89,8 +91,8 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
             let a = dl.y * dl.y + dl.z * dl.z;
             let b = xl.y * dl.y + xl.z * dl.z;
             let c = xl.y * xl.y + xl.z * xl.z - r * r;
-            let disc = b * b - a * c;
-            if a > 0.0 && disc >= 0.0 {
+            let disc = (b * b - a * c).max(0.0);
+            if a > 0.0 {
                 for t in [(-b - disc.sqrt()) / a, (-b + disc.sqrt()) / a] {
                     let y = xl + t * dl;
                     push(
