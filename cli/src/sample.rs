@@ -261,10 +261,11 @@ pub struct SamplingArgs {
     pub json: bool,
 }
 
-/// The median of `v` (sorted in place), `None` when empty.
+/// The median of `v` (sorted in place; the mean of the middle two for an even count), `None`
+/// when empty.
 fn median(v: &mut [f64]) -> Option<f64> {
     v.sort_by(f64::total_cmp);
-    (!v.is_empty()).then(|| v[v.len() / 2])
+    (!v.is_empty()).then(|| 0.5 * (v[(v.len() - 1) / 2] + v[v.len() / 2]))
 }
 
 /// Samples to 1 % noise: the relative variance per sample over 10⁻⁴, at least 1.
