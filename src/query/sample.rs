@@ -125,24 +125,16 @@ impl PreparedScene {
                 (0..count)
                     .map(|j| {
                         // Dimensions (S3): 0, 1 the point on the light, 2 the light, 3 (53
-                        // bits) and 4 an environment map's texel.
+                        // bits) and 4 an environment map's texel, 5 and 6 its tile.
                         let u = |d: u32| rng::uniform(opts.seed, key, j as u32, d);
                         let Some((k, pk)) = choose(&weights, total, u(2)) else {
                             return (n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
                         };
                         let p = &self.lights[k];
-                        let at = *cache[k]
+                        let at = cache[k]
                             .get_or_insert_with(|| LightAt::new(p, tables.env[k].as_ref(), x, n));
-                        let s = at.sample(
-                            p,
-                            x,
-                            [
-                                u(0),
-                                u(1),
-                                rng::uniform53(opts.seed, key, j as u32, 3),
-                                u(4),
-                            ],
-                        );
+                        let fine = rng::uniform53(opts.seed, key, j as u32, 3);
+                        let s = at.sample(p, x, [u(0), u(1), fine, u(4), u(5), u(6)]);
                         (s.dir, pk * s.pdf, s.radiance, pk, k as i32)
                     })
                     .collect()

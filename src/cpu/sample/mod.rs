@@ -12,7 +12,8 @@
 //! - rect: uniform in solid angle, Ureña's spherical rectangle or Arvo's two triangles for a
 //!   sheared rect ([`rect`]); a shaped rect takes the spot cone's cap where it is the smaller;
 //! - disk: uniform by area; cylinder: uniform over the visible band ([`area`]);
-//! - distant with angle > 0: uniform in its cone; dome: the filtered texture's alias table, or
+//! - distant with angle > 0: uniform in its cone; dome: the filtered texture's alias table —
+//!   with a normal, its product with the receiver's cosine bound over tiles of texels — or, untextured,
 //!   cosine-weighted about n ([`dome`]);
 //! - delta lights (distant with angle 0, `treatAsPoint`, `treatAsLine`): one direction, density
 //!   +∞, and `L` such that `L · max(0, n·ω)` is (on average over u, for a line) the
@@ -37,7 +38,7 @@ use super::shaping::shaping;
 use crate::model::LightType;
 use crate::prepare::Prepared;
 use crate::prepare::blackbody::REC709_LUMA;
-use crate::prepare::env_table::EnvTable;
+use crate::prepare::env_table::{EnvTable, ReceiverTiles};
 use area::{cylinder_pdf, cylinder_sample, disk_pdf, disk_sample, ellipsoid_pdf, ellipsoid_sample};
 use cone::Cone;
 use rect::RectSampler;
@@ -58,7 +59,7 @@ pub fn luminance(c: DVec3) -> f64 {
 }
 
 /// A light's strategy set up for one receiver.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 pub enum LightAt<'a> {
     /// The light delivers nothing at x (inside a sphere, behind a one-sided shape, dark): any
     /// unit direction, density 0.
@@ -89,9 +90,12 @@ pub enum LightAt<'a> {
         hl: f64,
         r: f64,
     },
+    /// A dome: its texture's table and, with a normal, the table's product with the
+    /// receiver's cosine by tiles (`EnvTable::receiver_tiles`).
     Dome {
         env: Option<&'a EnvTable>,
         n: Option<DVec3>,
+        tiles: Option<std::sync::Arc<ReceiverTiles>>,
     },
 }
 
@@ -105,7 +109,14 @@ impl<'a> LightAt<'a> {
         }
         let xl = p.to_local * (x - p.origin);
         match p.light.kind {
-            LightType::Dome => LightAt::Dome { env, n },
+            LightType::Dome => LightAt::Dome {
+                env,
+                n,
+                tiles: env
+                    .zip(n)
+                    .and_then(|(t, n)| t.receiver_tiles(n))
+                    .map(std::sync::Arc::new),
+            },
             LightType::Distant { .. } => {
                 let theta = p.distant_half_angle();
                 if theta == 0.0 {
@@ -208,11 +219,12 @@ impl<'a> LightAt<'a> {
         matches!(self, LightAt::Delta(..) | LightAt::Line { .. })
     }
 
-    /// Draws a direction for `u ∈ [0,1)⁴` (u[0], u[1] the point; u[2], u[3] an environment
-    /// map's texel, u[2] with 53 bits): `(ω, pdf)`, and for delta lights their `L`.
-    fn draw(&self, p: &Prepared, x: DVec3, u: [f64; 4]) -> (DVec3, f64, Option<DVec3>) {
+    /// Draws a direction for `u ∈ [0,1)⁶` (u[0], u[1] the point; u[2], u[3] an environment
+    /// map's texel, u[2] with 53 bits; u[4], u[5] its tile): `(ω, pdf)`, and for delta lights
+    /// their `L`.
+    fn draw(&self, p: &Prepared, x: DVec3, u: [f64; 6]) -> (DVec3, f64, Option<DVec3>) {
         let uv = [u[0], u[1]];
-        match *self {
+        match self.clone() {
             LightAt::Nothing(w) => (w, 0.0, Some(DVec3::ZERO)),
             LightAt::Delta(w, l) => (w, f64::INFINITY, Some(l)),
             LightAt::Line { a, e, hl, k } => {
@@ -244,15 +256,15 @@ impl<'a> LightAt<'a> {
                     Some(DVec3::ZERO),
                 ),
             },
-            LightAt::Dome { env, n } => {
-                let (w, pdf) = dome::sample_dome(p, env, n, u);
+            LightAt::Dome { env, n, tiles } => {
+                let (w, pdf) = dome::sample_dome(p, env, n, tiles.as_deref(), u);
                 (w, pdf, None)
             }
         }
     }
 
     /// A direction toward the light for `u` (see `draw`), its density and the radiance along it.
-    pub fn sample(&self, p: &Prepared, x: DVec3, u: [f64; 4]) -> Sample {
+    pub fn sample(&self, p: &Prepared, x: DVec3, u: [f64; 6]) -> Sample {
         let (dir, pdf, l) = self.draw(p, x, u);
         let radiance = match l {
             Some(l) => l,
@@ -282,7 +294,7 @@ impl<'a> LightAt<'a> {
             },
             LightAt::Disk { xl, r } => disk_pdf(p, xl, r, w),
             LightAt::Cylinder { xl, hl, r } => cylinder_pdf(p, xl, hl, r, w),
-            LightAt::Dome { env, n } => dome::pdf_dome(p, env, n, w),
+            LightAt::Dome { env, n, ref tiles } => dome::pdf_dome(p, env, n, tiles.as_deref(), w),
         }
     }
 }
@@ -291,13 +303,17 @@ impl<'a> LightAt<'a> {
 /// cone (`shaping:cone:angle` about the axis; the shaping factor is 0 beyond it, DESIGN.md §2):
 /// the cap about −axis. `None` for an unshaped light.
 fn spot_cap(p: &Prepared) -> Option<Cone> {
-    p.shaping.as_ref().map(|sh| Cone::with_angle(-p.axis, sh.cone))
+    p.shaping
+        .as_ref()
+        .map(|sh| Cone::with_angle(-p.axis, sh.cone))
 }
 
 /// The strategy that samples `p`, in words (for `lights --json`, the sampler report and docs).
 pub fn strategy(p: &Prepared) -> &'static str {
     match p.light.kind {
-        LightType::Dome if p.dome_texture().is_some() => "alias table over the filtered texture",
+        LightType::Dome if p.dome_texture().is_some() => {
+            "alias table over the filtered texture, times the receiver's cosine by tiles when a normal is given"
+        }
         LightType::Dome => "cosine-weighted about the normal (uniform without one)",
         LightType::Distant { .. } if p.distant_half_angle() == 0.0 => "delta (one direction)",
         LightType::Distant { .. } => "uniform in its cone",

@@ -338,6 +338,8 @@ fn check_density(name: &str, p: &Prepared, x: DVec3, n: DVec3, seed: u32) {
             uniform(seed, 0, s, 1),
             uniform53(seed, 0, s, 3),
             uniform(seed, 0, s, 4),
+            uniform(seed, 0, s, 5),
+            uniform(seed, 0, s, 6),
         ];
         let smp = at.sample(p, x, u);
         let back = at.pdf(p, x, smp.dir);
@@ -434,6 +436,8 @@ fn check_mean(name: &str, p: &Prepared, x: DVec3, n: DVec3, seed: u32) {
             uniform(seed, 2, s, 1),
             uniform53(seed, 2, s, 3),
             uniform(seed, 2, s, 4),
+            uniform(seed, 2, s, 5),
+            uniform(seed, 2, s, 6),
         ];
         let smp = at.sample(p, x, u);
         let f = luminance(smp.radiance) * n.dot(smp.dir).max(0.0);
@@ -554,7 +558,7 @@ fn a_wrong_pdf_is_caught() {
     );
     let mut counts = vec![0u64; cells.prob.len()];
     for s in 0..200_000u32 {
-        let mut u = [uniform(9, 0, s, 0), uniform(9, 0, s, 1), 0.0, 0.0];
+        let mut u = [uniform(9, 0, s, 0), uniform(9, 0, s, 1), 0.0, 0.0, 0.0, 0.0];
         // u₀ ↦ u₀^1.1: the solid angle drawn from the first 10 % of u₀ grows by ~26 %.
         u[0] = u[0].powf(1.1);
         let w = at.sample(&p, x, u).dir;
