@@ -364,7 +364,7 @@ def _integer(value: Any, name: str, low: int, high: int, what: str) -> int:
 
 def _check_selection(selection: str, normals: Any) -> None:
     if selection not in ("power", "bound", "exact"):
-        raise InputError(f'selection: {selection!r} is not one of "power", "bound", "exact"')
+        raise InputError(f'selection: "{selection}" is not one of "power", "bound", "exact"')
     if selection == "exact" and normals is None:
         raise InputError(
             'normals: selection="exact" needs a receiver normal per point (it weighs each '
