@@ -15,6 +15,7 @@ TemperatureMode = Literal["spec", "usd", "planckian"]
 TextureFilter = Literal["bilinear", "nearest"]
 Lights = Optional[Union[str, Sequence[str]]]
 Vec3 = Union[Sequence[float], npt.ArrayLike]
+Selection = Literal["power", "bound", "exact"]
 
 class InputError(ValueError):
     """Bad input: an unreadable or malformed stage, an attribute luxeval cannot evaluate, an
@@ -27,7 +28,8 @@ class DeviceError(RuntimeError):
 
 class DeviceWarning(RuntimeWarning):
     """Issued once per process when device="auto" finds no GPU adapter and falls back to the CPU
-    reference."""
+    reference; and by ``Stage.sample`` and ``Stage.pdf`` with device="gpu", which run on the
+    CPU reference (there are no GPU samplers yet)."""
 
 def device_name(device: Device = "auto") -> str:
     """The device a query with this ``device=`` argument runs on: the GPU adapter's name and
@@ -40,7 +42,7 @@ class Stage:
     the stage's ``startTimeCode`` when authored, else at each attribute's earliest time sample.
     Raises ``InputError`` when the file is missing, unreadable or malformed (naming the file and
     line or prim). Queries take any real dtype in C or Fortran order (C-contiguous float32 is
-    used without a copy) and return ``numpy.float32`` arrays; the lights are prepared once per
+    used without a copy) and return ``numpy.float32`` arrays (``sample``: a dict of arrays); the lights are prepared once per
     (lights, device, temperature_mode, texture_filter) and reused. Picklable: unpickling opens the stage again.
     """
 
@@ -140,4 +142,42 @@ class Stage:
     ) -> npt.NDArray[np.float32]:
         """The summed irradiance at the pixel centres of ``origin + s·u + t·v``, res = (W, H)
         → float32 (H, W, 3), row 0 at the top (the ``origin + v`` side)."""
+    def sample(
+        self,
+        points: npt.ArrayLike,
+        normals: Optional[npt.ArrayLike] = None,
+        *,
+        count: int = 1,
+        seed: int = 0,
+        selection: Selection = "bound",
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
+        first_point: int = 0,
+    ) -> dict[str, npt.NDArray[Any]]:
+        """``count`` (K, 1 to 2**20) directions per point (N, 3) toward the lights, as
+        ``luxeval sample``: ``{"dirs": float32 (N, K, 3), "pdf": float32 (N, K) (inf for a
+        delta light), "radiance": float32 (N, K, 3), "light_pdf": float32 (N, K), "light":
+        int32 (N, K) (row of light_paths(lights), -1 where no light reaches the point)}``.
+        ``normals`` (N, 3) or None (needed by ``selection="exact"``); ``seed`` 0 to 2**32 - 1;
+        ``first_point``: the row of ``points[0]`` in a larger input (a slice draws what the
+        whole would). Runs on the CPU reference whatever ``device`` (``DeviceWarning`` for
+        "gpu")."""
+    def pdf(
+        self,
+        points: npt.ArrayLike,
+        dirs: npt.ArrayLike,
+        normals: Optional[npt.ArrayLike] = None,
+        *,
+        per_light: bool = False,
+        selection: Selection = "bound",
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
+    ) -> npt.NDArray[np.float32]:
+        """The density ``sample`` draws each direction with (pairs of (M, 3); ``normals`` as
+        given to ``sample``) → float32 (M,), or (L, M) with ``per_light=True`` (rows sum to the
+        total). Runs on the CPU reference whatever ``device``."""
     def __reduce__(self) -> tuple[type[Stage], tuple[str, Optional[float]]]: ...

@@ -2,7 +2,8 @@
 
 Each function takes a stage (a path, or a :class:`luxeval.Stage`) and dask arrays of shape
 (N, 3), and returns a lazy ``dask.array.Array`` of float32, (N, 3) or (L, N, 3) with
-``per_light=True``, chunked along N like the input. Nothing runs until ``.compute()``; then every
+``per_light=True``, chunked along N like the input (:func:`sample` returns a dict of (N, K, ...) arrays,
+:func:`pdf` float32 (N,) or (L, N)). Nothing runs until ``.compute()``; then every
 chunk is evaluated by whichever scheduler computes it: the local threaded scheduler, a
 ``dask.distributed`` ``LocalCluster``, or any real cluster, the same way::
 
@@ -40,7 +41,15 @@ import numpy as np
 
 from ._luxeval import InputError, Stage
 
-__all__ = ["emission", "radiance", "irradiance", "cache_info", "clear_cache"]
+__all__ = [
+    "emission",
+    "radiance",
+    "irradiance",
+    "sample",
+    "pdf",
+    "cache_info",
+    "clear_cache",
+]
 
 StageLike = Union[str, "os.PathLike[str]", Stage]
 
@@ -136,6 +145,33 @@ def _rows(x: Any, name: str, chunks: int) -> da.Array:
     return x.rechunk({1: 3})
 
 
+def _check_options(device: str, temperature_mode: str, texture_filter: str) -> None:
+    if device not in ("auto", "gpu", "cpu"):
+        raise InputError(f'device: {device!r} is not one of "auto", "gpu", "cpu"')
+    if temperature_mode not in ("spec", "usd", "planckian"):
+        raise InputError(
+            f'temperature_mode: {temperature_mode!r} is not one of "spec", "usd", "planckian"'
+        )
+    if texture_filter not in ("bilinear", "nearest"):
+        raise InputError(
+            f'texture_filter: {texture_filter!r} is not one of "bilinear", "nearest"'
+        )
+
+
+def _paired(arrays: Sequence[tuple[Any, str]], chunks: int) -> list[da.Array]:
+    """The (N, 3) inputs as dask arrays, every one chunked like the first so that blocks pair
+    up row by row."""
+    xs = [_rows(x, name, chunks) for x, name in arrays]
+    first, first_name = xs[0], arrays[0][1]
+    for x, (_, name) in zip(xs[1:], arrays[1:]):
+        if x.shape[0] != first.shape[0]:
+            raise InputError(
+                f"{first_name}/{name}: {first.shape[0]} {first_name} but {x.shape[0]} {name}; "
+                "they pair up row by row"
+            )
+    return [first] + [x.rechunk((first.chunks[0], (3,))) for x in xs[1:]]
+
+
 def _map(
     query: str,
     stage: StageLike,
@@ -155,16 +191,7 @@ def _map(
     # reported now, and the number of lights gives the shape of per-light results.
     local = _stage(path, requested)
     n_lights = len(local.light_paths(lights))
-    if device not in ("auto", "gpu", "cpu"):
-        raise InputError(f'device: {device!r} is not one of "auto", "gpu", "cpu"')
-    if temperature_mode not in ("spec", "usd", "planckian"):
-        raise InputError(
-            f'temperature_mode: {temperature_mode!r} is not one of "spec", "usd", "planckian"'
-        )
-    if texture_filter not in ("bilinear", "nearest"):
-        raise InputError(
-            f'texture_filter: {texture_filter!r} is not one of "bilinear", "nearest"'
-        )
+    _check_options(device, temperature_mode, texture_filter)
     if isinstance(lights, str):
         lights = [lights]
     options = {
@@ -175,16 +202,8 @@ def _map(
         "texture_filter": texture_filter,
         **(extra or {}),
     }
-    xs = [_rows(x, name, chunks) for x, name in arrays]
-    first, first_name = xs[0], arrays[0][1]
-    for x, (_, name) in zip(xs[1:], arrays[1:]):
-        if x.shape[0] != first.shape[0]:
-            raise InputError(
-                f"{first_name}/{name}: {first.shape[0]} {first_name} but {x.shape[0]} {name}; "
-                "they pair up row by row"
-            )
-    # Every input chunked like the first, so that blocks pair up row by row.
-    xs = [first] + [x.rechunk((first.chunks[0], (3,))) for x in xs[1:]]
+    xs = _paired(arrays, chunks)
+    first = xs[0]
     func = functools.partial(_block, query, path, requested, options)
     if per_light:
         return da.map_blocks(
@@ -294,4 +313,183 @@ def irradiance(
         texture_filter=texture_filter,
         chunks=chunks,
         extra={"tolerance": float(tolerance)},
+    )
+
+
+# One record per (point, sample): what Stage.sample returns, in one array per chunk, so that a
+# chunk is sampled once however many of the five results are computed.
+_SAMPLE_DTYPE = np.dtype(
+    [
+        ("dirs", np.float32, (3,)),
+        ("pdf", np.float32),
+        ("radiance", np.float32, (3,)),
+        ("light_pdf", np.float32),
+        ("light", np.int32),
+    ]
+)
+
+MAX_COUNT = 1 << 20
+
+
+def _sample_block(
+    path: str,
+    time: Optional[float],
+    options: dict[str, Any],
+    *blocks: np.ndarray,
+    block_info: Optional[dict] = None,
+) -> np.ndarray:
+    # The chunk's first row in the whole input: the generator is keyed by the row, so every
+    # chunk draws what one call on the whole input draws for its rows.
+    start, stop = block_info[0]["array-location"][0]
+    try:
+        s = _stage(path, time).sample(*blocks, first_point=start, **options)
+    except InputError as e:
+        raise InputError(f"{e} (rows counted within the chunk of rows {start}:{stop})") from None
+    out = np.empty(s["pdf"].shape, dtype=_SAMPLE_DTYPE)
+    for name in _SAMPLE_DTYPE.names:
+        out[name] = s[name]
+    return out
+
+
+def _integer(value: Any, name: str, low: int, high: int, what: str) -> int:
+    if isinstance(value, (bool, np.bool_, float, np.floating)) or not hasattr(value, "__index__"):
+        ok = False
+    else:
+        value = value.__index__()
+        ok = low <= value <= high
+    if not ok:
+        raise InputError(f"{name}: {value!r} is not {what}")
+    return value
+
+
+def _check_selection(selection: str, normals: Any) -> None:
+    if selection not in ("power", "bound", "exact"):
+        raise InputError(f'selection: "{selection}" is not one of "power", "bound", "exact"')
+    if selection == "exact" and normals is None:
+        raise InputError(
+            'normals: selection="exact" needs a receiver normal per point (it weighs each '
+            "light by its irradiance on the receiver)"
+        )
+
+
+def sample(
+    stage: StageLike,
+    points: Any,
+    normals: Any = None,
+    *,
+    count: int = 1,
+    seed: int = 0,
+    selection: str = "bound",
+    time: Optional[float] = None,
+    lights: Union[None, str, Sequence[str]] = None,
+    device: str = "auto",
+    temperature_mode: str = "spec",
+    texture_filter: str = "bilinear",
+    chunks: int = 1_000_000,
+) -> dict[str, da.Array]:
+    """:meth:`luxeval.Stage.sample` over dask arrays of points (and receiver normals) (N, 3),
+    lazily; ``normals`` is rechunked like ``points``.
+
+    Returns a dict of lazy dask arrays chunked along N like ``points``: ``"dirs"`` float32
+    (N, K, 3), ``"pdf"`` (N, K), ``"radiance"`` (N, K, 3), ``"light_pdf"`` (N, K) and int32
+    ``"light"`` (N, K), K = ``count``. Each chunk is sampled with its first row's offset as
+    ``first_point``, so the result is bitwise :meth:`luxeval.Stage.sample` on the whole input,
+    however it is chunked. The five arrays share one sampling task per chunk: compute them
+    together (``dask.compute(result)[0]``) to sample each chunk once. Sampling runs on the CPU
+    reference whatever ``device`` says (``"gpu"`` warns in the worker's log). ``count``,
+    ``seed``, ``selection`` as :meth:`luxeval.Stage.sample`; other arguments as
+    :func:`emission` (``chunks`` counts points).
+    """
+    path, requested = _locate(stage, time)
+    local = _stage(path, requested)
+    local.light_paths(lights)  # a bad selection is reported now
+    _check_options(device, temperature_mode, texture_filter)
+    count = _integer(
+        count, "count", 1, MAX_COUNT,
+        f"from 1 to {MAX_COUNT} samples per point (use more seeds for more)",
+    )
+    seed = _integer(seed, "seed", 0, 2**32 - 1, f"an integer from 0 to {2**32 - 1}")
+    _check_selection(selection, normals)
+    if isinstance(lights, str):
+        lights = [lights]
+    options = {
+        "count": count,
+        "seed": seed,
+        "selection": selection,
+        "lights": None if lights is None else list(lights),
+        "device": device,
+        "temperature_mode": temperature_mode,
+        "texture_filter": texture_filter,
+    }
+    arrays = [(points, "points")] + ([] if normals is None else [(normals, "normals")])
+    xs = _paired(arrays, chunks)
+    func = functools.partial(_sample_block, path, requested, options)
+    records = da.map_blocks(
+        func,
+        *xs,
+        chunks=(xs[0].chunks[0], (count,)),
+        dtype=_SAMPLE_DTYPE,
+        meta=np.empty((0, 0), dtype=_SAMPLE_DTYPE),
+    )
+    return {
+        name: records[name].map_blocks(np.ascontiguousarray, dtype=_SAMPLE_DTYPE[name].base)
+        for name in _SAMPLE_DTYPE.names
+    }
+
+
+def pdf(
+    stage: StageLike,
+    points: Any,
+    dirs: Any,
+    normals: Any = None,
+    *,
+    per_light: bool = False,
+    selection: str = "bound",
+    time: Optional[float] = None,
+    lights: Union[None, str, Sequence[str]] = None,
+    device: str = "auto",
+    temperature_mode: str = "spec",
+    texture_filter: str = "bilinear",
+    chunks: int = 1_000_000,
+) -> da.Array:
+    """:meth:`luxeval.Stage.pdf` over dask arrays of points, directions (and receiver normals)
+    (M, 3) each, lazily; ``dirs`` and ``normals`` are rechunked like ``points``. Returns float32
+    (M,), or (L, M) with ``per_light=True``, chunked along M like ``points``. ``selection`` as
+    :meth:`luxeval.Stage.pdf`; other arguments as :func:`emission`."""
+    path, requested = _locate(stage, time)
+    local = _stage(path, requested)
+    n_lights = len(local.light_paths(lights))
+    _check_options(device, temperature_mode, texture_filter)
+    _check_selection(selection, normals)
+    if isinstance(lights, str):
+        lights = [lights]
+    options = {
+        "per_light": per_light,
+        "selection": selection,
+        "lights": None if lights is None else list(lights),
+        "device": device,
+        "temperature_mode": temperature_mode,
+        "texture_filter": texture_filter,
+    }
+    arrays = [(points, "points"), (dirs, "dirs")]
+    arrays += [] if normals is None else [(normals, "normals")]
+    xs = _paired(arrays, chunks)
+    func = functools.partial(_block, "pdf", path, requested, options)
+    if per_light:
+        return da.map_blocks(
+            func,
+            *xs,
+            drop_axis=1,
+            new_axis=0,
+            chunks=((n_lights,), xs[0].chunks[0]),
+            dtype=np.float32,
+            meta=np.empty((0, 0), dtype=np.float32),
+        )
+    return da.map_blocks(
+        func,
+        *xs,
+        drop_axis=1,
+        chunks=(xs[0].chunks[0],),
+        dtype=np.float32,
+        meta=np.empty((0,), dtype=np.float32),
     )

@@ -2,7 +2,9 @@
 //! selection, and `falloff`'s vectors and resolution, checked with errors naming the argument.
 
 use glam::DVec3;
-use luxeval::{Accumulate, FalloffPlane as Plane, PreparedScene, TemperatureMode, TextureFilter};
+use luxeval::{
+    Accumulate, FalloffPlane as Plane, PreparedScene, Selection, TemperatureMode, TextureFilter,
+};
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyString;
@@ -137,4 +139,59 @@ pub(crate) fn resolution(res: &Bound<'_, PyAny>) -> PyResult<(u32, u32)> {
         )));
     }
     Ok((w, h))
+}
+
+/// The `selection=` argument of `sample` and `pdf` (the CLI's `--selection`).
+pub(crate) fn parse_selection(s: &str) -> PyResult<Selection> {
+    match s {
+        "power" => Ok(Selection::Power),
+        "bound" => Ok(Selection::Bound),
+        "exact" => Ok(Selection::Exact),
+        other => Err(errors::input(format!(
+            "selection: {other:?} is not one of \"power\", \"bound\", \"exact\""
+        ))),
+    }
+}
+
+/// The most samples per point `sample` draws (the CLI's `--count` limit).
+pub(crate) const MAX_COUNT: usize = 1 << 20;
+
+/// `sample`'s `count`: from 1 to [`MAX_COUNT`].
+pub(crate) fn count(count: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let bad = || {
+        errors::input(format!(
+            "count: {} is not from 1 to {MAX_COUNT} samples per point (use more seeds for more)",
+            count.repr().map(|r| r.to_string()).unwrap_or_default()
+        ))
+    };
+    let k: i64 = integer(count).ok_or_else(bad)?;
+    usize::try_from(k)
+        .ok()
+        .filter(|k| (1..=MAX_COUNT).contains(k))
+        .ok_or_else(bad)
+}
+
+/// A non-negative integer argument (`seed`: at most 2³² − 1; `first_point`: at most 2⁶³ − 1).
+pub(crate) fn unsigned(obj: &Bound<'_, PyAny>, name: &str, max: u64) -> PyResult<u64> {
+    integer(obj)
+        .and_then(|v| u64::try_from(v).ok())
+        .filter(|v| *v <= max)
+        .ok_or_else(|| {
+            errors::input(format!(
+                "{name}: {} is not an integer from 0 to {max}",
+                obj.repr().map(|r| r.to_string()).unwrap_or_default()
+            ))
+        })
+}
+
+/// A Python or NumPy integer (not a bool, not a float) that fits an i64.
+fn integer(obj: &Bound<'_, PyAny>) -> Option<i64> {
+    if obj.is_instance_of::<pyo3::types::PyBool>() || obj.is_instance_of::<pyo3::types::PyFloat>()
+    {
+        return None;
+    }
+    obj.call_method0(intern!(obj.py(), "__index__"))
+        .ok()?
+        .extract::<i64>()
+        .ok()
 }

@@ -47,19 +47,20 @@ impl Chunks {
     }
 }
 
-/// A zeroed f32 buffer of `len` values (`None`: more than `usize` can count), or `MemoryError`
+/// A zeroed buffer of `len` values (`None`: more than `usize` can count), or `MemoryError`
 /// rather than an abort when it cannot be allocated.
-pub(crate) fn zeros(len: Option<usize>) -> PyResult<Vec<f32>> {
+pub(crate) fn zeros<T: Copy + Default>(len: Option<usize>) -> PyResult<Vec<T>> {
     let too_big =
         |what: String| PyMemoryError::new_err(format!("cannot allocate the result: {what}"));
     let len = len.ok_or_else(|| too_big("more values than memory can address".into()))?;
     let mut v = Vec::new();
     v.try_reserve_exact(len).map_err(|_| {
         too_big(format!(
-            "{len} float32 values ({} bytes)",
-            len.saturating_mul(4)
+            "{len} values of {} bytes ({} bytes)",
+            size_of::<T>(),
+            len.saturating_mul(size_of::<T>())
         ))
     })?;
-    v.resize(len, 0.0);
+    v.resize(len, T::default());
     Ok(v)
 }

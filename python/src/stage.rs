@@ -6,20 +6,20 @@ use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use luxeval::{
-    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, Stage as ReadStage, TemperatureMode,
-    TextureFilter, TimeRule,
+    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, SampleOptions, Selection,
+    Stage as ReadStage, TemperatureMode, TextureFilter, TimeRule,
 };
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyUserWarning;
 use pyo3::intern;
 use pyo3::prelude::*;
-use pyo3::types::{PyString, PyTuple, PyType};
+use pyo3::types::{PyDict, PyString, PyTuple, PyType};
 
-use crate::args::{Options, parse_lights, resolution, vec3};
+use crate::args::{self, Options, parse_lights, resolution, vec3};
 use crate::arrays;
 use crate::chunks::{Chunks, zeros};
-use crate::device;
+use crate::device::{self, Device};
 use crate::errors::{self, no_panic};
 
 /// A USD stage (``.usda``, ``.usdc``, ``.usdz``) and its lights, read once at one time.
@@ -29,9 +29,9 @@ use crate::errors::{self, no_panic};
 /// when it is authored, else at each attribute's earliest time sample (USD's EarliestTime), as
 /// ``luxeval lights`` does.
 ///
-/// The queries (``emission``, ``radiance``, ``irradiance``, ``falloff``) take NumPy arrays (any
-/// real dtype, C or Fortran order; C-contiguous float32 is used without a copy) and return
-/// ``numpy.float32`` arrays. The lights a query evaluates are prepared once per
+/// The queries (``emission``, ``radiance``, ``irradiance``, ``falloff``, ``sample``, ``pdf``)
+/// take NumPy arrays (any real dtype, C or Fortran order; C-contiguous float32 is used without a
+/// copy) and return ``numpy.float32`` arrays (``sample``: a dict of arrays). The lights a query evaluates are prepared once per
 /// (``lights``, device, ``temperature_mode``, ``texture_filter``) and kept on the stage: later calls reuse the
 /// prepared lights, the GPU pipelines and buffers. The GIL is released while the device works,
 /// and Ctrl-C stops a long call with ``KeyboardInterrupt`` between chunks.
@@ -124,6 +124,66 @@ impl Stage {
         Ok(self.cache().entry(key).or_insert(scene).clone())
     }
 
+    /// The options of `sample` and `pdf`: checked as every query's, then on the CPU reference
+    /// whatever `device` says (there are no GPU samplers yet), with a `DeviceWarning` for "gpu".
+    fn sampling_options(
+        &self,
+        py: Python<'_>,
+        lights: Option<&Bound<'_, PyAny>>,
+        device: &str,
+        mode: &str,
+        filter: &str,
+    ) -> PyResult<Options> {
+        let mut o = Options::parse(lights, device, mode, filter)?;
+        if o.device == Device::Gpu {
+            PyErr::warn(
+                py,
+                &py.get_type::<errors::DeviceWarning>(),
+                c"device=\"gpu\": sampling runs on the CPU reference (the GPU samplers are not written yet)",
+                2,
+            )?;
+        }
+        o.device = Device::Cpu;
+        Ok(o)
+    }
+
+    /// `sample`'s and `pdf`'s points and optional normals, checked (rows, pairing, and the
+    /// normals that `selection="exact"` needs).
+    #[allow(clippy::type_complexity)]
+    fn sampling_rows<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: Option<&Bound<'py, PyAny>>,
+        selection: Selection,
+    ) -> PyResult<(
+        PyReadonlyArray2<'py, f32>,
+        Option<PyReadonlyArray2<'py, f32>>,
+    )> {
+        let normals = normals.filter(|n| !n.is_none());
+        if normals.is_none() && selection == Selection::Exact {
+            return Err(errors::input(
+                "normals: selection=\"exact\" needs a receiver normal per point (it weighs each \
+                 light by its irradiance on the receiver)",
+            ));
+        }
+        let p = arrays::rows(py, points, "points", RowKind::Points)?;
+        let n = match normals {
+            Some(n) => Some(arrays::rows(py, n, "normals", RowKind::Directions)?),
+            None => None,
+        };
+        if let Some(n) = &n
+            && n.shape()[0] != p.shape()[0]
+        {
+            return Err(errors::input(format!(
+                "points/normals: {} points but {} normals; they pair up row by row",
+                p.shape()[0],
+                n.shape()[0]
+            )));
+        }
+        Ok((p, n))
+    }
+
     fn cache(&self) -> std::sync::MutexGuard<'_, HashMap<Key, Arc<PreparedScene>>> {
         self.prepared
             .lock()
@@ -172,7 +232,7 @@ impl Stage {
         } else {
             (Accumulate::Sum, 1)
         };
-        let mut out = zeros(width.checked_mul(n).and_then(|x| x.checked_mul(3)))?;
+        let mut out = zeros::<f32>(width.checked_mul(n).and_then(|x| x.checked_mul(3)))?;
         let mut chunks = Chunks::new(
             match q {
                 Query::Irradiance => 256,
@@ -506,7 +566,7 @@ impl Stage {
         let scene = self.prepare_for(py, &o)?;
         let normal = plane.normal().as_vec3().to_array();
         let pixels = plane.pixels();
-        let mut out = zeros(pixels.checked_mul(3))?;
+        let mut out = zeros::<f32>(pixels.checked_mul(3))?;
         // Whole rows of pixels per call, sized like the queries' chunks.
         let mut chunks = Chunks::new(256, scene.len());
         let file = self.file();
@@ -542,6 +602,226 @@ impl Stage {
         Ok(PyArray1::from_vec(py, out)
             .reshape([h as usize, w as usize, 3])?
             .into_any())
+    }
+
+    /// Draws ``count`` directions per point toward the lights, with their densities, as
+    /// ``luxeval sample`` does (DESIGN.md §9, docs/SAMPLING.md): at each point a light is chosen
+    /// by ``selection``, then a direction by that light's strategy.
+    ///
+    /// ``points``: (N, 3); ``normals``: (N, 3) receiver normals paired with the points, or
+    /// ``None`` (they make the choice of light receiver-aware and the dome cosine-weighted;
+    /// ``selection="exact"`` needs them). ``count``: samples per point, K, from 1 to 2²⁰.
+    /// ``seed``: 0 to 2³² − 1; the generator is keyed by (seed, row, sample), so the same seed
+    /// draws the same directions however the rows are split. ``selection``: ``"bound"`` (each
+    /// light weighed by what it can deliver at the receiver), ``"power"`` (by its flux) or
+    /// ``"exact"`` (by its exact irradiance at (x, n)). ``first_point``: the row of
+    /// ``points[0]`` in a larger input, so that a slice of it draws what the whole would draw
+    /// for those rows (``luxeval.dask.sample`` passes each chunk's offset).
+    ///
+    /// Returns a dict of NumPy arrays, row i·K + j of the library's output at ``[i, j]``:
+    /// ``"dirs"`` float32 (N, K, 3), unit directions from the point toward the chosen light;
+    /// ``"pdf"`` float32 (N, K), P(light | x) · pdf_light(ω) per unit solid angle (``inf`` for a
+    /// delta light: distant, or a point-like sphere; 0 where no light reaches the point);
+    /// ``"radiance"`` float32 (N, K, 3), the chosen light's radiance along the direction (for a
+    /// delta light, the value whose product with max(0, n·ω) is its irradiance, without
+    /// ``diffuse``); ``"light_pdf"`` float32 (N, K), P(light | x); ``"light"`` int32 (N, K), the
+    /// chosen light's row in ``light_paths(lights)``, −1 where no light reaches the point. The
+    /// estimate ``radiance · max(0, n·ω) / pdf`` (``/ light_pdf`` where ``pdf`` is ``inf``)
+    /// averages to the irradiance divided by each light's ``diffuse``.
+    ///
+    /// Sampling runs on the f64 CPU reference whatever ``device`` says (there are no GPU
+    /// samplers yet): ``device="gpu"`` issues a ``DeviceWarning`` saying so, ``"auto"`` opens no
+    /// GPU. The results are bitwise those of ``luxeval sample``. Other options as ``emission``.
+    /// Raises ``InputError`` for a count, seed or selection out of range (naming it), missing
+    /// normals with ``selection="exact"``, and the errors of ``emission``.
+    #[pyo3(signature = (points, normals = None, *, count = None, seed = None, selection = "bound", lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", first_point = None))]
+    #[pyo3(
+        text_signature = "(self, points, normals=None, *, count=1, seed=0, selection=\"bound\", lights=None, device=\"auto\", temperature_mode=\"spec\", texture_filter=\"bilinear\", first_point=0)"
+    )]
+    #[allow(clippy::too_many_arguments)]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        normals: Option<&Bound<'py, PyAny>>,
+        count: Option<&Bound<'py, PyAny>>,
+        seed: Option<&Bound<'py, PyAny>>,
+        selection: &str,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+        texture_filter: &str,
+        first_point: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let o = self.sampling_options(py, lights, device, temperature_mode, texture_filter)?;
+        let k = match count {
+            Some(c) => args::count(c)?,
+            None => 1,
+        };
+        let seed = match seed {
+            Some(s) => args::unsigned(s, "seed", u32::MAX.into())? as u32,
+            None => 0,
+        };
+        let first_point = match first_point {
+            Some(f) => args::unsigned(f, "first_point", i64::MAX as u64)?,
+            None => 0,
+        };
+        let selection = args::parse_selection(selection)?;
+        let (p_arr, n_arr) = self.sampling_rows(py, points, normals, selection)?;
+        let pts = arrays::as_vec3(&p_arr)?;
+        let nrm = match &n_arr {
+            Some(a) => Some(arrays::as_vec3(a)?),
+            None => None,
+        };
+        let scene = self.prepare_for(py, &o)?;
+        let n = pts.len();
+        let total = n.checked_mul(k);
+        let times3 = total.and_then(|t| t.checked_mul(3));
+        let mut dirs = zeros::<f32>(times3)?;
+        let mut pdf = zeros::<f32>(total)?;
+        let mut radiance = zeros::<f32>(times3)?;
+        let mut light_pdf = zeros::<f32>(total)?;
+        let mut light = zeros::<i32>(total)?;
+        // Points per call: a point costs K samples (at most 2²² samples per call).
+        let mut chunks = Chunks::new(((1usize << 12) / k).max(1), k);
+        let file = self.file();
+        let mut start = 0;
+        while start < n {
+            let end = (start + chunks.rows).min(n);
+            let scene = &*scene;
+            let (dirs, pdf, radiance, light_pdf, light) = (
+                &mut dirs,
+                &mut pdf,
+                &mut radiance,
+                &mut light_pdf,
+                &mut light,
+            );
+            let t0 = Instant::now();
+            py.detach(|| {
+                no_panic(|| {
+                    let opts = SampleOptions {
+                        seed,
+                        selection,
+                        first_point: first_point + start as u64,
+                    };
+                    let s = scene
+                        .sample(&pts[start..end], nrm.map(|v| &v[start..end]), k, &opts)
+                        .map_err(|e| errors::lux(e, Some(file)))?;
+                    let (a, b) = (start * k, end * k);
+                    dirs[a * 3..b * 3].copy_from_slice(s.dirs.as_flattened());
+                    pdf[a..b].copy_from_slice(&s.pdf);
+                    radiance[a * 3..b * 3].copy_from_slice(s.radiance.as_flattened());
+                    light_pdf[a..b].copy_from_slice(&s.light_pdf);
+                    light[a..b].copy_from_slice(&s.light);
+                    Ok(())
+                })
+            })?;
+            if end < n {
+                chunks.update(end - start, t0.elapsed().as_secs_f64());
+            }
+            py.check_signals()?;
+            start = end;
+        }
+        let out = PyDict::new(py);
+        out.set_item("dirs", PyArray1::from_vec(py, dirs).reshape([n, k, 3])?)?;
+        out.set_item("pdf", PyArray1::from_vec(py, pdf).reshape([n, k])?)?;
+        out.set_item(
+            "radiance",
+            PyArray1::from_vec(py, radiance).reshape([n, k, 3])?,
+        )?;
+        out.set_item(
+            "light_pdf",
+            PyArray1::from_vec(py, light_pdf).reshape([n, k])?,
+        )?;
+        out.set_item("light", PyArray1::from_vec(py, light).reshape([n, k])?)?;
+        Ok(out)
+    }
+
+    /// The density ``sample`` draws each direction with: for each (point, direction) pair,
+    /// Σ over lights of P(light | x) · pdf_light(ω) per unit solid angle (delta lights add 0),
+    /// as ``luxeval pdf`` computes it.
+    ///
+    /// ``points``, ``dirs``: (M, 3) each, paired row by row (``dirs[i]`` from ``points[i]``,
+    /// any non-zero length); ``normals``: (M, 3) or ``None``, as given to ``sample`` (the
+    /// density depends on them). Returns float32 (M,), or (L, M) with ``per_light=True`` (one
+    /// row per light, in the order of ``light_paths(lights)``, whose sum is the summed
+    /// density). ``selection``, ``device`` and errors as ``sample``; other options as
+    /// ``emission``.
+    #[pyo3(signature = (points, dirs, normals = None, *, per_light = false, selection = "bound", lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
+    #[allow(clippy::too_many_arguments)]
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        points: &Bound<'py, PyAny>,
+        dirs: &Bound<'py, PyAny>,
+        normals: Option<&Bound<'py, PyAny>>,
+        per_light: bool,
+        selection: &str,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+        texture_filter: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = self.sampling_options(py, lights, device, temperature_mode, texture_filter)?;
+        let selection = args::parse_selection(selection)?;
+        let (p_arr, n_arr) = self.sampling_rows(py, points, normals, selection)?;
+        let d_arr = arrays::rows(py, dirs, "dirs", RowKind::Directions)?;
+        let pts = arrays::as_vec3(&p_arr)?;
+        let d = arrays::as_vec3(&d_arr)?;
+        let nrm = match &n_arr {
+            Some(a) => Some(arrays::as_vec3(a)?),
+            None => None,
+        };
+        if d.len() != pts.len() {
+            return Err(errors::input(format!(
+                "points/dirs: {} points but {} dirs; they pair up row by row",
+                pts.len(),
+                d.len()
+            )));
+        }
+        let scene = self.prepare_for(py, &o)?;
+        let m = pts.len();
+        let l = scene.len();
+        let (acc, width) = if per_light {
+            (Accumulate::PerLight, l)
+        } else {
+            (Accumulate::Sum, 1)
+        };
+        let mut out = zeros::<f32>(width.checked_mul(m))?;
+        let mut chunks = Chunks::new(1 << 10, l);
+        let file = self.file();
+        let mut start = 0;
+        while start < m {
+            let end = (start + chunks.rows).min(m);
+            let scene = &*scene;
+            let out = &mut out;
+            let t0 = Instant::now();
+            py.detach(|| {
+                no_panic(|| {
+                    let v = scene
+                        .pdf(
+                            &pts[start..end],
+                            nrm.map(|x| &x[start..end]),
+                            &d[start..end],
+                            selection,
+                            acc,
+                        )
+                        .map_err(|e| errors::lux(e, Some(file)))?;
+                    let c = end - start;
+                    for li in 0..width {
+                        out[li * m + start..li * m + end].copy_from_slice(&v[li * c..(li + 1) * c]);
+                    }
+                    Ok(())
+                })
+            })?;
+            if end < m {
+                chunks.update(end - start, t0.elapsed().as_secs_f64());
+            }
+            py.check_signals()?;
+            start = end;
+        }
+        let shape: Vec<usize> = if per_light { vec![l, m] } else { vec![m] };
+        Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyType>, StageArgs)> {

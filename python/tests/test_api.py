@@ -383,7 +383,7 @@ def test_the_stubs_name_every_public_name_with_its_signature():
     assert set(luxeval.__all__) == public
     stage_public = {n for n in dir(luxeval.Stage) if not n.startswith("_")}
     assert stage_public == {n for n in members if not n.startswith("_")}, stage_public ^ set(members)
-    for name in ("emission", "radiance", "irradiance", "falloff", "light_paths"):
+    for name in ("emission", "radiance", "irradiance", "falloff", "sample", "pdf", "light_paths"):
         runtime = inspect.signature(getattr(luxeval.Stage, name))
         stub_args = members[name].args
         stub = [a.arg for a in stub_args.args + stub_args.kwonlyargs]

@@ -26,10 +26,11 @@ def _run(code: str, tmp_path, timeout: float) -> subprocess.CompletedProcess:
     return p
 
 
-def test_the_readme_has_the_two_examples():
+def test_the_readme_has_the_three_examples():
     blocks = _python_blocks()
-    assert len(blocks) == 2, blocks
-    assert "from pxr import" in blocks[0] and "luxeval.dask" in blocks[1]
+    assert len(blocks) == 3, blocks
+    assert "from pxr import" in blocks[0] and "stage.sample(" in blocks[1]
+    assert "luxeval.dask" in blocks[2]
 
 
 def test_the_usd_core_example(tmp_path):
@@ -39,7 +40,12 @@ def test_the_usd_core_example(tmp_path):
     assert out[1] == "[2. 2. 2.]", out
 
 
+def test_the_sampling_example(tmp_path):
+    out = _run(_python_blocks()[1], tmp_path, 300).stdout.splitlines()
+    assert out == ["[1. 1.]", "[1. 1.]"], out
+
+
 def test_the_dask_example(tmp_path):
     pytest.importorskip("distributed")
-    out = _run(_python_blocks()[1], tmp_path, 300).stdout.splitlines()
+    out = _run(_python_blocks()[2], tmp_path, 300).stdout.splitlines()
     assert out[-1] == "(1000000, 3) float32", out
