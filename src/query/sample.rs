@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::{Accumulate, PreparedScene, check_directions, check_pairs, check_points};
 use crate::cpu::dvec;
 use crate::cpu::sample::{
-    LightAt, SceneTables, choose, rng, scene_pdf, selection_weights, strategy,
+    LightAt, SceneTables, choose, env_tables, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
 
@@ -102,7 +102,7 @@ impl PreparedScene {
                 "0: draw at least one sample per point",
             ));
         }
-        let tables = SceneTables::new(&self.lights, opts.selection);
+        let tables = self.sampling_tables(opts.selection);
         let rows: Vec<Vec<(DVec3, f64, DVec3, f64, i32)>> = points
             .par_iter()
             .enumerate()
@@ -167,7 +167,7 @@ impl PreparedScene {
     ) -> Result<Vec<f32>> {
         self.check_sampling_inputs(points, normals, selection)?;
         check_pairs(points, "points", dirs, "directions")?;
-        let tables = SceneTables::new(&self.lights, selection);
+        let tables = self.sampling_tables(selection);
         let l = self.lights.len();
         let rows: Vec<Vec<f64>> = points
             .par_iter()
@@ -209,7 +209,7 @@ impl PreparedScene {
         normals: &[[f32; 3]],
     ) -> Result<Vec<StrategyVariance>> {
         check_pairs(points, "points", normals, "normals")?;
-        let tables = SceneTables::new(&self.lights, Selection::Bound);
+        let tables = self.sampling_tables(Selection::Bound);
         let mut out = Vec::with_capacity(self.lights.len() * points.len());
         for (k, p) in self.lights.iter().enumerate() {
             let rows: Vec<StrategyVariance> = points
@@ -337,6 +337,22 @@ impl PreparedScene {
                 }
             })
             .collect())
+    }
+
+    /// The sampling tables for `selection`, built on the first call and kept.
+    fn sampling_tables(&self, selection: Selection) -> &SceneTables {
+        let slot = match selection {
+            Selection::Power => 0,
+            Selection::Bound => 1,
+            Selection::Exact => 2,
+        };
+        self.sampling_tables[slot].get_or_init(|| {
+            let env = self
+                .sampling_env
+                .get_or_init(|| std::sync::Arc::new(env_tables(&self.lights)))
+                .clone();
+            SceneTables::new(&self.lights, selection, env)
+        })
     }
 
     fn check_sampling_inputs(

@@ -29,6 +29,11 @@ pub struct PreparedScene {
     device_warnings: Vec<String>,
     /// The CPU's irradiance rule (the reference's, or one for a requested tolerance).
     pub(super) rule: Adaptive,
+    /// Light sampling's tables, built on first use and kept for every later call (a textured
+    /// dome's alias table and tiles cost a pass over its texels): the environment tables, and
+    /// the per-selection weights (`query/sample.rs`).
+    pub(super) sampling_env: std::sync::OnceLock<std::sync::Arc<Vec<Option<crate::prepare::env_table::EnvTable>>>>,
+    pub(super) sampling_tables: [std::sync::OnceLock<crate::cpu::sample::SceneTables>; 3],
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -98,6 +103,8 @@ impl PreparedScene {
             warnings,
             device_warnings,
             rule: Adaptive::REFERENCE,
+            sampling_env: Default::default(),
+            sampling_tables: Default::default(),
         })
     }
 

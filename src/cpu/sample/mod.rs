@@ -383,17 +383,26 @@ fn world_bound_radius(p: &Prepared) -> f64 {
 /// The per-light data of a scene's sampler: the dome tables and, for `Selection::Exact`, the
 /// lights with `diffuse` 1 (the estimator targets irradiance / diffuse, S1).
 pub struct SceneTables {
-    pub env: Vec<Option<EnvTable>>,
+    pub env: std::sync::Arc<Vec<Option<EnvTable>>>,
     power: Vec<f64>,
     undiffused: Vec<Prepared>,
 }
 
+/// Each light's environment table (textured domes; `None` for the others).
+pub fn env_tables(lights: &[Prepared]) -> Vec<Option<EnvTable>> {
+    lights
+        .iter()
+        .map(|p| p.dome_texture().and_then(EnvTable::new))
+        .collect()
+}
+
 impl SceneTables {
-    pub fn new(lights: &[Prepared], selection: Selection) -> SceneTables {
-        let env = lights
-            .iter()
-            .map(|p| p.dome_texture().and_then(EnvTable::new))
-            .collect();
+    /// The tables for `selection`, sharing `env` (built once per scene by [`env_tables`]).
+    pub fn new(
+        lights: &[Prepared],
+        selection: Selection,
+        env: std::sync::Arc<Vec<Option<EnvTable>>>,
+    ) -> SceneTables {
         let power = match selection {
             Selection::Power => lights.iter().map(power_weight).collect(),
             _ => Vec::new(),

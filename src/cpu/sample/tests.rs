@@ -590,7 +590,7 @@ fn a_wrong_pdf_is_caught() {
 fn scene_selection_is_a_proper_mixture() {
     let ls: Vec<Prepared> = lights().iter().map(|(_, l)| prep(l)).collect();
     for sel in [Selection::Power, Selection::Bound, Selection::Exact] {
-        let tables = SceneTables::new(&ls, sel);
+        let tables = SceneTables::new(&ls, sel, std::sync::Arc::new(env_tables(&ls)));
         let (x, n) = (DVec3::new(0.3, 0.0, 0.2), DVec3::Y);
         let mut w = Vec::new();
         selection_weights(&ls, &tables, x, Some(n), sel, &Adaptive::REFERENCE, &mut w);
