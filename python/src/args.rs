@@ -186,8 +186,7 @@ pub(crate) fn unsigned(obj: &Bound<'_, PyAny>, name: &str, max: u64) -> PyResult
 
 /// A Python or NumPy integer (not a bool, not a float) that fits an i64.
 fn integer(obj: &Bound<'_, PyAny>) -> Option<i64> {
-    if obj.is_instance_of::<pyo3::types::PyBool>() || obj.is_instance_of::<pyo3::types::PyFloat>()
-    {
+    if obj.is_instance_of::<pyo3::types::PyBool>() || obj.is_instance_of::<pyo3::types::PyFloat>() {
         return None;
     }
     obj.call_method0(intern!(obj.py(), "__index__"))

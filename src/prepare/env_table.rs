@@ -144,7 +144,10 @@ impl EnvTable {
             .max(1);
         if self.format == DomeFormat::Cross {
             let n = self.width / 3;
-            (1..=target.min(n)).rev().find(|d| n % d == 0).unwrap_or(1)
+            (1..=target.min(n))
+                .rev()
+                .find(|d| n.is_multiple_of(*d))
+                .unwrap_or(1)
         } else {
             target
         }

@@ -72,6 +72,9 @@ pub struct Samples {
     pub light: Vec<i32>,
 }
 
+/// One draw as the batch collects it: direction, `P(l|x)·pdf_l`, radiance, `P(l|x)`, light row.
+type Drawn = (DVec3, f64, DVec3, f64, i32);
+
 impl PreparedScene {
     /// Where sampling runs: always the CPU reference for now (`"cpu"`); a GPU evaluator says
     /// so in its warnings (the CLI prints it).
@@ -103,7 +106,7 @@ impl PreparedScene {
             ));
         }
         let tables = self.sampling_tables(opts.selection);
-        let rows: Vec<Vec<(DVec3, f64, DVec3, f64, i32)>> = points
+        let rows: Vec<Vec<Drawn>> = points
             .par_iter()
             .enumerate()
             .map(|(i, &pt)| {
@@ -113,7 +116,7 @@ impl PreparedScene {
                 let mut weights = Vec::new();
                 selection_weights(
                     &self.lights,
-                    &tables,
+                    tables,
                     x,
                     n,
                     opts.selection,
@@ -179,7 +182,7 @@ impl PreparedScene {
                 let mut weights = Vec::new();
                 selection_weights(
                     &self.lights,
-                    &tables,
+                    tables,
                     x,
                     n,
                     selection,
@@ -187,7 +190,7 @@ impl PreparedScene {
                     &mut weights,
                 );
                 let mut per = vec![0.0; l + 1];
-                let sum = scene_pdf(&self.lights, &tables, &weights, x, n, w, &mut per[..l]);
+                let sum = scene_pdf(&self.lights, tables, &weights, x, n, w, &mut per[..l]);
                 per[l] = sum;
                 per
             })

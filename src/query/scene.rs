@@ -32,7 +32,8 @@ pub struct PreparedScene {
     /// Light sampling's tables, built on first use and kept for every later call (a textured
     /// dome's alias table and tiles cost a pass over its texels): the environment tables, and
     /// the per-selection weights (`query/sample.rs`).
-    pub(super) sampling_env: std::sync::OnceLock<std::sync::Arc<Vec<Option<crate::prepare::env_table::EnvTable>>>>,
+    pub(super) sampling_env:
+        std::sync::OnceLock<std::sync::Arc<Vec<Option<crate::prepare::env_table::EnvTable>>>>,
     pub(super) sampling_tables: [std::sync::OnceLock<crate::cpu::sample::SceneTables>; 3],
 }
 
