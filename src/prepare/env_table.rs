@@ -70,7 +70,7 @@ pub struct EnvTable {
 }
 
 /// Square tiles of `side` texels (the last row and column may be narrower; for a cross `side`
-/// divides the face size, so a tile never straddles faces), about 4096 of them: each with the
+/// divides the face size, so a tile never straddles faces), about 1024 of them: each with the
 /// sum of its texels' probabilities, a cap of world directions holding its image, and an alias
 /// table over its texels.
 #[derive(Clone, Debug, Default)]
@@ -135,7 +135,7 @@ impl EnvTable {
         Some(t)
     }
 
-    /// The tile side: about 4096 tiles; for a cross, the largest divisor of the face size N not
+    /// The tile side: about 1024 tiles (a receiver's table is one pass over them); for a cross, the largest divisor of the face size N not
     /// above that.
     fn tile_side(&self) -> u32 {
         let target = ((self.width as f64 * self.height as f64 / 4096.0)

@@ -134,8 +134,7 @@ impl PreparedScene {
                             return (n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
                         };
                         let p = &self.lights[k];
-                        let at = cache[k]
-                            .get_or_insert_with(|| LightAt::new(p, tables.env[k].as_ref(), x, n));
+                        let at = cache[k].get_or_insert_with(|| tables.light_at(k, p, x, n));
                         let fine = rng::uniform53(opts.seed, key, j as u32, 3);
                         let s = at.sample(p, x, [u(0), u(1), fine, u(4), u(5), u(6)]);
                         (s.dir, pk * s.pdf, s.radiance, pk, k as i32)

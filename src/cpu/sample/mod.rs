@@ -103,6 +103,20 @@ impl<'a> LightAt<'a> {
     /// Sets up light `p`'s strategy for the receiver at `x` (normal `n`, where given); `env` is
     /// the light's alias table if it is a textured dome.
     pub fn new(p: &Prepared, env: Option<&'a EnvTable>, x: DVec3, n: Option<DVec3>) -> LightAt<'a> {
+        Self::with_tiles(p, env, x, n, &|t, n| {
+            t.receiver_tiles(n).map(std::sync::Arc::new)
+        })
+    }
+
+    /// [`LightAt::new`], taking a textured dome's tiles for the receiver from `tiles` (a cache,
+    /// [`SceneTables::light_at`]).
+    pub fn with_tiles(
+        p: &Prepared,
+        env: Option<&'a EnvTable>,
+        x: DVec3,
+        n: Option<DVec3>,
+        tiles: &dyn Fn(&EnvTable, DVec3) -> Option<std::sync::Arc<ReceiverTiles>>,
+    ) -> LightAt<'a> {
         let toward = (p.origin - x).try_normalize().or(n).unwrap_or(DVec3::Y);
         if p.profile.dark {
             return LightAt::Nothing(toward);
@@ -112,10 +126,7 @@ impl<'a> LightAt<'a> {
             LightType::Dome => LightAt::Dome {
                 env,
                 n,
-                tiles: env
-                    .zip(n)
-                    .and_then(|(t, n)| t.receiver_tiles(n))
-                    .map(std::sync::Arc::new),
+                tiles: env.zip(n).and_then(|(t, n)| tiles(t, n)),
             },
             LightType::Distant { .. } => {
                 let theta = p.distant_half_angle();
@@ -386,7 +397,16 @@ pub struct SceneTables {
     pub env: std::sync::Arc<Vec<Option<EnvTable>>>,
     power: Vec<f64>,
     undiffused: Vec<Prepared>,
+    /// Textured domes' receiver tiles by (light, normal's bits): a falloff map's receivers share
+    /// one normal, and a tile table costs a pass over the tiles. Holds at most
+    /// [`TILE_CACHE`] entries; past that, tables are built per receiver.
+    tiles: std::sync::Mutex<
+        std::collections::HashMap<(usize, [u64; 3]), std::sync::Arc<ReceiverTiles>>,
+    >,
 }
+
+/// The most receiver tile tables a scene keeps.
+const TILE_CACHE: usize = 4096;
 
 /// Each light's environment table (textured domes; `None` for the others).
 pub fn env_tables(lights: &[Prepared]) -> Vec<Option<EnvTable>> {
@@ -422,7 +442,32 @@ impl SceneTables {
             env,
             power,
             undiffused,
+            tiles: Default::default(),
         }
+    }
+
+    /// Light k's strategy at (x, n), a textured dome's tiles taken from the cache.
+    pub fn light_at<'s>(
+        &'s self,
+        k: usize,
+        p: &Prepared,
+        x: DVec3,
+        n: Option<DVec3>,
+    ) -> LightAt<'s> {
+        let lookup = |t: &EnvTable, n: DVec3| {
+            let key = (k, n.to_array().map(f64::to_bits));
+            if let Some(hit) = self.tiles.lock().ok().and_then(|m| m.get(&key).cloned()) {
+                return Some(hit);
+            }
+            let built = std::sync::Arc::new(t.receiver_tiles(n)?);
+            if let Ok(mut m) = self.tiles.lock()
+                && m.len() < TILE_CACHE
+            {
+                m.insert(key, built.clone());
+            }
+            Some(built)
+        };
+        LightAt::with_tiles(p, self.env[k].as_ref(), x, n, &lookup)
     }
 }
 
@@ -571,7 +616,7 @@ pub fn scene_pdf(
     let mut sum = 0.0;
     for (k, p) in lights.iter().enumerate() {
         let v = if total > 0.0 && weights[k] > 0.0 {
-            let at = LightAt::new(p, tables.env[k].as_ref(), x, n);
+            let at = tables.light_at(k, p, x, n);
             weights[k] / total * at.pdf(p, x, w)
         } else {
             0.0
