@@ -34,6 +34,7 @@ mod layers;
 mod luxtest_check;
 mod math;
 mod rect_conformance;
+mod sample_conformance;
 mod resident;
 mod robustness;
 mod sampling;

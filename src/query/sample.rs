@@ -1,17 +1,25 @@
 //! Light sampling on a prepared scene (DESIGN.md §9 S1, S4): `sample` draws directions toward
-//! the lights with their densities, `pdf` gives the density of any direction. Both run on the
-//! f64 CPU reference (`cpu::sample`) on every device: the WGSL samplers are not written yet, so
-//! on a GPU evaluator these queries are the host's (said by [`PreparedScene::sampling_device`]).
+//! the lights with their densities, `pdf` gives the density of any direction.
+//!
+//! On a GPU evaluator `sample` chooses each row's light on the host (the CPU's `P(l | x)`, from
+//! the generator's dimension 2) and draws the direction, its density `pdf_l` and the radiance
+//! with the WGSL samplers (shaders/sample.wgsl, keyed by the same (seed, point, sample) as the
+//! CPU, dimensions 0 and 1), except for the lights [`Prepared::sample_on_host`] names (textured
+//! domes), whose rows come from the CPU reference. `pdf` runs on the CPU reference on every
+//! device.
+//!
+//! [`Prepared::sample_on_host`]: crate::prepare::Prepared::sample_on_host
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Accumulate, PreparedScene, check_directions, check_pairs, check_points};
+use super::{Accumulate, Backend, PreparedScene, check_directions, check_pairs, check_points};
 use crate::cpu::dvec;
 use crate::cpu::sample::{
     LightAt, SceneTables, choose, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
+use crate::gpu::sample::SampleRow;
 
 pub use crate::cpu::sample::Selection;
 pub use crate::cpu::sample::report::StrategyVariance;
@@ -72,11 +80,40 @@ pub struct Samples {
     pub light: Vec<i32>,
 }
 
+/// One drawn row of [`PreparedScene::sample`]: ω, `P(l | x) · pdf_l`, L, `P(l | x)`, the light
+/// (−1: none), and the kernel's input where the device draws it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Row {
+    dir: DVec3,
+    pdf: f64,
+    radiance: DVec3,
+    pk: f64,
+    light: i32,
+    gpu: Option<SampleRow>,
+}
+
+impl Row {
+    fn done(dir: DVec3, pdf: f64, radiance: DVec3, pk: f64, light: i32) -> Row {
+        Row {
+            dir,
+            pdf,
+            radiance,
+            pk,
+            light,
+            gpu: None,
+        }
+    }
+}
+
 impl PreparedScene {
-    /// Where sampling runs: always the CPU reference for now (`"cpu"`); a GPU evaluator says
-    /// so in its warnings (the CLI prints it).
+    /// Where `sample` draws directions: `"gpu"` on a GPU evaluator with a light the WGSL
+    /// samplers take (the host fills the rows of textured domes), else `"cpu"`. `pdf` always
+    /// runs on the CPU reference.
     pub fn sampling_device(&self) -> &'static str {
-        "cpu"
+        match self.backend {
+            Backend::Gpu(_) if self.lights.iter().any(|p| !p.sample_on_host()) => "gpu",
+            _ => "cpu",
+        }
     }
 
     /// The strategy light `k` is sampled with, in words (DESIGN.md §9 S2).
@@ -103,7 +140,13 @@ impl PreparedScene {
             ));
         }
         let tables = SceneTables::new(&self.lights, opts.selection);
-        let rows: Vec<Vec<(DVec3, f64, DVec3, f64, i32)>> = points
+        // The rows the GPU draws (a light it samples, on a GPU evaluator).
+        let gpu = match (&self.backend, &self.gpu) {
+            (Backend::Gpu(g), Some(lights)) => Some((g, lights)),
+            _ => None,
+        };
+        let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
+        let rows: Vec<Vec<Row>> = points
             .par_iter()
             .enumerate()
             .map(|(i, &pt)| {
@@ -128,8 +171,24 @@ impl PreparedScene {
                         // bits) and 4 an environment map's texel.
                         let u = |d: u32| rng::uniform(opts.seed, key, j as u32, d);
                         let Some((k, pk)) = choose(&weights, total, u(2)) else {
-                            return (n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
+                            return Row::done(n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
                         };
+                        if on_gpu(k) {
+                            // Drawn on the device below.
+                            return Row {
+                                pk,
+                                light: k as i32,
+                                gpu: Some(SampleRow {
+                                    point: pt,
+                                    normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
+                                    light: k as u32,
+                                    seed: opts.seed,
+                                    point_key: key,
+                                    sample_key: j as u32,
+                                }),
+                                ..Row::default()
+                            };
+                        }
                         let p = &self.lights[k];
                         let at = *cache[k]
                             .get_or_insert_with(|| LightAt::new(p, tables.env[k].as_ref(), x, n));
@@ -143,21 +202,36 @@ impl PreparedScene {
                                 u(4),
                             ],
                         );
-                        (s.dir, pk * s.pdf, s.radiance, pk, k as i32)
+                        Row::done(s.dir, pk * s.pdf, s.radiance, pk, k as i32)
                     })
                     .collect()
             })
             .collect();
+        let mut rows: Vec<Row> = rows.into_iter().flatten().collect();
+        if let Some((g, lights)) = gpu {
+            let (index, input): (Vec<usize>, Vec<SampleRow>) = rows
+                .iter()
+                .enumerate()
+                .filter_map(|(r, row)| row.gpu.map(|g| (r, g)))
+                .unzip();
+            let drawn = g.run_sample(lights, &input)?;
+            for (r, d) in index.into_iter().zip(drawn) {
+                let row = &mut rows[r];
+                row.dir = DVec3::from_array(d.dir.map(f64::from));
+                row.pdf = row.pk * d.pdf as f64;
+                row.radiance = DVec3::from_array(d.radiance.map(f64::from));
+            }
+        }
         let mut out = Samples {
             count,
             ..Samples::default()
         };
-        for (dir, pdf, l, pk, k) in rows.into_iter().flatten() {
-            out.dirs.push(dir.as_vec3().to_array());
-            out.pdf.push(pdf as f32);
-            out.radiance.push(l.as_vec3().to_array());
-            out.light_pdf.push(pk as f32);
-            out.light.push(k);
+        for row in rows {
+            out.dirs.push(row.dir.as_vec3().to_array());
+            out.pdf.push(row.pdf as f32);
+            out.radiance.push(row.radiance.as_vec3().to_array());
+            out.light_pdf.push(row.pk as f32);
+            out.light.push(row.light);
         }
         Ok(out)
     }
