@@ -19,11 +19,11 @@ use glam::DVec3;
 use luxeval::testkit::check::radiance_margin;
 use luxeval::testkit::sample::{angle, sampler_margin, uniform};
 use luxeval::testkit::{Rng, radiance_samples, random_lights};
-use luxeval::{Evaluator, Reference, SampleOptions, Selection, TemperatureMode};
+use luxeval::{Accumulate, Evaluator, Reference, SampleOptions, Selection, TemperatureMode};
 
 const TOL: f64 = 1e-4;
 const MAP_BAND: f64 = 1e-4;
-const RADIANCE_BAND: f64 = 1e-3;
+const RADIANCE_BAND: f64 = 1e-4;
 
 fn d(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
@@ -58,6 +58,7 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
     let (mut total, mut excluded, mut compared_delta) = (0usize, 0usize, 0usize);
     let mut worst = Worst::default();
     let mut failures = Vec::new();
+    let mut why = std::collections::BTreeMap::new();
     let t0 = std::time::Instant::now();
     for (li, light) in lights.iter().enumerate() {
         let r = Reference::new(light, TemperatureMode::Spec).unwrap();
@@ -82,6 +83,14 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
         assert_eq!(g.sampling_device(), "gpu");
         let sc = c.sample(&points, normals.as_deref(), count, &opts).unwrap();
         let sg = g.sample(&points, normals.as_deref(), count, &opts).unwrap();
+        // The reference's radiance along the GPU's own directions: where it differs from the
+        // reference's along the CPU's by more than half the tolerance, the radiance is too
+        // steep there (a boundary, a focus toward grazing) for directions 1e-5 rad apart.
+        let xs: Vec<[f32; 3]> = points
+            .iter()
+            .flat_map(|p| std::iter::repeat_n(*p, count))
+            .collect();
+        let along_gpu = c.radiance(&xs, &sg.dirs, Accumulate::Sum).unwrap();
         assert_eq!(sc.light, sg.light, "{}: light choice", light.path);
         assert_eq!(sc.light_pdf, sg.light_pdf, "{}: P(l | x)", light.path);
         for i in 0..points.len() {
@@ -106,10 +115,22 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
                 if sc.light[row] < 0 {
                     continue;
                 }
-                let near = sampler_margin(&r, x, n, u) < MAP_BAND
-                    || (pc > 0.0 && radiance_margin(&r, d(x), dc) < RADIANCE_BAND);
-                if near {
+                let near_map = sampler_margin(&r, x, n, u) < MAP_BAND;
+                let steep = pc.is_finite() && rel(lc, d(along_gpu[row])) > 0.5 * TOL;
+                // A delta light's L is not a radiance along ω (S1): no band.
+                let near_edge = pc > 0.0
+                    && pc.is_finite()
+                    && (steep || radiance_margin(&r, d(x), dc) < RADIANCE_BAND);
+                if near_map || near_edge {
                     excluded += 1;
+                    *why.entry((light.kind.usd_type(), near_map)).or_insert(0) += 1;
+                    if std::env::var("SHOW_EXCLUDED").is_ok() {
+                        println!(
+                            "excluded (map {near_map}, margin {:.2e}): {}",
+                            radiance_margin(&r, d(x), dc),
+                            what()
+                        );
+                    }
                     continue;
                 }
                 if pc.is_infinite() {
@@ -143,6 +164,7 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
         100.0 * frac,
         t0.elapsed().as_secs_f64()
     );
+    println!("excluded by (type, near the sampler map's seam): {why:?}");
     println!("worst angle {:.3e} rad: {}", worst.angle.0, worst.angle.1);
     println!("worst pdf {:.3e} rel: {}", worst.pdf.0, worst.pdf.1);
     println!("worst radiance {:.3e} rel: {}", worst.radiance.0, worst.radiance.1);

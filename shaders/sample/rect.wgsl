@@ -8,15 +8,18 @@
 //   SphericalTriangle::sample and RectSampler::{new, solid_angle, sample}. Which of the two
 //   samplers a rect takes is the host's f64 decision (FLAG_SHEARED_RECT, gpu/record.rs), with
 //   RectSampler::new's own test.
-// GPU-only great_circle_angle, oosterom: the f32 forms of the interior angle and of the solid
-//   angle of a triangle (Van Oosterom & Strackee 1983), see below.
+// GPU-only oosterom: the solid angle of a triangle by Van Oosterom & Strackee (1983), see below.
+// GPU-only sub_rect_solid_angle: the solid angle of Ureña's sub-rectangle, for the bisection.
 // f32: the solid angles Ω (the density 1/Ω and the u[0] scale) are Van Oosterom & Strackee's
 //   atan2 formula with the triple product formed from the exact edges, not Girard's Σγ − π, which
 //   loses every digit of a small Ω in f32 (a 0.1 m rect 5 m away: Ω ≈ 4e-4, Girard's f32 error
-//   1e-3 relative). The interior angles are atan2(|a × b|, −a·b) (shared/math.wgsl's
-//   atan2_accurate), not acos, which loses half the digits near 0 and π. The spherical
-//   triangles' plane normals are crossed from the exact edge vectors rather than from the unit
-//   vertex directions.
+//   1e-3 relative); its atan2 is shared/math.wgsl's atan2_accurate. Ureña's k, b0, b1 and Arvo's
+//   angle α are not needed (see the next item).
+// f32: the first step of each parametrization — Ureña's edge xu, Arvo's vertex Ĉ — is the same
+//   point (the sub-rectangle or sub-triangle of solid angle u[0]·Ω), found by 26 bisection steps
+//   on that solid angle (Van Oosterom & Strackee again) instead of the closed forms, whose f32
+//   cancellations (cos(au)·b0 − b1, 1 − q²) put small lights' directions 1e-3 of their angular
+//   size (Ureña) to 10 % (Arvo) off. Arvo's second step takes 1 − cos from the chord |Ĉ − B|²/2.
 // f32: the Ureña point is returned as its direction from o, without adding o and subtracting it.
 
 // #import shared/math.wgsl
@@ -31,16 +34,8 @@ struct SphRect {
     x1: f32,
     y0: f32,
     y1: f32,
-    b0: f32,
-    b1: f32,
-    k: f32,
     // Ω; 0 when o lies in the rectangle's plane.
     solid_angle: f32,
-}
-
-// The angle between two great circles of inner normals a and b: acos(−a·b), by atan2.
-fn great_circle_angle(a: vec3<f32>, b: vec3<f32>) -> f32 {
-    return atan2_accurate(length(cross(a, b)), -dot(a, b));
 }
 
 // 2·atan2(|triple|, la lb lc + (a·b) lc + (a·c) lb + (b·c) la): the solid angle of the triangle
@@ -76,29 +71,39 @@ fn spherical_rect(d: vec3<f32>, ex: vec3<f32>, ey: vec3<f32>, lx: f32, ly: f32) 
     let v01 = vec3<f32>(r.x0, r.y1, r.z0);
     let v10 = vec3<f32>(r.x1, r.y0, r.z0);
     let v11 = vec3<f32>(r.x1, r.y1, r.z0);
-    let n0 = normalize(cross(v00, v10));
-    let n1 = normalize(cross(v10, v11));
-    let n2 = normalize(cross(v11, v01));
-    let n3 = normalize(cross(v01, v00));
-    let g2 = great_circle_angle(n2, n3);
-    let g3 = great_circle_angle(n3, n0);
-    r.k = 2.0 * PI - g2 - g3;
     // Both triangles (v00, v10, v11) and (v00, v11, v01) have triple product z0·lx·ly.
     let triple = r.z0 * lx * ly;
     r.solid_angle = oosterom(v00, v10, v11, triple) + oosterom(v00, v11, v01, triple);
-    r.b0 = n0.z;
-    r.b1 = n2.z;
     return r;
 }
 
-// The direction from o toward the rectangle's point for u (Ureña 2013, Algorithm 2).
+// The solid angle of the sub-rectangle [x0, xu] × [y0, y1] (Ureña's frame).
+fn sub_rect_solid_angle(r: SphRect, xu: f32) -> f32 {
+    let a = vec3<f32>(r.x0, r.y0, r.z0);
+    let b = vec3<f32>(xu, r.y0, r.z0);
+    let c = vec3<f32>(xu, r.y1, r.z0);
+    let d = vec3<f32>(r.x0, r.y1, r.z0);
+    let triple = r.z0 * (xu - r.x0) * (r.y1 - r.y0);
+    return oosterom(a, b, c, triple) + oosterom(a, c, d, triple);
+}
+
+// The direction from o toward the rectangle's point for u (Ureña 2013, Algorithm 2): the edge xu
+// of the sub-rectangle of solid angle u[0]·Ω, then the height along it by u[1].
 fn sample_point(r: SphRect, u: vec2<f32>) -> vec3<f32> {
-    let au = u.x * r.solid_angle + r.k;
-    let sa = sin(au);
-    let ca = cos(au);
-    let fu = (ca * r.b0 - r.b1) / sa;
-    let cu = clamp(select(1.0, -1.0, fu < 0.0) / sqrt(fu * fu + r.b0 * r.b0), -1.0, 1.0);
-    let xu = clamp(-(cu * r.z0) / sqrt(max(1.0 - cu * cu, 0.0)), r.x0, r.x1);
+    // xu by bisection on the sub-rectangle's solid angle (see the header): 26 halvings leave
+    // (x1 − x0)·2⁻²⁶, below the f32 rounding of xu.
+    let goal = u.x * r.solid_angle;
+    var lo = r.x0;
+    var hi = r.x1;
+    for (var i = 0; i < 26; i++) {
+        let mid = 0.5 * (lo + hi);
+        if sub_rect_solid_angle(r, mid) < goal {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let xu = 0.5 * (lo + hi);
     let d = sqrt(xu * xu + r.z0 * r.z0);
     let h0 = r.y0 / sqrt(d * d + r.y0 * r.y0);
     let h1 = r.y1 / sqrt(d * d + r.y1 * r.y1);
@@ -111,53 +116,46 @@ fn sample_point(r: SphRect, u: vec2<f32>) -> vec3<f32> {
     return normalize(xu * r.x + yv * r.y + r.z0 * r.z);
 }
 
-// A spherical triangle: unit vertex directions a, b, c and the angle α at a; Ω its solid angle
-// (0: none).
+// A spherical triangle: its vertex vectors va, vb, vc from the receiver (their directions are the
+// vertices), the triple product va·(vb × vc), and Ω (0: none).
 struct SphTri {
-    a: vec3<f32>,
-    b: vec3<f32>,
-    c: vec3<f32>,
-    alpha: f32,
-    cos_c: f32,
-    solid_angle: f32,
-}
-
-// The triangle of vertex vectors va, vb, vc from the receiver, with the exact edges ab = vb − va,
-// ac = vc − va, bc = vc − vb and the triple product va·(vb × vc).
-fn spherical_triangle(
     va: vec3<f32>,
     vb: vec3<f32>,
     vc: vec3<f32>,
-    ab: vec3<f32>,
-    ac: vec3<f32>,
     triple: f32,
-) -> SphTri {
-    var t: SphTri;
-    t.a = normalize(va);
-    t.b = normalize(vb);
-    t.c = normalize(vc);
-    let nab = normalize(cross(va, ab));
-    let nac = normalize(cross(va, ac));
-    t.alpha = atan2_accurate(length(cross(nab, nac)), dot(nab, nac));
-    t.cos_c = dot(t.a, t.b);
-    let omega = oosterom(va, vb, vc, triple);
-    t.solid_angle = select(0.0, omega, omega > 0.0 && omega < 4.0 * PI);
-    return t;
+    solid_angle: f32,
 }
 
-// A direction uniform in the triangle (Arvo 1995).
+fn spherical_triangle(va: vec3<f32>, vb: vec3<f32>, vc: vec3<f32>, triple: f32) -> SphTri {
+    let omega = oosterom(va, vb, vc, triple);
+    return SphTri(va, vb, vc, triple, select(0.0, omega, omega > 0.0 && omega < 4.0 * PI));
+}
+
+// A direction uniform in the triangle (Arvo 1995): Ĉ on the arc AC where the sub-triangle A B Ĉ
+// has solid angle u[0]·Ω, then the point on the arc B Ĉ whose 1 − cos of its distance from B is
+// u[1] times the arc's.
 fn triangle_sample(t: SphTri, u: vec2<f32>) -> vec3<f32> {
-    let sin_a = sin(t.alpha);
-    let cos_a = cos(t.alpha);
-    let phi = u.x * t.solid_angle - t.alpha;
-    let s = sin(phi);
-    let tt = cos(phi);
-    let uu = tt - cos_a;
-    let vv = s + sin_a * t.cos_c;
-    let q = clamp(((vv * tt - uu * s) * cos_a - vv) / ((vv * s + uu * tt) * sin_a), -1.0, 1.0);
-    let c_hat = q * t.a + sqrt(max(1.0 - q * q, 0.0)) * ortho(t.c, t.a);
-    let z = 1.0 - u.y * (1.0 - dot(c_hat, t.b));
-    return normalize(z * t.b + sqrt(max(1.0 - z * z, 0.0)) * ortho(c_hat, t.b));
+    // Ĉ = va + s (vc − va) (the chord projects onto the arc; the sub-triangle's triple product
+    // is s·triple) by bisection on s (see the header).
+    let goal = u.x * t.solid_angle;
+    let ac = t.vc - t.va;
+    var lo = 0.0;
+    var hi = 1.0;
+    for (var i = 0; i < 26; i++) {
+        let mid = 0.5 * (lo + hi);
+        if oosterom(t.va, t.vb, t.va + mid * ac, mid * t.triple) < goal {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let c_hat = normalize(t.va + (0.5 * (lo + hi)) * ac);
+    let b = normalize(t.vb);
+    // 1 − cos from the chord, |Ĉ − b|²/2, which keeps its digits for short arcs.
+    let chord = c_hat - b;
+    let omc = u.y * 0.5 * dot(chord, chord);
+    let z = 1.0 - omc;
+    return normalize(z * b + sqrt(max(omc * (2.0 - omc), 0.0)) * ortho(c_hat, b));
 }
 
 // The unit component of v orthogonal to the unit w (zero when there is none).
@@ -197,8 +195,8 @@ fn rect_sample(light: Record, o: vec3<f32>, u: vec2<f32>) -> vec4<f32> {
     let vc = d + e1 + e2;
     let vd = d + e2;
     let triple = dot(d, cross(e1, e2));
-    let t1 = spherical_triangle(va, vb, vc, e1, e1 + e2, triple);
-    let t2 = spherical_triangle(va, vc, vd, e1 + e2, e2, triple);
+    let t1 = spherical_triangle(va, vb, vc, triple);
+    let t2 = spherical_triangle(va, vc, vd, triple);
     let total = t1.solid_angle + t2.solid_angle;
     if !(total > 0.0) {
         return vec4<f32>(0.0);
