@@ -4,26 +4,38 @@
 //! rows on both paths: the same light and `P(l | x)` (chosen on the host), directions within
 //! 1e-4 rad, densities and radiance within 1e-4 relative.
 //!
-//! Excluded rows (counted, at most 2 %): those whose draw lies near a discontinuity, where an
+//! Excluded rows (counted; at most 2 % of the random lights' rows, 4 % of the IES-shaped and
+//! textured lights'): those whose draw lies near a discontinuity, where an
 //! f32 rounding legitimately sends the GPU elsewhere or amplifies the difference:
 //! - of the sampler map (`testkit::sample::sampler_margin` < [`MAP_BAND`]): the seam of a sheared
 //!   rect's two triangles, the frame flip of a cone whose axis lies near z = 0, the tie between a
-//!   spot's cone and a sphere's, a cylinder's silhouette;
-//! - of the radiance along the CPU's direction (`check::radiance_margin` < [`RADIANCE_BAND`]): a
-//!   shape's silhouette, a cone edge, a one-sided horizon. It is wider than the radiance
-//!   conformance band (1e-4) because the GPU evaluates its own direction, up to ~1e-5 rad away.
+//!   spot's cone and a sphere's, a cylinder's silhouette,
+//!   and the receiver's height over a rect's or disk's plane or a cylinder's surface (where the
+//!   density carries the f32 rounding of that height);
+//! - of the radiance along the CPU's direction (not for delta lights, whose L is no radiance):
+//!   `check::radiance_margin` < [`RADIANCE_BAND`] (the radiance conformance's own band: a
+//!   shape's silhouette, a cone edge, a one-sided horizon, the IES band), a textured rect's edge
+//!   within [`RECT_EDGE`] (tests/rect_conformance.rs's band), and rows where the reference's own
+//!   radiance along the GPU's direction differs from that along the CPU's by more than half the
+//!   tolerance (the radiance is too steep there for two directions ~1e-6 rad apart).
 
 use crate::common;
 
 use glam::DVec3;
 use luxeval::testkit::check::radiance_margin;
 use luxeval::testkit::sample::{angle, sampler_margin, uniform};
-use luxeval::testkit::{Rng, radiance_samples, random_lights};
-use luxeval::{Accumulate, Evaluator, Reference, SampleOptions, Selection, TemperatureMode};
+use luxeval::testkit::ies::{SHAPES, with_random_ies};
+use luxeval::testkit::rect::near_rect_discontinuity;
+use luxeval::testkit::{Rng, TRANSFORMS, radiance_samples, random_light, random_lights};
+use luxeval::{
+    Accumulate, Asset, Evaluator, Light, Reference, SampleOptions, Selection, TemperatureMode,
+    Texture,
+};
 
 const TOL: f64 = 1e-4;
 const MAP_BAND: f64 = 1e-4;
 const RADIANCE_BAND: f64 = 1e-4;
+const RECT_EDGE: f64 = 1e-3;
 
 fn d(v: [f32; 3]) -> DVec3 {
     DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64)
@@ -47,22 +59,58 @@ fn note(slot: &mut (f64, String), err: f64, what: impl FnOnce() -> String) {
     }
 }
 
-#[test]
-fn gpu_samples_match_cpu_on_randomised_lights() {
-    let Some(gpu) = common::gpu() else { return };
+/// What [`compare`] found over a set of lights.
+#[derive(Default)]
+struct Stats {
+    total: usize,
+    delta: usize,
+    excluded: usize,
+    why: std::collections::BTreeMap<(&'static str, bool), usize>,
+    worst: Worst,
+    failures: Vec<String>,
+}
+
+impl Stats {
+    fn report(&self, what: &str, secs: f64, max_excluded: f64) {
+        let frac = self.excluded as f64 / self.total as f64;
+        println!(
+            "{what}: {} rows ({} delta), {} excluded ({:.3} %), {secs:.1} s",
+            self.total,
+            self.delta,
+            self.excluded,
+            100.0 * frac
+        );
+        println!("excluded by (type, near the sampler map's seam): {:?}", self.why);
+        let w = &self.worst;
+        println!("worst angle {:.3e} rad: {}", w.angle.0, w.angle.1);
+        println!("worst pdf {:.3e} rel: {}", w.pdf.0, w.pdf.1);
+        println!("worst radiance {:.3e} rel: {}", w.radiance.0, w.radiance.1);
+        let shown: Vec<&String> = self.failures.iter().take(20).collect();
+        assert!(
+            self.failures.is_empty(),
+            "{what}: {} of {} rows differ:\n{shown:#?}",
+            self.failures.len(),
+            self.total
+        );
+        assert!(
+            frac <= max_excluded,
+            "{what}: excluded {:.2} % > {:.0} %",
+            100.0 * frac,
+            100.0 * max_excluded
+        );
+    }
+}
+
+/// Samples each light alone on both paths (`points_per_light` receivers from
+/// `radiance_samples`, normals for every other light, `count` samples each) and compares the
+/// rows (module docs).
+fn compare(gpu: &Evaluator, lights: &[Light], points_per_light: usize, count: usize, rng: &mut Rng) -> Stats {
     let cpu = Evaluator::cpu();
-    let mut rng = Rng::new(0x5A3F_1E5);
-    let lights = random_lights(&mut rng, 2); // 6 types × 7 transforms × 2 = 84 lights
-    let (points_per_light, count) = (24, 12);
     let seed = 41;
-    let (mut total, mut excluded, mut compared_delta) = (0usize, 0usize, 0usize);
-    let mut worst = Worst::default();
-    let mut failures = Vec::new();
-    let mut why = std::collections::BTreeMap::new();
-    let t0 = std::time::Instant::now();
+    let mut st = Stats::default();
     for (li, light) in lights.iter().enumerate() {
         let r = Reference::new(light, TemperatureMode::Spec).unwrap();
-        let (points, _) = radiance_samples(&r, points_per_light, &mut rng);
+        let (points, _) = radiance_samples(&r, points_per_light, rng);
         // Half the lights with receiver normals (the cosine-weighted dome and the
         // receiver-aware choice use them), half without.
         let normals: Option<Vec<[f32; 3]>> = (li % 2 == 0).then(|| {
@@ -83,20 +131,23 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
         assert_eq!(g.sampling_device(), "gpu");
         let sc = c.sample(&points, normals.as_deref(), count, &opts).unwrap();
         let sg = g.sample(&points, normals.as_deref(), count, &opts).unwrap();
+        assert_eq!(sc.light, sg.light, "{}: light choice", light.path);
+        assert_eq!(sc.light_pdf, sg.light_pdf, "{}: P(l | x)", light.path);
         // The reference's radiance along the GPU's own directions: where it differs from the
         // reference's along the CPU's by more than half the tolerance, the radiance is too
-        // steep there (a boundary, a focus toward grazing) for directions 1e-5 rad apart.
+        // steep there (a boundary, a focus toward grazing, a texel edge) for directions 1e-5
+        // rad apart.
         let xs: Vec<[f32; 3]> = points
             .iter()
             .flat_map(|p| std::iter::repeat_n(*p, count))
             .collect();
         let along_gpu = c.radiance(&xs, &sg.dirs, Accumulate::Sum).unwrap();
-        assert_eq!(sc.light, sg.light, "{}: light choice", light.path);
-        assert_eq!(sc.light_pdf, sg.light_pdf, "{}: P(l | x)", light.path);
+        // A textured rect's edge where f32 may straddle it (tests/rect_conformance.rs's band).
+        let texel = near_rect_discontinuity(light, &xs, &sc.dirs, false, RECT_EDGE).unwrap();
         for i in 0..points.len() {
             for j in 0..count {
                 let row = i * count + j;
-                total += 1;
+                st.total += 1;
                 let x = points[i];
                 let n = normals.as_ref().map(|ns| ns[i]);
                 let u = [
@@ -120,10 +171,10 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
                 // A delta light's L is not a radiance along ω (S1): no band.
                 let near_edge = pc > 0.0
                     && pc.is_finite()
-                    && (steep || radiance_margin(&r, d(x), dc) < RADIANCE_BAND);
+                    && (steep || texel[row] || radiance_margin(&r, d(x), dc) < RADIANCE_BAND);
                 if near_map || near_edge {
-                    excluded += 1;
-                    *why.entry((light.kind.usd_type(), near_map)).or_insert(0) += 1;
+                    st.excluded += 1;
+                    *st.why.entry((light.kind.usd_type(), near_map)).or_insert(0) += 1;
                     if std::env::var("SHOW_EXCLUDED").is_ok() {
                         println!(
                             "excluded (map {near_map}, margin {:.2e}): {}",
@@ -134,7 +185,7 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
                     continue;
                 }
                 if pc.is_infinite() {
-                    compared_delta += 1;
+                    st.delta += 1;
                 }
                 let e_angle = if pc > 0.0 { angle(dc, dg) } else { 0.0 };
                 let e_pdf = if pc.is_infinite() || pg.is_infinite() {
@@ -146,35 +197,133 @@ fn gpu_samples_match_cpu_on_randomised_lights() {
                 };
                 let e_l = rel(lc, lg);
                 if e_angle > TOL || e_pdf > TOL || e_l > TOL || e_pdf.is_nan() {
-                    failures.push(format!(
+                    st.failures.push(format!(
                         "angle {e_angle:.2e} pdf {e_pdf:.2e} L {e_l:.2e}: {}",
                         what()
                     ));
                 }
-                note(&mut worst.angle, e_angle, what);
-                note(&mut worst.pdf, e_pdf, what);
-                note(&mut worst.radiance, e_l, what);
+                note(&mut st.worst.angle, e_angle, what);
+                note(&mut st.worst.pdf, e_pdf, what);
+                note(&mut st.worst.radiance, e_l, what);
             }
         }
     }
-    let frac = excluded as f64 / total as f64;
-    println!(
-        "{} lights, {total} rows ({compared_delta} delta), {excluded} excluded ({:.3} %), {:.1} s",
-        lights.len(),
-        100.0 * frac,
-        t0.elapsed().as_secs_f64()
+    st
+}
+
+#[test]
+fn gpu_samples_match_cpu_on_randomised_lights() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(0x5A3F_1E5);
+    let lights = random_lights(&mut rng, 4); // 6 types × 7 transforms × 4 = 168 lights
+    let t0 = std::time::Instant::now();
+    let st = compare(&gpu, &lights, 32, 16, &mut rng);
+    st.report(
+        &format!("{} random lights", lights.len()),
+        t0.elapsed().as_secs_f64(),
+        0.02,
     );
-    println!("excluded by (type, near the sampler map's seam): {why:?}");
-    println!("worst angle {:.3e} rad: {}", worst.angle.0, worst.angle.1);
-    println!("worst pdf {:.3e} rel: {}", worst.pdf.0, worst.pdf.1);
-    println!("worst radiance {:.3e} rel: {}", worst.radiance.0, worst.radiance.1);
-    let shown: Vec<&String> = failures.iter().take(20).collect();
-    assert!(
-        failures.is_empty(),
-        "{} of {total} rows differ:\n{shown:#?}",
-        failures.len()
+}
+
+/// IES-shaped shapes and textured rects (both sampled by their geometry on the GPU; their
+/// radiance reads the IES atlas and the texture atlas).
+#[test]
+fn gpu_samples_match_cpu_on_ies_shaped_and_textured_lights() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(0x1E5_7E47);
+    let mut lights = Vec::new();
+    for (k, xf) in TRANSFORMS.into_iter().enumerate() {
+        for ty in 1..5 {
+            let l = random_light(ty, xf, &mut rng, lights.len());
+            lights.push(with_random_ies(l, &mut rng, (k + ty) % SHAPES.len(), true));
+        }
+        let l = random_light(3, xf, &mut rng, lights.len());
+        lights.push(l.with_texture(Texture::new(png(7 + k as u32, 5, &mut rng))));
+    }
+    let t0 = std::time::Instant::now();
+    let st = compare(&gpu, &lights, 24, 12, &mut rng);
+    st.report(
+        &format!("{} IES-shaped and textured lights", lights.len()),
+        t0.elapsed().as_secs_f64(),
+        // The IES band (check::radiance_margin's ies_margin, the profile's jumps and zeros)
+        // and the texels' steep bilinear slopes leave out more rows here.
+        0.04,
     );
-    assert!(frac <= 0.02, "excluded {:.2} % > 2 %", 100.0 * frac);
+}
+
+fn png(w: u32, h: u32, rng: &mut Rng) -> Asset {
+    let img = image::RgbImage::from_fn(w, h, |_, _| {
+        image::Rgb([0, 1, 2].map(|_| 128 + rng.below(128) as u8))
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
+}
+
+/// A scene mixing a textured dome (sampled on the host) with lights the GPU samples: the
+/// device is "gpu", the light choices and `P(l | x)` are the CPU's, the dome's rows are the
+/// CPU's to the bit, and the others agree as above; a scene of only a textured dome samples on
+/// the CPU.
+#[test]
+fn textured_domes_are_sampled_on_the_host_beside_gpu_lights() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(99);
+    let dome = Light::dome()
+        .with_path("/Dome")
+        .with_intensity(0.5)
+        .with_texture(Texture::new(png(16, 8, &mut rng)));
+    let lights = vec![
+        dome.clone(),
+        random_light(1, "rotate", &mut rng, 1),
+        random_light(3, "shear", &mut rng, 2),
+        random_light(0, "identity", &mut rng, 3),
+    ];
+    let g = gpu.prepare(&lights).unwrap();
+    let c = Evaluator::cpu().prepare(&lights).unwrap();
+    assert_eq!(g.sampling_device(), "gpu");
+    assert_eq!(c.sampling_device(), "cpu");
+    assert_eq!(gpu.prepare(std::slice::from_ref(&dome)).unwrap().sampling_device(), "cpu");
+    let points: Vec<[f32; 3]> = (0..50)
+        .map(|_| {
+            let v = rng.unit() * rng.range(2.0, 6.0);
+            [v.x as f32, v.y as f32, v.z as f32]
+        })
+        .collect();
+    let normals: Vec<[f32; 3]> = (0..points.len())
+        .map(|_| {
+            let v = rng.unit();
+            [v.x as f32, v.y as f32, v.z as f32]
+        })
+        .collect();
+    let opts = SampleOptions {
+        seed: 5,
+        selection: Selection::Bound,
+        first_point: 0,
+    };
+    let sg = g.sample(&points, Some(&normals), 20, &opts).unwrap();
+    let sc = c.sample(&points, Some(&normals), 20, &opts).unwrap();
+    assert_eq!(sg.light, sc.light);
+    assert_eq!(sg.light_pdf, sc.light_pdf);
+    let (mut dome_rows, mut close, mut others) = (0, 0, 0);
+    for r in 0..sg.light.len() {
+        if sg.light[r] == 0 {
+            dome_rows += 1;
+            assert_eq!(
+                (sg.dirs[r], sg.pdf[r], sg.radiance[r]),
+                (sc.dirs[r], sc.pdf[r], sc.radiance[r])
+            );
+        } else if sg.light[r] > 0 {
+            others += 1;
+            let (pc, pg) = (sc.pdf[r] as f64, sg.pdf[r] as f64);
+            let pdf_ok = pc == pg || (pg / pc - 1.0).abs() <= TOL;
+            if pdf_ok && angle(d(sc.dirs[r]), d(sg.dirs[r])) <= TOL {
+                close += 1;
+            }
+        }
+    }
+    println!("{dome_rows} dome rows, {close} of {others} other rows within tolerance");
+    assert!(dome_rows > 50 && others > 50);
+    assert!(close as f64 >= 0.98 * others as f64);
 }
 
 /// A seed gives the same GPU rows whether the points come in one call or in chunks (each keyed

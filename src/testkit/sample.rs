@@ -22,7 +22,10 @@ pub use crate::cpu::sample::rng::{pcg_hash, uniform};
 ///   other sign within its rounding, and then every azimuth differs);
 /// - a shaped sphere: `|Ω_spot / Ω_ball − 1|`, where the choice between the two cones flips;
 /// - a cylinder: the sample's distance from the visible band's edge, `min(u[1], 1 − u[1])`
-///   (the silhouette, where the density `∝ 1/cos` is unbounded).
+///   (the silhouette, where the density `∝ 1/cos` is unbounded), and the receiver's height
+///   over its surface, `(ρ − r)/ρ` scaled by [`SURFACE_SCALE`];
+/// - a rect or disk: the receiver's elevation over the light's plane (its sine, seen from the
+///   light's centre) scaled by [`SURFACE_SCALE`].
 pub fn sampler_margin(r: &Reference, x: [f32; 3], n: Option<[f32; 3]>, u: [f64; 2]) -> f64 {
     let p = &r.p;
     let x = dvec(x);
@@ -38,10 +41,10 @@ pub fn sampler_margin(r: &Reference, x: [f32; 3], n: Option<[f32; 3]>, u: [f64; 
         }
         LightAt::Cone(c) => {
             let mut m = c.axis.z.abs();
-            if let (Some(s), Some(sh)) = (p.similarity, &p.shaping) {
+            if let (Some(s), Some(sh), true) = (p.similarity, &p.shaping, radius(p) > 0.0) {
                 let w = p.origin - x;
                 let d = w.length();
-                let ball = crate::cpu::sample::cone::Cone::subtended(w / d, 1.0 * s * radius(p), d);
+                let ball = crate::cpu::sample::cone::Cone::subtended(w / d, s * radius(p), d);
                 let spot = crate::cpu::sample::cone::Cone::with_angle(-p.axis, sh.cone);
                 m = m.min((spot.solid_angle() / ball.solid_angle() - 1.0).abs());
             }
@@ -49,10 +52,27 @@ pub fn sampler_margin(r: &Reference, x: [f32; 3], n: Option<[f32; 3]>, u: [f64; 
         }
         LightAt::Ellipsoid { xl, .. } => (xl.z / xl.length()).abs(),
         LightAt::Dome { n: Some(n), .. } => n.z.abs(),
-        LightAt::Cylinder { .. } => u[1].min(1.0 - u[1]),
+        LightAt::Cylinder { xl, r, .. } => {
+            let rho = (xl.y * xl.y + xl.z * xl.z).sqrt();
+            u[1].min(1.0 - u[1]).min((rho - r) / rho * SURFACE_SCALE)
+        }
         _ => f64::INFINITY,
     }
+    .min(match at {
+        LightAt::Rect(_) | LightAt::Disk { .. } => {
+            let w = x - p.origin;
+            w.dot(p.normal).abs() / w.length() * SURFACE_SCALE
+        }
+        _ => f64::INFINITY,
+    })
 }
+
+/// The scale of the receiver's own margins in [`sampler_margin`]: a density that depends on the
+/// receiver's height over a rect's or disk's plane (the triple product, cos θ_l), or over a
+/// cylinder's surface (the band's half-width β ≈ √(2(ρ − r)/ρ)), carries the f32 rounding of
+/// that height, ~2e-7 of the distance, relative to the height: 1e-4 of the density at a height
+/// of 2e-3 of the distance, where the margin is `2e-3 · SURFACE_SCALE` = 1e-4.
+const SURFACE_SCALE: f64 = 0.05;
 
 fn radius(p: &crate::prepare::Prepared) -> f64 {
     match p.light.kind {
