@@ -444,3 +444,43 @@ impl PreparedScene {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Backend, Evaluator};
+    use super::SampleOptions;
+
+    /// The sample kernel's rows cut into many device chunks (6 rows each, the last partial)
+    /// are the rows of one chunk.
+    #[test]
+    fn many_sample_chunks_equal_one_chunk() {
+        let eval = match Evaluator::gpu() {
+            Ok(e) => e,
+            Err(e) if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") => {
+                panic!("CI=true but no GPU adapter: {e}")
+            }
+            Err(e) => return eprintln!("skipping GPU test: {e}"),
+        };
+        let Backend::Gpu(ctx) = &eval.backend else {
+            unreachable!("a GPU evaluator")
+        };
+        let scene = eval
+            .prepare(&crate::synthetic::synthetic_lights(5))
+            .expect("the synthetic lights prepare");
+        assert_eq!(scene.sampling_device(), "gpu");
+        let points: Vec<[f32; 3]> = (0..37)
+            .map(|i| [(i % 7) as f32 - 3.0, (i % 5) as f32 - 2.5, (i % 3) as f32 + 1.5])
+            .collect();
+        let opts = SampleOptions {
+            seed: 9,
+            ..SampleOptions::default()
+        };
+        let one = scene.sample(&points, None, 11, &opts).unwrap();
+        // chunk_capacity 16 rows of 12 bytes: 6 rows of the sample kernel's 28 a chunk.
+        ctx.cap_chunk_rows(16);
+        let many = scene.sample(&points, None, 11, &opts).unwrap();
+        ctx.cap_chunk_rows(usize::MAX);
+        assert_eq!(one, many);
+        assert!(one.pdf.iter().any(|&p| p > 0.0 && p.is_finite()));
+    }
+}
