@@ -23,9 +23,9 @@ use crate::common;
 
 use glam::DVec3;
 use luxeval::testkit::check::radiance_margin;
-use luxeval::testkit::sample::{angle, sampler_margin, uniform};
 use luxeval::testkit::ies::{SHAPES, with_random_ies};
 use luxeval::testkit::rect::near_rect_discontinuity;
+use luxeval::testkit::sample::{angle, sampler_margin, uniform};
 use luxeval::testkit::{Rng, TRANSFORMS, radiance_samples, random_light, random_lights};
 use luxeval::{
     Accumulate, Asset, Evaluator, Light, Reference, SampleOptions, Selection, TemperatureMode,
@@ -43,7 +43,11 @@ fn d(v: [f32; 3]) -> DVec3 {
 
 fn rel(a: DVec3, b: DVec3) -> f64 {
     let m = a.abs().max_element().max(b.abs().max_element());
-    if m == 0.0 { 0.0 } else { (a - b).abs().max_element() / m }
+    if m == 0.0 {
+        0.0
+    } else {
+        (a - b).abs().max_element() / m
+    }
 }
 
 #[derive(Default)]
@@ -80,7 +84,10 @@ impl Stats {
             self.excluded,
             100.0 * frac
         );
-        println!("excluded by (type, near the sampler map's seam): {:?}", self.why);
+        println!(
+            "excluded by (type, near the sampler map's seam): {:?}",
+            self.why
+        );
         let w = &self.worst;
         println!("worst angle {:.3e} rad: {}", w.angle.0, w.angle.1);
         println!("worst pdf {:.3e} rel: {}", w.pdf.0, w.pdf.1);
@@ -104,7 +111,13 @@ impl Stats {
 /// Samples each light alone on both paths (`points_per_light` receivers from
 /// `radiance_samples`, normals for every other light, `count` samples each) and compares the
 /// rows (module docs).
-fn compare(gpu: &Evaluator, lights: &[Light], points_per_light: usize, count: usize, rng: &mut Rng) -> Stats {
+fn compare(
+    gpu: &Evaluator,
+    lights: &[Light],
+    points_per_light: usize,
+    count: usize,
+    rng: &mut Rng,
+) -> Stats {
     let cpu = Evaluator::cpu();
     let seed = 41;
     let mut st = Stats::default();
@@ -214,7 +227,7 @@ fn compare(gpu: &Evaluator, lights: &[Light], points_per_light: usize, count: us
 #[test]
 fn gpu_samples_match_cpu_on_randomised_lights() {
     let Some(gpu) = common::gpu() else { return };
-    let mut rng = Rng::new(0x5A3F_1E5);
+    let mut rng = Rng::new(0x05A3_F1E5);
     let lights = random_lights(&mut rng, 4); // 6 types × 7 transforms × 4 = 168 lights
     let t0 = std::time::Instant::now();
     let st = compare(&gpu, &lights, 32, 16, &mut rng);
@@ -282,7 +295,12 @@ fn textured_domes_are_sampled_on_the_host_beside_gpu_lights() {
     let c = Evaluator::cpu().prepare(&lights).unwrap();
     assert_eq!(g.sampling_device(), "gpu");
     assert_eq!(c.sampling_device(), "cpu");
-    assert_eq!(gpu.prepare(std::slice::from_ref(&dome)).unwrap().sampling_device(), "cpu");
+    assert_eq!(
+        gpu.prepare(std::slice::from_ref(&dome))
+            .unwrap()
+            .sampling_device(),
+        "cpu"
+    );
     let points: Vec<[f32; 3]> = (0..50)
         .map(|_| {
             let v = rng.unit() * rng.range(2.0, 6.0);
@@ -358,9 +376,15 @@ fn gpu_samples_do_not_depend_on_chunking() {
                 first_point: first + start as u64,
                 ..opts
             };
-            let part = g.sample(&points[start..start + len], None, count, &o).unwrap();
+            let part = g
+                .sample(&points[start..start + len], None, count, &o)
+                .unwrap();
             let rows = start * count..(start + len) * count;
-            assert_eq!(part.dirs, whole.dirs[rows.clone()], "first {first} start {start}");
+            assert_eq!(
+                part.dirs,
+                whole.dirs[rows.clone()],
+                "first {first} start {start}"
+            );
             assert_eq!(part.pdf, whole.pdf[rows.clone()]);
             assert_eq!(part.radiance, whole.radiance[rows.clone()]);
             assert_eq!(part.light, whole.light[rows]);
@@ -376,6 +400,9 @@ fn gpu_samples_do_not_depend_on_chunking() {
             .filter(|((a, b), p)| **p > 0.0 && angle(d(**a), d(**b)) < 1e-3)
             .count();
         let drawn = cpu.pdf.iter().filter(|p| **p > 0.0).count();
-        assert!(close as f64 >= 0.97 * drawn as f64, "{close} of {drawn} close");
+        assert!(
+            close as f64 >= 0.97 * drawn as f64,
+            "{close} of {drawn} close"
+        );
     }
 }

@@ -255,9 +255,9 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
                 r.flags |= FLAG_SHEARED_RECT;
             }
             (
-            KIND_RECT,
-            [(width / 2.0) as f32, (height / 2.0) as f32, 0.0, 0.0],
-        )
+                KIND_RECT,
+                [(width / 2.0) as f32, (height / 2.0) as f32, 0.0, 0.0],
+            )
         }
         LightType::Cylinder {
             length,

@@ -36,7 +36,11 @@ const OUT_FLOATS: usize = 7;
 
 impl GpuContext {
     /// Runs the sample kernel over `rows`, in chunks that fit the device's limits.
-    pub(crate) fn run_sample(&self, lights: &GpuLights, rows: &[SampleRow]) -> Result<Vec<SampleOut>> {
+    pub(crate) fn run_sample(
+        &self,
+        lights: &GpuLights,
+        rows: &[SampleRow],
+    ) -> Result<Vec<SampleOut>> {
         let mut out = Vec::with_capacity(rows.len());
         if rows.is_empty() {
             return Ok(out);
@@ -154,12 +158,18 @@ impl GpuContext {
         let validation = pollster::block_on(validation.pop());
         if let Some(why) = self.lost() {
             return Err(LuxError::gpu(
-                format!("the device was lost ({why}) while running {}", kernel.entry_point()),
+                format!(
+                    "the device was lost ({why}) while running {}",
+                    kernel.entry_point()
+                ),
                 GpuFailure::Lost,
             ));
         }
         if let Some(e) = validation {
-            return Err(LuxError::gpu(format!("running {}", kernel.entry_point()), e));
+            return Err(LuxError::gpu(
+                format!("running {}", kernel.entry_point()),
+                e,
+            ));
         }
         result.map(|_| out)
     }

@@ -469,7 +469,13 @@ mod tests {
             .expect("the synthetic lights prepare");
         assert_eq!(scene.sampling_device(), "gpu");
         let points: Vec<[f32; 3]> = (0..37)
-            .map(|i| [(i % 7) as f32 - 3.0, (i % 5) as f32 - 2.5, (i % 3) as f32 + 1.5])
+            .map(|i| {
+                [
+                    (i % 7) as f32 - 3.0,
+                    (i % 5) as f32 - 2.5,
+                    (i % 3) as f32 + 1.5,
+                ]
+            })
             .collect();
         let opts = SampleOptions {
             seed: 9,
