@@ -1,17 +1,22 @@
 // sample(light, x, u): a direction toward one light, its density per unit solid angle and the
-// radiance along it (DESIGN.md §9 S1). Twin of src/cpu/sample/mod.rs, which carries the
-// strategies (S2) and their reasons.
+// radiance along it; pdf(light, x, ω): the density sample draws ω with (DESIGN.md §9 S1).
+// Twin of src/cpu/sample/mod.rs, which carries the strategies (S2) and their reasons.
 //
 // Rows (src/gpu/sample.rs packs them): in_a holds (point xyz, normal xyz) per row, a zero normal
 // standing for none; in_b holds the u32 bits of (light index, point key, sample key, seed). The
 // row's u is rng_uniform(seed, point key, sample key, 0 and 1), the CPU's dimensions 0 and 1
 // (S3); the light was chosen on the host with dimension 2, so that P(l | x) is the CPU's.
 // out_rgb holds (ω xyz, pdf_l, L rgb) per row, pdf_l = −1 standing for +∞ (a delta light).
+// pdf_main's rows: in_a as sample_main's, in_b the u32 bits of the light index and the unit ω
+// (f32) per row; out_rgb one pdf_l per row (0 for delta lights, S1).
 // Textured domes are never sent here (prepare::Prepared::sample_on_host).
 //
 // draw is LightAt::new and LightAt::draw in one (WGSL has no enums to carry the strategy).
 // GPU-only drawn, fixed: Drawn's two constructors (a drawn density, or a fixed L).
 // GPU-only sample_main: the kernel's entry point (LightAt::sample's radiance step is inline).
+// GPU-only light_pdf, pdf_main: LightAt::new and LightAt::pdf in one (cone.wgsl's pdf holds the
+//   name), and the pdf kernel's entry point. A rect's Ω comes from rect_sample (its draw is
+//   discarded).
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
@@ -181,4 +186,81 @@ fn sample_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     out_rgb[o + 4u] = l.x;
     out_rgb[o + 5u] = l.y;
     out_rgb[o + 6u] = l.z;
+}
+
+// The density draw draws the unit w with, for the receiver at x (normal n, zero for none).
+fn light_pdf(light: Record, x: vec3<f32>, n: vec3<f32>, w: vec3<f32>) -> f32 {
+    if has_flag(light, FLAG_DARK) {
+        return 0.0;
+    }
+    let to = world_origin(light) - x;
+    let xl = to_local_point(light, x);
+    switch light.kind {
+        case KIND_DOME: {
+            return pdf_dome(n, w);
+        }
+        case KIND_DISTANT: {
+            let theta = light.axis.w;
+            if theta == 0.0 {
+                return 0.0;
+            }
+            return pdf(with_angle(-light.axis.xyz, theta), w);
+        }
+        case KIND_SPHERE: {
+            let r = light.size.x;
+            if has_flag(light, FLAG_TREAT_AS_POINT_OR_LINE) || !(length(xl) > r) {
+                return 0.0;
+            }
+            if has_flag(light, FLAG_SIMILARITY) && has_flag(light, FLAG_SHAPING) {
+                let d = length(to);
+                let ball = subtended(to / d, r * length(light.world_x.xyz), d);
+                let spot = with_angle(-light.axis.xyz, light.cone.x);
+                var c = ball;
+                if spot.w < ball.w {
+                    c = spot;
+                }
+                return pdf(c, w);
+            }
+            return ellipsoid_pdf(light, xl, r, w);
+        }
+        case KIND_RECT: {
+            if !(xl.z < 0.0) {
+                return 0.0;
+            }
+            let omega = rect_sample(light, x, vec2<f32>(0.5)).w;
+            if !(omega > 0.0) || !rect_hit(xl, to_local_dir(light, w), light.size.x, light.size.y) {
+                return 0.0;
+            }
+            return 1.0 / omega;
+        }
+        case KIND_DISK: {
+            if !(xl.z < 0.0) {
+                return 0.0;
+            }
+            return disk_pdf(light, xl, light.size.x, w);
+        }
+        case KIND_CYLINDER: {
+            let r = light.size.y;
+            let rho = sqrt(xl.y * xl.y + xl.z * xl.z);
+            if has_flag(light, FLAG_TREAT_AS_POINT_OR_LINE) || !(rho > r) {
+                return 0.0;
+            }
+            return cylinder_pdf(light, xl, light.size.x, r, w);
+        }
+        default: {}
+    }
+    return 0.0;
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn pdf_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = sample_index(gid);
+    if i >= params.count {
+        return;
+    }
+    let x = vec3<f32>(in_a[6u * i], in_a[6u * i + 1u], in_a[6u * i + 2u]);
+    let n = vec3<f32>(in_a[6u * i + 3u], in_a[6u * i + 4u], in_a[6u * i + 5u]);
+    let light = lights[bitcast<u32>(in_b[4u * i])];
+    let w = vec3<f32>(in_b[4u * i + 1u], in_b[4u * i + 2u], in_b[4u * i + 3u]);
+    out_rgb[i] = light_pdf(light, x, n, w);
 }

@@ -6,9 +6,14 @@
 // f32: the cylinder's azimuth of x is shared/math.wgsl's atan2_accurate, and its visible
 //   half-width β = acos(r/ρ) is atan2(√((ρ − r)(ρ + r)), r), which keeps its digits for a
 //   receiver near the surface (acos loses half of them near 1).
-// disk_pdf, cylinder_pdf and ellipsoid_pdf have no GPU twin: pdf stays on the host.
+// f32: cylinder_pdf forms the root's c = ρ² − r² as (ρ − r)(ρ + r) and its discriminant
+//   b² − 4ac as 4a(r − p)(r + p), p the distance of the ray's yz line from the axis (b² − 4ac
+//   cancels to 1e-4 relative when the receiver is 20 radii away); and the entry point's |Δ| as
+//   asin(p/r) − γ (γ the ray's angle off the direction toward the axis) rather than from the
+//   entry point, whose yz components cancel to r out of ρ-sized terms.
 
 // #import shared/record.wgsl
+// #import shared/shapes.wgsl
 // #import shared/math.wgsl
 // #import sample/cone.wgsl
 
@@ -47,6 +52,21 @@ fn disk_sample(light: Record, xl: vec3<f32>, r: f32, u: vec2<f32>) -> vec4<f32> 
     return to_world(light, d, dist2 / (PI * r * r * cs));
 }
 
+// The density disk_sample draws the world direction w with.
+fn disk_pdf(light: Record, xl: vec3<f32>, r: f32, w: vec3<f32>) -> f32 {
+    let dl = to_local_dir(light, w);
+    if !disk_hit(xl, dl, r) {
+        return 0.0;
+    }
+    let y = plane_hit(xl, dl);
+    if !(y.w > 0.0) {
+        return 0.0;
+    }
+    let d = y.xyz - xl;
+    let dist2 = dot(d, d);
+    return dist2 / (PI * r * r * (d.z / sqrt(dist2))) * local_jacobian(light, w);
+}
+
 // The band of a cylinder (local X axis) the local point xl sees: vec2(x's azimuth, β); β < 0
 // from inside the infinite cylinder.
 fn visible_band(xl: vec3<f32>, r: f32) -> vec2<f32> {
@@ -83,6 +103,43 @@ fn cylinder_sample(light: Record, xl: vec3<f32>, hl: f32, r: f32, u: vec2<f32>) 
     return to_world(light, d, dist2 / (4.0 * beta * r * hl * cs));
 }
 
+// The density cylinder_sample draws the world direction w with: through the entry point of the
+// ray on the outer wall.
+fn cylinder_pdf(light: Record, xl: vec3<f32>, hl: f32, r: f32, w: vec3<f32>) -> f32 {
+    let dl = to_local_dir(light, w);
+    if !cylinder_hit(xl, dl, hl, r) {
+        return 0.0;
+    }
+    let band = visible_band(xl, r);
+    let beta = band.y;
+    if !(beta >= 0.0) {
+        return 0.0;
+    }
+    // The nearer root of |(x + t d)_yz|² = r², in the cancellation-free form, with the
+    // discriminant b² − 4ac = 4a(r² − p²).
+    let pyz = vec2<f32>(xl.y, xl.z);
+    let dyz = vec2<f32>(dl.y, dl.z);
+    let rho = length(pyz);
+    let a = dot(dyz, dyz);
+    let la = sqrt(a);
+    let p = abs(pyz.x * dyz.y - pyz.y * dyz.x) / la;
+    let b = 2.0 * dot(pyz, dyz);
+    let c = (rho - r) * (rho + r);
+    let rp = max((r - p) * (r + p), 0.0);
+    let q = -0.5 * (b + select(-1.0, 1.0, b >= 0.0) * sqrt(4.0 * a * rp));
+    let t = min(q / a, c / q);
+    let d = t * dl;
+    let dist2 = dot(d, d);
+    // |Δ|, the entry point's azimuth from x's: asin(p/r) − γ, γ the ray's angle off −x_yz.
+    let gamma = atan2_accurate(p, -dot(pyz, dyz) / la);
+    let delta = atan2_accurate(p, sqrt(rp)) - gamma;
+    let cs = facing(xl, beta, delta) / sqrt(dist2);
+    if !(cs > 0.0) {
+        return 0.0;
+    }
+    return dist2 / (4.0 * beta * r * hl * cs) * local_jacobian(light, w);
+}
+
 // The cone the local sphere of radius r subtends from xl; w < 0 from inside.
 fn local_cone(xl: vec3<f32>, r: f32) -> vec4<f32> {
     let d = length(xl);
@@ -99,4 +156,13 @@ fn ellipsoid_sample(light: Record, xl: vec3<f32>, r: f32, u: vec2<f32>) -> vec4<
         return vec4<f32>(0.0);
     }
     return to_world(light, sample(c, u), 1.0 / solid_angle(c));
+}
+
+// The density ellipsoid_sample draws the world direction w with.
+fn ellipsoid_pdf(light: Record, xl: vec3<f32>, r: f32, w: vec3<f32>) -> f32 {
+    let c = local_cone(xl, r);
+    if c.w < 0.0 {
+        return 0.0;
+    }
+    return pdf(c, normalize(to_local_dir(light, w))) * local_jacobian(light, w);
 }

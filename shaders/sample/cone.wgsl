@@ -5,7 +5,6 @@
 // does, so that tiny cones such as the sun's keep their digits).
 // f32: basis takes the sign of n.z from its sign bit, as f64::copysign does (−0 gives −1), so
 //   that both paths build the same frame wherever n.z has the same sign on both.
-// Cone::contains and Cone::pdf have no GPU twin: the GPU only draws (pdf stays on the host).
 
 // #import shared/math.wgsl
 
@@ -34,6 +33,17 @@ fn sample(c: vec4<f32>, u: vec2<f32>) -> vec3<f32> {
     let phi = 2.0 * PI * u.y;
     let b = basis(c.xyz);
     return normalize(b[0] * (sn * cos(phi)) + b[1] * (sn * sin(phi)) + c.xyz * cs);
+}
+
+// Whether the unit w lies in the cone (boundary included): 1 − cos from the chord, |w − axis|²/2.
+fn contains(c: vec4<f32>, w: vec3<f32>) -> bool {
+    let chord = w - c.xyz;
+    return 0.5 * dot(chord, chord) <= c.w;
+}
+
+// The uniform density, 1/Ω inside and 0 outside.
+fn pdf(c: vec4<f32>, w: vec3<f32>) -> f32 {
+    return select(0.0, 1.0 / solid_angle(c), contains(c, w));
 }
 
 // An orthonormal pair completing the unit n to a right-handed frame (Duff et al. 2017, Listing 3).

@@ -1,6 +1,6 @@
 // Sampling an untextured dome (f32), DESIGN.md §9 S2 "dome". Twin of src/cpu/sample/dome.rs.
 //
-// Only the untextured branch of sample_dome: cosine-weighted about the normal when one is given
+// Only the untextured branches of sample_dome and pdf_dome: cosine-weighted about the normal when one is given
 // (a zero normal stands for none), else uniform over the sphere. A textured dome's alias table
 // stays on the host (prepare::Prepared::sample_on_host), so the rest of dome.rs has no GPU twin.
 // f32: the frame is cone.wgsl's basis, the same formula as dome.rs's private basis.
@@ -26,4 +26,13 @@ fn sample_dome(n: vec3<f32>, u: vec2<f32>) -> vec4<f32> {
     let r = sqrt(max(1.0 - z * z, 0.0));
     let phi = 2.0 * PI * u.y;
     return vec4<f32>(r * cos(phi), r * sin(phi), z, 1.0 / (4.0 * PI));
+}
+
+// The density sample_dome draws the unit world direction w with.
+fn pdf_dome(n: vec3<f32>, w: vec3<f32>) -> f32 {
+    let len = length(n);
+    if len > 0.0 {
+        return max(dot(n / len, w), 0.0) / PI;
+    }
+    return 1.0 / (4.0 * PI);
 }

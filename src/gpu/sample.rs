@@ -1,6 +1,6 @@
 //! Running the sample kernel (shaders/sample.wgsl) over rows of (point, normal, light, keys):
 //! one direction per row toward the row's light, its density and the radiance along it
-//! (DESIGN.md §9 S1). The light is chosen on the host (the CPU's `P(l | x)`); the kernel draws
+//! (DESIGN.md §9 S1); and the pdf kernel over rows of (point, normal, light, direction). The light is chosen on the host (the CPU's `P(l | x)`); the kernel draws
 //! u from the same counter-based keys (S3), so a row gives the same direction on any chunking.
 
 use crate::error::{GpuFailure, LuxError, Result};
@@ -31,7 +31,18 @@ pub struct SampleOut {
     pub radiance: [f32; 3],
 }
 
-/// Floats per output row: ω, pdf_l, L.
+/// One row of the pdf kernel's input.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PdfRow {
+    pub point: [f32; 3],
+    /// The receiver's unit normal, zero for none.
+    pub normal: [f32; 3],
+    pub light: u32,
+    /// The unit direction.
+    pub dir: [f32; 3],
+}
+
+/// Floats per output row of the sample kernel: ω, pdf_l, L.
 const OUT_FLOATS: usize = 7;
 
 impl GpuContext {
@@ -41,16 +52,64 @@ impl GpuContext {
         lights: &GpuLights,
         rows: &[SampleRow],
     ) -> Result<Vec<SampleOut>> {
-        let mut out = Vec::with_capacity(rows.len());
-        if rows.is_empty() {
+        let a: Vec<f32> = rows
+            .iter()
+            .flat_map(|r| r.point.into_iter().chain(r.normal))
+            .collect();
+        let b: Vec<u32> = rows
+            .iter()
+            .flat_map(|r| [r.light, r.point_key, r.sample_key, r.seed])
+            .collect();
+        let values = self.run_rows(Kernel::Sample, lights, rows.len(), &a, &b, OUT_FLOATS)?;
+        Ok(values
+            .chunks_exact(OUT_FLOATS)
+            .map(|v| SampleOut {
+                dir: [v[0], v[1], v[2]],
+                // −1 stands for +∞ (a delta light).
+                pdf: if v[3] < 0.0 { f32::INFINITY } else { v[3] },
+                radiance: [v[4], v[5], v[6]],
+            })
+            .collect())
+    }
+
+    /// Runs the pdf kernel over `rows`: each row's light's density of its direction.
+    pub(crate) fn run_pdf(&self, lights: &GpuLights, rows: &[PdfRow]) -> Result<Vec<f32>> {
+        let a: Vec<f32> = rows
+            .iter()
+            .flat_map(|r| r.point.into_iter().chain(r.normal))
+            .collect();
+        let b: Vec<u32> = rows
+            .iter()
+            .flat_map(|r| {
+                [
+                    r.light,
+                    r.dir[0].to_bits(),
+                    r.dir[1].to_bits(),
+                    r.dir[2].to_bits(),
+                ]
+            })
+            .collect();
+        self.run_rows(Kernel::Pdf, lights, rows.len(), &a, &b, 1)
+    }
+
+    /// Runs `kernel` (sample or pdf) over `n` rows of 6 floats in `a` and 4 words in `b`,
+    /// `out_floats` floats out per row, in chunks that fit the device's limits.
+    fn run_rows(
+        &self,
+        kernel: Kernel,
+        lights: &GpuLights,
+        n: usize,
+        a: &[f32],
+        b: &[u32],
+        out_floats: usize,
+    ) -> Result<Vec<f32>> {
+        let mut out = Vec::with_capacity(n * out_floats);
+        if n == 0 {
             return Ok(out);
         }
-        let kernel = Kernel::Sample;
         let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
-        // The widest buffer is the output, 28 bytes a row; chunk_capacity counts 12.
-        let chunk = (self.chunk_capacity(1, false) * 12 / (OUT_FLOATS * 4))
-            .max(1)
-            .min(rows.len());
+        // The widest buffer holds 28 bytes a row; chunk_capacity counts 12.
+        let chunk = (self.chunk_capacity(1, false) * 12 / 28).max(1).min(n);
         let dev = &self.device;
         let validation = dev.push_error_scope(wgpu::ErrorFilter::Validation);
         let storage = |label, size: usize, usage: wgpu::BufferUsages| {
@@ -66,12 +125,12 @@ impl GpuContext {
         let buf_b = storage("sample in_b", chunk * 4, input);
         let buf_out = storage(
             "sample out",
-            chunk * OUT_FLOATS,
+            chunk * out_floats,
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         );
         let staging = storage(
             "sample readback",
-            chunk * OUT_FLOATS,
+            chunk * out_floats,
             wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
         );
         let align = self.params_align();
@@ -95,18 +154,12 @@ impl GpuContext {
             ],
         });
         let mut result = Ok(());
-        for piece in rows.chunks(chunk) {
-            let count = piece.len();
-            let a: Vec<f32> = piece
-                .iter()
-                .flat_map(|r| r.point.into_iter().chain(r.normal))
-                .collect();
-            let b: Vec<u32> = piece
-                .iter()
-                .flat_map(|r| [r.light, r.point_key, r.sample_key, r.seed])
-                .collect();
-            self.queue.write_buffer(&buf_a, 0, bytemuck::cast_slice(&a));
-            self.queue.write_buffer(&buf_b, 0, bytemuck::cast_slice(&b));
+        for start in (0..n).step_by(chunk) {
+            let count = chunk.min(n - start);
+            let a = &a[6 * start..6 * (start + count)];
+            let b = &b[4 * start..4 * (start + count)];
+            self.queue.write_buffer(&buf_a, 0, bytemuck::cast_slice(a));
+            self.queue.write_buffer(&buf_b, 0, bytemuck::cast_slice(b));
             let grid = self.grid(count as u32);
             let block = params_block(&[(0, 0)], align, count as u32, false, grid);
             self.queue.write_buffer(&params, 0, &block);
@@ -114,7 +167,7 @@ impl GpuContext {
                 label: Some(kernel.entry_point()),
             });
             record_passes(&mut enc, kernel, &pipeline, &bind_group, 1, align, grid);
-            let used = (count * OUT_FLOATS * 4) as u64;
+            let used = (count * out_floats * 4) as u64;
             enc.copy_buffer_to_buffer(&buf_out, 0, &staging, 0, used);
             self.queue.submit([enc.finish()]);
             let slice = staging.slice(..used);
@@ -145,13 +198,7 @@ impl GpuContext {
                         break;
                     }
                 };
-                let values: Vec<f32> = bytemuck::pod_collect_to_vec(&view);
-                out.extend(values.chunks_exact(OUT_FLOATS).map(|v| SampleOut {
-                    dir: [v[0], v[1], v[2]],
-                    // −1 stands for +∞ (a delta light).
-                    pdf: if v[3] < 0.0 { f32::INFINITY } else { v[3] },
-                    radiance: [v[4], v[5], v[6]],
-                }));
+                out.extend(bytemuck::pod_collect_to_vec::<u8, f32>(&view));
             }
             staging.unmap();
         }

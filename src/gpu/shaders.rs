@@ -115,16 +115,19 @@ pub enum Kernel {
     Intensity,
     /// One direction per row toward a given light (shaders/sample.wgsl; rows in gpu::sample).
     Sample,
+    /// The density of one direction per row for a given light (the same file).
+    Pdf,
 }
 
 impl Kernel {
     /// Every kernel (tests/wgsl.rs validates each, through the `testkit` feature).
-    pub const ALL: [Kernel; 5] = [
+    pub const ALL: [Kernel; 6] = [
         Kernel::Emission,
         Kernel::Radiance,
         Kernel::Irradiance,
         Kernel::Intensity,
         Kernel::Sample,
+        Kernel::Pdf,
     ];
 
     pub fn file(self) -> &'static str {
@@ -133,7 +136,7 @@ impl Kernel {
             Kernel::Radiance => "radiance.wgsl",
             Kernel::Irradiance => "irradiance.wgsl",
             Kernel::Intensity => "intensity.wgsl",
-            Kernel::Sample => "sample.wgsl",
+            Kernel::Sample | Kernel::Pdf => "sample.wgsl",
         }
     }
 
@@ -144,6 +147,7 @@ impl Kernel {
             Kernel::Irradiance => "irradiance_main",
             Kernel::Intensity => "intensity_main",
             Kernel::Sample => "sample_main",
+            Kernel::Pdf => "pdf_main",
         }
     }
 }

@@ -5,8 +5,8 @@
 //! the generator's dimension 2) and draws the direction, its density `pdf_l` and the radiance
 //! with the WGSL samplers (shaders/sample.wgsl, keyed by the same (seed, point, sample) as the
 //! CPU, dimensions 0 and 1), except for the lights [`Prepared::sample_on_host`] names (textured
-//! domes), whose rows come from the CPU reference. `pdf` runs on the CPU reference on every
-//! device.
+//! domes), whose rows come from the CPU reference. `pdf` likewise: `P(l | x)` on the host,
+//! each light's `pdf_l(ω)` on the device (shaders/sample.wgsl `pdf_main`) but for those lights.
 //!
 //! [`Prepared::sample_on_host`]: crate::prepare::Prepared::sample_on_host
 
@@ -19,7 +19,7 @@ use crate::cpu::sample::{
     LightAt, SceneTables, choose, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
-use crate::gpu::sample::SampleRow;
+use crate::gpu::sample::{PdfRow, SampleRow};
 
 pub use crate::cpu::sample::Selection;
 pub use crate::cpu::sample::report::StrategyVariance;
@@ -106,9 +106,9 @@ impl Row {
 }
 
 impl PreparedScene {
-    /// Where `sample` draws directions: `"gpu"` on a GPU evaluator with a light the WGSL
-    /// samplers take (the host fills the rows of textured domes), else `"cpu"`. `pdf` always
-    /// runs on the CPU reference.
+    /// Where `sample` draws directions and `pdf` evaluates densities: `"gpu"` on a GPU evaluator
+    /// with a light the WGSL samplers take (the host fills the rows of textured domes), else
+    /// `"cpu"`.
     pub fn sampling_device(&self) -> &'static str {
         match self.backend {
             Backend::Gpu(_) if self.lights.iter().any(|p| !p.sample_on_host()) => "gpu",
@@ -251,7 +251,14 @@ impl PreparedScene {
         check_pairs(points, "points", dirs, "directions")?;
         let tables = SceneTables::new(&self.lights, selection);
         let l = self.lights.len();
-        let rows: Vec<Vec<f64>> = points
+        let gpu = match (&self.backend, &self.gpu) {
+            (Backend::Gpu(g), Some(lights)) => Some((g, lights)),
+            _ => None,
+        };
+        let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
+        // Per point: P(l | x) · pdf_l(ω) per light and the sum (row l), the GPU's lights left
+        // for the device with their P(l | x).
+        let mut rows: Vec<(Vec<f64>, Vec<(usize, f64, PdfRow)>)> = points
             .par_iter()
             .enumerate()
             .map(|(i, &pt)| {
@@ -269,15 +276,52 @@ impl PreparedScene {
                     &mut weights,
                 );
                 let mut per = vec![0.0; l + 1];
-                let sum = scene_pdf(&self.lights, &tables, &weights, x, n, w, &mut per[..l]);
-                per[l] = sum;
-                per
+                let mut device = Vec::new();
+                if gpu.is_none() {
+                    per[l] = scene_pdf(&self.lights, &tables, &weights, x, n, w, &mut per[..l]);
+                    return (per, device);
+                }
+                let total: f64 = weights.iter().sum();
+                for (k, p) in self.lights.iter().enumerate() {
+                    if !(total > 0.0 && weights[k] > 0.0) {
+                        continue;
+                    }
+                    let pk = weights[k] / total;
+                    if on_gpu(k) {
+                        device.push((
+                            k,
+                            pk,
+                            PdfRow {
+                                point: pt,
+                                normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
+                                light: k as u32,
+                                dir: w.as_vec3().to_array(),
+                            },
+                        ));
+                    } else {
+                        per[k] = pk * LightAt::new(p, tables.env[k].as_ref(), x, n).pdf(p, x, w);
+                    }
+                }
+                (per, device)
             })
             .collect();
+        if let Some((g, lights)) = gpu {
+            let input: Vec<PdfRow> = rows
+                .iter()
+                .flat_map(|(_, d)| d.iter().map(|r| r.2))
+                .collect();
+            let mut values = g.run_pdf(lights, &input)?.into_iter();
+            for (per, device) in &mut rows {
+                for &(k, pk, _) in device.iter() {
+                    per[k] = pk * values.next().unwrap_or(0.0) as f64;
+                }
+                per[l] = per[..l].iter().sum();
+            }
+        }
         Ok(match acc {
-            Accumulate::Sum => rows.iter().map(|r| r[l] as f32).collect(),
+            Accumulate::Sum => rows.iter().map(|r| r.0[l] as f32).collect(),
             Accumulate::PerLight => (0..l)
-                .flat_map(|k| rows.iter().map(move |r| r[k] as f32))
+                .flat_map(|k| rows.iter().map(move |r| r.0[k] as f32))
                 .collect(),
         })
     }
@@ -447,11 +491,11 @@ impl PreparedScene {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Backend, Evaluator};
-    use super::SampleOptions;
+    use super::super::{Accumulate, Backend, Evaluator};
+    use super::{SampleOptions, Selection};
 
-    /// The sample kernel's rows cut into many device chunks (6 rows each, the last partial)
-    /// are the rows of one chunk.
+    /// The sample and pdf kernels' rows cut into many device chunks (6 rows each, the last
+    /// partial) are the rows of one chunk.
     #[test]
     fn many_sample_chunks_equal_one_chunk() {
         let eval = match Evaluator::gpu() {
@@ -482,11 +526,23 @@ mod tests {
             ..SampleOptions::default()
         };
         let one = scene.sample(&points, None, 11, &opts).unwrap();
+        let xs: Vec<[f32; 3]> = points
+            .iter()
+            .flat_map(|p| std::iter::repeat_n(*p, 11))
+            .collect();
+        let pdf = |s: &super::PreparedScene| {
+            s.pdf(&xs, None, &one.dirs, Selection::Bound, Accumulate::PerLight)
+                .unwrap()
+        };
+        let pdf_one = pdf(&scene);
         // chunk_capacity 16 rows of 12 bytes: 6 rows of the sample kernel's 28 a chunk.
         ctx.cap_chunk_rows(16);
         let many = scene.sample(&points, None, 11, &opts).unwrap();
+        let pdf_many = pdf(&scene);
         ctx.cap_chunk_rows(usize::MAX);
         assert_eq!(one, many);
+        assert_eq!(pdf_one, pdf_many);
+        assert!(pdf_one.iter().any(|&p| p > 0.0));
         assert!(one.pdf.iter().any(|&p| p > 0.0 && p.is_finite()));
     }
 }

@@ -71,8 +71,9 @@ pub fn sampler_margin(r: &Reference, x: [f32; 3], n: Option<[f32; 3]>, u: [f64; 
 /// receiver's height over a rect's or disk's plane (the triple product, cos θ_l), or over a
 /// cylinder's surface (the band's half-width β ≈ √(2(ρ − r)/ρ)), carries the f32 rounding of
 /// that height, ~2e-7 of the distance, relative to the height: 1e-4 of the density at a height
-/// of 2e-3 of the distance, where the margin is `2e-3 · SURFACE_SCALE` = 1e-4.
-const SURFACE_SCALE: f64 = 0.05;
+/// of 2e-3 of the distance (measured on lavapipe: 5e-5 at 2.5e-3, the receiver's local position
+/// rounding with it); the margin is 1e-4 at 1e-2 of the distance.
+const SURFACE_SCALE: f64 = 0.01;
 
 fn radius(p: &crate::prepare::Prepared) -> f64 {
     match p.light.kind {
