@@ -248,7 +248,8 @@ fn compare(
                 let q0 = qc[row] as f64;
                 let steep_q = turned.iter().any(|q| {
                     let q = q[row] as f64;
-                    q != q0 && !((q / q0 - 1.0).abs() <= 0.5 * TOL)
+                    let e = (q / q0 - 1.0).abs();
+                    q != q0 && (e.is_nan() || e > 0.5 * TOL)
                 });
                 let steep = pc.is_finite() && rel(lc, d(along_gpu[row])) > 0.5 * TOL;
                 // A delta light's L is not a radiance along ω (S1): no band.

@@ -80,6 +80,10 @@ pub struct Samples {
     pub light: Vec<i32>,
 }
 
+/// One point of [`PreparedScene::pdf`]: `P(l | x) · pdf_l(ω)` per light and their sum (last),
+/// and the lights the device evaluates, with their `P(l | x)` and kernel rows.
+type PointPdf = (Vec<f64>, Vec<(usize, f64, PdfRow)>);
+
 /// One drawn row of [`PreparedScene::sample`]: ω, `P(l | x) · pdf_l`, L, `P(l | x)`, the light
 /// (−1: none), and the kernel's input where the device draws it.
 #[derive(Clone, Copy, Debug, Default)]
@@ -258,7 +262,7 @@ impl PreparedScene {
         let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
         // Per point: P(l | x) · pdf_l(ω) per light and the sum (row l), the GPU's lights left
         // for the device with their P(l | x).
-        let mut rows: Vec<(Vec<f64>, Vec<(usize, f64, PdfRow)>)> = points
+        let mut rows: Vec<PointPdf> = points
             .par_iter()
             .enumerate()
             .map(|(i, &pt)| {
