@@ -36,6 +36,7 @@ mod math;
 mod rect_conformance;
 mod resident;
 mod robustness;
+mod sample_conformance;
 mod sampling;
 mod tolerance;
 mod twins;

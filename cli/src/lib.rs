@@ -139,7 +139,7 @@ enum Command {
     Falloff(falloff::FalloffArgs),
     /// Draw directions toward the lights with their densities (DESIGN.md §9): per point, a light
     /// chosen by --selection, then a direction by its strategy; dirs, pdf, radiance, light_pdf
-    /// and light into an .npz. Runs on the CPU reference.
+    /// and light into an .npz.
     Sample(sample::SampleArgs),
     /// The density with which `sample` draws each (point, direction) pair's direction:
     /// Σ_l P(l | x) · pdf_l(ω) (delta lights 0), or per light with --per-light.

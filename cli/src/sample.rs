@@ -1,7 +1,8 @@
 //! `luxeval sample` and `luxeval pdf` (DESIGN.md §9 S4): directions drawn toward a stage's
 //! lights with their densities, streamed chunk by chunk into an `.npz`; and the density of
-//! given directions into an `.npy`. Both run on the f64 CPU reference (the GPU samplers are not
-//! written yet; `--device gpu` says so and runs there too).
+//! given directions into an `.npy`. Both run where `--device` says (the light is chosen on the
+//! host; a textured dome's rows are drawn by the CPU reference on every device);
+//! `luxeval sampling` (the report and `--check`) runs on the CPU reference.
 
 use std::path::{Path, PathBuf};
 
@@ -60,8 +61,9 @@ pub struct SampleArgs {
     pub seed: u32,
     #[arg(long, value_enum, default_value_t = SelectionArg::Bound)]
     pub selection: SelectionArg,
-    /// `auto` and `cpu` run on the CPU reference; `gpu` too, with a warning (no GPU samplers
-    /// yet).
+    /// Where to draw: `auto` (default: a hardware GPU when there is one, else the CPU
+    /// reference), `gpu`, `cpu`. The light is chosen on the host, and a textured dome's rows
+    /// are drawn by the CPU reference on every device.
     #[arg(long, value_enum)]
     pub device: Option<DeviceArg>,
     /// Output .npz: float32 dirs (N, K, 3), pdf (N, K) (inf for a delta light), radiance
@@ -95,18 +97,13 @@ pub struct PdfArgs {
     pub output: PathBuf,
 }
 
-/// The scene on the CPU reference, whatever `--device` says (module docs).
+/// The scene on `device` (the report and the check: the CPU reference).
 fn prepare(
     scene: &SceneArgs,
     device: Option<DeviceArg>,
     outputs: &[(&str, &Path)],
 ) -> CliResult<PreparedScene> {
-    if matches!(device, Some(DeviceArg::Gpu)) {
-        eprintln!(
-            "warning: --device gpu: sampling runs on the CPU reference (the GPU samplers are not written yet)"
-        );
-    }
-    Ok(open::prepare(scene, Some(DeviceArg::Cpu), outputs)?.1)
+    Ok(open::prepare(scene, device, outputs)?.1)
 }
 
 fn open_normals(path: Option<&Path>, points: &npy::Reader) -> CliResult<Option<npy::Reader>> {
@@ -155,7 +152,11 @@ pub fn run_sample(a: &SampleArgs) -> CliResult {
     let light = out.add("light", Dtype::I32, &[n, k])?;
     // Points per chunk such that a chunk holds about as many rows as a query chunk.
     let chunk = (npy::chunk_rows_from_env()? / a.count).max(1);
-    let bar = query::progress_bar(n, "points", "sample on cpu".into());
+    let bar = query::progress_bar(
+        n,
+        "points",
+        format!("sample on {}", scene.sampling_device()),
+    );
     let mut start = 0u64;
     while let Some(p) = points.next_chunk(chunk)? {
         let nrm = match &mut normals {
@@ -221,7 +222,7 @@ pub fn run_pdf(a: &PdfArgs) -> CliResult {
     } else {
         Accumulate::Sum
     };
-    let bar = query::progress_bar(m, "rows", "pdf on cpu".into());
+    let bar = query::progress_bar(m, "rows", format!("pdf on {}", scene.sampling_device()));
     let mut start = 0u64;
     while let Some(p) = points.next_chunk(chunk)? {
         let d = dirs.next_chunk(chunk)?.unwrap_or_default();
@@ -285,7 +286,7 @@ pub fn run_sampling(a: &SamplingArgs) -> CliResult {
             normals.len()
         )));
     }
-    let scene = prepare(&a.scene, None, &[])?;
+    let scene = prepare(&a.scene, Some(DeviceArg::Cpu), &[])?;
     let paths: Vec<String> = scene.lights().map(|l| l.path.clone()).collect();
     if let Some(files) = &a.check {
         return run_check(a, &scene, &points, &normals, &files[0], &files[1]);

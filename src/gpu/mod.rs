@@ -8,6 +8,7 @@ pub(crate) mod dispatch;
 pub(crate) mod ies_atlas;
 pub(crate) mod record;
 pub(crate) mod resident;
+pub(crate) mod sample;
 pub(crate) mod shaders;
 pub(crate) mod texture_atlas;
 

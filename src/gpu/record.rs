@@ -46,6 +46,10 @@ pub const FLAG_RECT_TEXTURE: u32 = 2048;
 /// The irradiance kernel gives 0: the host adds the CPU reference's value
 /// (`prepare::Prepared::irradiance_on_host`).
 pub const FLAG_HOST_IRRADIANCE: u32 = 4096;
+/// A rect whose world shape is a parallelogram, not a rectangle: the sampler takes Arvo's two
+/// spherical triangles (`prepare::is_sheared`, the test
+/// `cpu::sample::rect::RectSampler::new` takes, in f64).
+pub const FLAG_SHEARED_RECT: u32 = 8192;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -71,6 +75,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_DOME_TEXTURE", FLAG_DOME_TEXTURE),
     ("FLAG_RECT_TEXTURE", FLAG_RECT_TEXTURE),
     ("FLAG_HOST_IRRADIANCE", FLAG_HOST_IRRADIANCE),
+    ("FLAG_SHEARED_RECT", FLAG_SHEARED_RECT),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
 ];
 
@@ -242,10 +247,18 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
             (KIND_SPHERE, [radius as f32, 0.0, 0.0, 0.0])
         }
         LightType::Disk { radius } => (KIND_DISK, [radius as f32, 0.0, 0.0, 0.0]),
-        LightType::Rect { width, height } => (
-            KIND_RECT,
-            [(width / 2.0) as f32, (height / 2.0) as f32, 0.0, 0.0],
-        ),
+        LightType::Rect { width, height } => {
+            if crate::prepare::is_sheared(
+                p.linear * glam::DVec3::new(width, 0.0, 0.0),
+                p.linear * glam::DVec3::new(0.0, height, 0.0),
+            ) {
+                r.flags |= FLAG_SHEARED_RECT;
+            }
+            (
+                KIND_RECT,
+                [(width / 2.0) as f32, (height / 2.0) as f32, 0.0, 0.0],
+            )
+        }
         LightType::Cylinder {
             length,
             radius,

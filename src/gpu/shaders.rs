@@ -83,6 +83,27 @@ pub const SOURCES: &[(&str, &str)] = &[
         "irradiance/outer.wgsl",
         include_str!("../../shaders/irradiance/outer.wgsl"),
     ),
+    ("sample.wgsl", include_str!("../../shaders/sample.wgsl")),
+    (
+        "sample/rng.wgsl",
+        include_str!("../../shaders/sample/rng.wgsl"),
+    ),
+    (
+        "sample/cone.wgsl",
+        include_str!("../../shaders/sample/cone.wgsl"),
+    ),
+    (
+        "sample/rect.wgsl",
+        include_str!("../../shaders/sample/rect.wgsl"),
+    ),
+    (
+        "sample/area.wgsl",
+        include_str!("../../shaders/sample/area.wgsl"),
+    ),
+    (
+        "sample/dome.wgsl",
+        include_str!("../../shaders/sample/dome.wgsl"),
+    ),
 ];
 
 /// A compute kernel: the file that holds its entry point, and the entry point's name.
@@ -92,15 +113,21 @@ pub enum Kernel {
     Radiance,
     Irradiance,
     Intensity,
+    /// One direction per row toward a given light (shaders/sample.wgsl; rows in gpu::sample).
+    Sample,
+    /// The density of one direction per row for a given light (the same file).
+    Pdf,
 }
 
 impl Kernel {
     /// Every kernel (tests/wgsl.rs validates each, through the `testkit` feature).
-    pub const ALL: [Kernel; 4] = [
+    pub const ALL: [Kernel; 6] = [
         Kernel::Emission,
         Kernel::Radiance,
         Kernel::Irradiance,
         Kernel::Intensity,
+        Kernel::Sample,
+        Kernel::Pdf,
     ];
 
     pub fn file(self) -> &'static str {
@@ -109,6 +136,7 @@ impl Kernel {
             Kernel::Radiance => "radiance.wgsl",
             Kernel::Irradiance => "irradiance.wgsl",
             Kernel::Intensity => "intensity.wgsl",
+            Kernel::Sample | Kernel::Pdf => "sample.wgsl",
         }
     }
 
@@ -118,6 +146,8 @@ impl Kernel {
             Kernel::Radiance => "radiance_main",
             Kernel::Irradiance => "irradiance_main",
             Kernel::Intensity => "intensity_main",
+            Kernel::Sample => "sample_main",
+            Kernel::Pdf => "pdf_main",
         }
     }
 }

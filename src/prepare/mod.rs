@@ -186,6 +186,13 @@ impl Prepared {
         matches!(self.irradiance_path, IrradiancePath::Host(_))
     }
 
+    /// Whether light sampling takes this light on the host even on a GPU evaluator: a textured
+    /// dome, whose alias table and 53-bit texel pick stay with the CPU reference
+    /// (`cpu::sample::dome`); every other light has a WGSL sampler (shaders/sample.wgsl).
+    pub fn sample_on_host(&self) -> bool {
+        self.dome_texture().is_some()
+    }
+
     /// Validates `light` and computes its constants for `mode`.
     pub fn new(light: &Light, mode: TemperatureMode) -> Result<Self> {
         Self::with_assets(light, mode, &mut AssetCache::default())
@@ -556,6 +563,13 @@ pub fn prepare(lights: &[Light], mode: TemperatureMode) -> Result<Vec<Prepared>>
         .iter()
         .map(|l| Prepared::with_assets(l, mode, &mut cache))
         .collect()
+}
+
+/// Whether the parallelogram of world edges `e1`, `e2` (both non-zero) is sheared, i.e. not a
+/// rectangle: the rect sampler's choice between Ureña's spherical rectangle and Arvo's two
+/// triangles (`cpu::sample::rect::RectSampler`), made once in f64 for both paths.
+pub fn is_sheared(e1: DVec3, e2: DVec3) -> bool {
+    e1.dot(e2).abs() > 1e-12 * e1.length() * e2.length()
 }
 
 /// The scale s when `m` is a similarity (s times an orthogonal matrix) to 1e-12, else None.

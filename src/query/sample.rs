@@ -1,17 +1,25 @@
 //! Light sampling on a prepared scene (DESIGN.md §9 S1, S4): `sample` draws directions toward
-//! the lights with their densities, `pdf` gives the density of any direction. Both run on the
-//! f64 CPU reference (`cpu::sample`) on every device: the WGSL samplers are not written yet, so
-//! on a GPU evaluator these queries are the host's (said by [`PreparedScene::sampling_device`]).
+//! the lights with their densities, `pdf` gives the density of any direction.
+//!
+//! On a GPU evaluator `sample` chooses each row's light on the host (the CPU's `P(l | x)`, from
+//! the generator's dimension 2) and draws the direction, its density `pdf_l` and the radiance
+//! with the WGSL samplers (shaders/sample.wgsl, keyed by the same (seed, point, sample) as the
+//! CPU, dimensions 0 and 1), except for the lights [`Prepared::sample_on_host`] names (textured
+//! domes), whose rows come from the CPU reference. `pdf` likewise: `P(l | x)` on the host,
+//! each light's `pdf_l(ω)` on the device (shaders/sample.wgsl `pdf_main`) but for those lights.
+//!
+//! [`Prepared::sample_on_host`]: crate::prepare::Prepared::sample_on_host
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::{Accumulate, PreparedScene, check_directions, check_pairs, check_points};
+use super::{Accumulate, Backend, PreparedScene, check_directions, check_pairs, check_points};
 use crate::cpu::dvec;
 use crate::cpu::sample::{
     LightAt, SceneTables, choose, env_tables, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
+use crate::gpu::sample::{PdfRow, SampleRow};
 
 pub use crate::cpu::sample::Selection;
 pub use crate::cpu::sample::report::StrategyVariance;
@@ -72,14 +80,44 @@ pub struct Samples {
     pub light: Vec<i32>,
 }
 
-/// One draw as the batch collects it: direction, `P(l|x)·pdf_l`, radiance, `P(l|x)`, light row.
-type Drawn = (DVec3, f64, DVec3, f64, i32);
+/// One point of [`PreparedScene::pdf`]: `P(l | x) · pdf_l(ω)` per light and their sum (last),
+/// and the lights the device evaluates, with their `P(l | x)` and kernel rows.
+type PointPdf = (Vec<f64>, Vec<(usize, f64, PdfRow)>);
+
+/// One drawn row of [`PreparedScene::sample`]: ω, `P(l | x) · pdf_l`, L, `P(l | x)`, the light
+/// (−1: none), and the kernel's input where the device draws it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Row {
+    dir: DVec3,
+    pdf: f64,
+    radiance: DVec3,
+    pk: f64,
+    light: i32,
+    gpu: Option<SampleRow>,
+}
+
+impl Row {
+    fn done(dir: DVec3, pdf: f64, radiance: DVec3, pk: f64, light: i32) -> Row {
+        Row {
+            dir,
+            pdf,
+            radiance,
+            pk,
+            light,
+            gpu: None,
+        }
+    }
+}
 
 impl PreparedScene {
-    /// Where sampling runs: always the CPU reference for now (`"cpu"`); a GPU evaluator says
-    /// so in its warnings (the CLI prints it).
+    /// Where `sample` draws directions and `pdf` evaluates densities: `"gpu"` on a GPU evaluator
+    /// with a light the WGSL samplers take (the host fills the rows of textured domes), else
+    /// `"cpu"`.
     pub fn sampling_device(&self) -> &'static str {
-        "cpu"
+        match self.backend {
+            Backend::Gpu(_) if self.lights.iter().any(|p| !p.sample_on_host()) => "gpu",
+            _ => "cpu",
+        }
     }
 
     /// The strategy light `k` is sampled with, in words (DESIGN.md §9 S2).
@@ -106,7 +144,13 @@ impl PreparedScene {
             ));
         }
         let tables = self.sampling_tables(opts.selection);
-        let rows: Vec<Vec<Drawn>> = points
+        // The rows the GPU draws (a light it samples, on a GPU evaluator).
+        let gpu = match (&self.backend, &self.gpu) {
+            (Backend::Gpu(g), Some(lights)) => Some((g, lights)),
+            _ => None,
+        };
+        let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
+        let rows: Vec<Vec<Row>> = points
             .par_iter()
             .enumerate()
             .map(|(i, &pt)| {
@@ -131,27 +175,58 @@ impl PreparedScene {
                         // bits) and 4 an environment map's texel, 5 and 6 its tile.
                         let u = |d: u32| rng::uniform(opts.seed, key, j as u32, d);
                         let Some((k, pk)) = choose(&weights, total, u(2)) else {
-                            return (n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
+                            return Row::done(n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
                         };
+                        if on_gpu(k) {
+                            // Drawn on the device below.
+                            return Row {
+                                pk,
+                                light: k as i32,
+                                gpu: Some(SampleRow {
+                                    point: pt,
+                                    normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
+                                    light: k as u32,
+                                    seed: opts.seed,
+                                    point_key: key,
+                                    sample_key: j as u32,
+                                }),
+                                ..Row::default()
+                            };
+                        }
                         let p = &self.lights[k];
                         let at = cache[k].get_or_insert_with(|| tables.light_at(k, p, x, n));
                         let fine = rng::uniform53(opts.seed, key, j as u32, 3);
                         let s = at.sample(p, x, [u(0), u(1), fine, u(4), u(5), u(6)]);
-                        (s.dir, pk * s.pdf, s.radiance, pk, k as i32)
+                        Row::done(s.dir, pk * s.pdf, s.radiance, pk, k as i32)
                     })
                     .collect()
             })
             .collect();
+        let mut rows: Vec<Row> = rows.into_iter().flatten().collect();
+        if let Some((g, lights)) = gpu {
+            let (index, input): (Vec<usize>, Vec<SampleRow>) = rows
+                .iter()
+                .enumerate()
+                .filter_map(|(r, row)| row.gpu.map(|g| (r, g)))
+                .unzip();
+            let drawn = g.run_sample(lights, &input)?;
+            for (r, d) in index.into_iter().zip(drawn) {
+                let row = &mut rows[r];
+                row.dir = DVec3::from_array(d.dir.map(f64::from));
+                row.pdf = row.pk * d.pdf as f64;
+                row.radiance = DVec3::from_array(d.radiance.map(f64::from));
+            }
+        }
         let mut out = Samples {
             count,
             ..Samples::default()
         };
-        for (dir, pdf, l, pk, k) in rows.into_iter().flatten() {
-            out.dirs.push(dir.as_vec3().to_array());
-            out.pdf.push(pdf as f32);
-            out.radiance.push(l.as_vec3().to_array());
-            out.light_pdf.push(pk as f32);
-            out.light.push(k);
+        for row in rows {
+            out.dirs.push(row.dir.as_vec3().to_array());
+            out.pdf.push(row.pdf as f32);
+            out.radiance.push(row.radiance.as_vec3().to_array());
+            out.light_pdf.push(row.pk as f32);
+            out.light.push(row.light);
         }
         Ok(out)
     }
@@ -171,7 +246,14 @@ impl PreparedScene {
         check_pairs(points, "points", dirs, "directions")?;
         let tables = self.sampling_tables(selection);
         let l = self.lights.len();
-        let rows: Vec<Vec<f64>> = points
+        let gpu = match (&self.backend, &self.gpu) {
+            (Backend::Gpu(g), Some(lights)) => Some((g, lights)),
+            _ => None,
+        };
+        let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
+        // Per point: P(l | x) · pdf_l(ω) per light and the sum (row l), the GPU's lights left
+        // for the device with their P(l | x).
+        let mut rows: Vec<PointPdf> = points
             .par_iter()
             .enumerate()
             .map(|(i, &pt)| {
@@ -189,15 +271,52 @@ impl PreparedScene {
                     &mut weights,
                 );
                 let mut per = vec![0.0; l + 1];
-                let sum = scene_pdf(&self.lights, tables, &weights, x, n, w, &mut per[..l]);
-                per[l] = sum;
-                per
+                let mut device = Vec::new();
+                if gpu.is_none() {
+                    per[l] = scene_pdf(&self.lights, tables, &weights, x, n, w, &mut per[..l]);
+                    return (per, device);
+                }
+                let total: f64 = weights.iter().sum();
+                for (k, p) in self.lights.iter().enumerate() {
+                    if !(total > 0.0 && weights[k] > 0.0) {
+                        continue;
+                    }
+                    let pk = weights[k] / total;
+                    if on_gpu(k) {
+                        device.push((
+                            k,
+                            pk,
+                            PdfRow {
+                                point: pt,
+                                normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
+                                light: k as u32,
+                                dir: w.as_vec3().to_array(),
+                            },
+                        ));
+                    } else {
+                        per[k] = pk * tables.light_at(k, p, x, n).pdf(p, x, w);
+                    }
+                }
+                (per, device)
             })
             .collect();
+        if let Some((g, lights)) = gpu {
+            let input: Vec<PdfRow> = rows
+                .iter()
+                .flat_map(|(_, d)| d.iter().map(|r| r.2))
+                .collect();
+            let mut values = g.run_pdf(lights, &input)?.into_iter();
+            for (per, device) in &mut rows {
+                for &(k, pk, _) in device.iter() {
+                    per[k] = pk * values.next().unwrap_or(0.0) as f64;
+                }
+                per[l] = per[..l].iter().sum();
+            }
+        }
         Ok(match acc {
-            Accumulate::Sum => rows.iter().map(|r| r[l] as f32).collect(),
+            Accumulate::Sum => rows.iter().map(|r| r.0[l] as f32).collect(),
             Accumulate::PerLight => (0..l)
-                .flat_map(|k| rows.iter().map(move |r| r[k] as f32))
+                .flat_map(|k| rows.iter().map(move |r| r.0[k] as f32))
                 .collect(),
         })
     }
@@ -378,5 +497,63 @@ impl PreparedScene {
             None => {}
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Accumulate, Backend, Evaluator};
+    use super::{SampleOptions, Selection};
+
+    /// The sample and pdf kernels' rows cut into many device chunks (6 rows each, the last
+    /// partial) are the rows of one chunk.
+    #[test]
+    fn many_sample_chunks_equal_one_chunk() {
+        let eval = match Evaluator::gpu() {
+            Ok(e) => e,
+            Err(e) if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") => {
+                panic!("CI=true but no GPU adapter: {e}")
+            }
+            Err(e) => return eprintln!("skipping GPU test: {e}"),
+        };
+        let Backend::Gpu(ctx) = &eval.backend else {
+            unreachable!("a GPU evaluator")
+        };
+        let scene = eval
+            .prepare(&crate::synthetic::synthetic_lights(5))
+            .expect("the synthetic lights prepare");
+        assert_eq!(scene.sampling_device(), "gpu");
+        let points: Vec<[f32; 3]> = (0..37)
+            .map(|i| {
+                [
+                    (i % 7) as f32 - 3.0,
+                    (i % 5) as f32 - 2.5,
+                    (i % 3) as f32 + 1.5,
+                ]
+            })
+            .collect();
+        let opts = SampleOptions {
+            seed: 9,
+            ..SampleOptions::default()
+        };
+        let one = scene.sample(&points, None, 11, &opts).unwrap();
+        let xs: Vec<[f32; 3]> = points
+            .iter()
+            .flat_map(|p| std::iter::repeat_n(*p, 11))
+            .collect();
+        let pdf = |s: &super::PreparedScene| {
+            s.pdf(&xs, None, &one.dirs, Selection::Bound, Accumulate::PerLight)
+                .unwrap()
+        };
+        let pdf_one = pdf(&scene);
+        // chunk_capacity 16 rows of 12 bytes: 6 rows of the sample kernel's 28 a chunk.
+        ctx.cap_chunk_rows(16);
+        let many = scene.sample(&points, None, 11, &opts).unwrap();
+        let pdf_many = pdf(&scene);
+        ctx.cap_chunk_rows(usize::MAX);
+        assert_eq!(one, many);
+        assert_eq!(pdf_one, pdf_many);
+        assert!(pdf_one.iter().any(|&p| p > 0.0));
+        assert!(one.pdf.iter().any(|&p| p > 0.0 && p.is_finite()));
     }
 }

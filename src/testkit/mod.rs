@@ -9,6 +9,7 @@ pub mod ies;
 pub mod ies_replay;
 pub mod kernel_rule;
 pub mod rect;
+pub mod sample;
 
 pub use crate::synthetic::{
     Rng, TRANSFORMS, emission_samples, irradiance_samples, radiance_samples, random_light,

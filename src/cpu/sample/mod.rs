@@ -225,7 +225,7 @@ impl<'a> LightAt<'a> {
     }
 
     /// Whether this is a delta light (its density is +∞).
-    #[cfg(test)]
+    #[cfg(any(test, feature = "testkit"))]
     pub fn is_delta(&self) -> bool {
         matches!(self, LightAt::Delta(..) | LightAt::Line { .. })
     }

@@ -170,7 +170,7 @@ impl RectSampler {
         if !(l1 > 0.0 && l2 > 0.0) {
             return None;
         }
-        if e1.dot(e2).abs() <= 1e-12 * l1 * l2 {
+        if !crate::prepare::is_sheared(e1, e2) {
             // A rectangle in the world (the transform does not shear it): Ureña.
             let ey = (e2 - e1 * (e1.dot(e2) / (l1 * l1))).normalize();
             return SphericalRect::new(o, s, e1 / l1, ey, l1, l2).map(RectSampler::Rect);

@@ -1,5 +1,5 @@
 //! The counter-based random numbers of DESIGN.md §9 S3 (f64 side). Twin of
-//! `shaders/sample/rng.wgsl` once the GPU samples.
+//! `shaders/sample/rng.wgsl`.
 //!
 //! `u(seed, point, sample, dimension)` is a pure function of its four keys, so a seed gives the
 //! same directions on any chunking, thread count or machine. Each key is folded in by the PCG
