@@ -400,10 +400,11 @@ pub struct SceneTables {
     /// Textured domes' receiver tiles by (light, normal's bits): a falloff map's receivers share
     /// one normal, and a tile table costs a pass over the tiles. Holds at most
     /// [`TILE_CACHE`] entries; past that, tables are built per receiver.
-    tiles: std::sync::Mutex<
-        std::collections::HashMap<(usize, [u64; 3]), std::sync::Arc<ReceiverTiles>>,
-    >,
+    tiles: std::sync::Mutex<TileCache>,
 }
+
+/// Receiver tile tables by (light, the normal's bits).
+type TileCache = std::collections::HashMap<(usize, [u64; 3]), std::sync::Arc<ReceiverTiles>>;
 
 /// The most receiver tile tables a scene keeps.
 const TILE_CACHE: usize = 4096;
@@ -517,10 +518,11 @@ pub fn selection_weights(
     }
 }
 
-/// [`Selection::Bound`]'s estimate: `Y(base) · Ω̃ · cos_bound`, with Ω̃ the solid angle of the
-/// bounding sphere (2π from inside it) and cos_bound the cosine of the angle between n and the
-/// nearest direction of that sphere (1 without a normal). Positive wherever the light can
-/// deliver light to (x, n); zero behind a one-sided shape or below the receiver's horizon.
+/// [`Selection::Bound`]'s estimate: `Y(base) · Ω̃ · cos_bound · spot_bound`, with Ω̃ the solid
+/// angle of the bounding sphere (2π from inside it), cos_bound the cosine of the angle between n
+/// and the nearest direction of that sphere (1 without a normal) and spot_bound the largest cone
+/// factor toward x ([`spot_bound`]). Positive wherever the light can deliver light to (x, n);
+/// zero behind a one-sided shape, below the receiver's horizon or outside a spot's cone.
 fn bound_weight(p: &Prepared, x: DVec3, n: Option<DVec3>) -> f64 {
     if p.profile.dark {
         return 0.0;
@@ -577,7 +579,28 @@ fn bound_weight(p: &Prepared, x: DVec3, n: Option<DVec3>) -> f64 {
     };
     // A receiver grazing the bound still gets a positive weight when the sphere straddles its
     // horizon (theta − alpha < π/2 strictly).
-    y * omega * cos
+    y * omega * cos * spot_bound(p, -axis, alpha)
+}
+
+/// The largest cone factor of ShapingAPI (DESIGN.md §2 "Shaping") over the emission directions
+/// within `alpha` of `e` — the directions from a finite light's bounding sphere toward the
+/// receiver — so that a spot weighs 0 exactly where none of its light reaches the receiver
+/// (the factor falls with the angle off the axis: its maximum is at the smallest angle). 1 for
+/// an unshaped light, a dome or a distant light.
+fn spot_bound(p: &Prepared, e: DVec3, alpha: f64) -> f64 {
+    match (&p.shaping, &p.light.kind) {
+        (
+            Some(s),
+            LightType::Sphere { .. }
+            | LightType::Rect { .. }
+            | LightType::Disk { .. }
+            | LightType::Cylinder { .. },
+        ) => {
+            let theta = (super::shaping::off_axis_angle(p.axis, e) - alpha).max(0.0);
+            super::shaping::cone_factor(theta, s.cone, s.start)
+        }
+        _ => 1.0,
+    }
 }
 
 /// The light chosen for uniform `u` by the normalised weights' CDF, with its probability;

@@ -584,6 +584,36 @@ fn a_wrong_pdf_is_caught() {
     );
 }
 
+/// `Bound` weighs a spot 0 exactly where its cone cannot reach the receiver: outside the cone
+/// the irradiance is 0 too, inside both are positive.
+#[test]
+fn bound_weight_follows_the_spot_cone() {
+    let ls = vec![prep(&placed(
+        Light::sphere(0.2).with_shaping(spot(20.0)),
+        glam::DMat3::IDENTITY,
+    ))];
+    let tables = SceneTables::new(&ls, Selection::Bound, std::sync::Arc::new(env_tables(&ls)));
+    let mut w = Vec::new();
+    // Below the light (inside the 20° cone) and far off to the side (outside it).
+    for (x, inside) in [
+        (DVec3::new(0.2, 0.0, -0.1), true),
+        (DVec3::new(5.0, 0.0, 0.0), false),
+    ] {
+        selection_weights(
+            &ls,
+            &tables,
+            x,
+            Some(DVec3::Y),
+            Selection::Bound,
+            &Adaptive::REFERENCE,
+            &mut w,
+        );
+        let e = luminance(irradiance(&ls[0], x, DVec3::Y));
+        assert_eq!(w[0] > 0.0, inside, "{x}: weight {}", w[0]);
+        assert_eq!(e > 0.0, inside, "{x}: irradiance {e}");
+    }
+}
+
 /// Scene level: `choose` never picks a light of weight 0 and returns its probability; the
 /// scene pdf is the mixture; `Bound` is positive for every light that lights the receiver.
 #[test]
