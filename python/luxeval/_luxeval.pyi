@@ -28,8 +28,7 @@ class DeviceError(RuntimeError):
 
 class DeviceWarning(RuntimeWarning):
     """Issued once per process when device="auto" finds no GPU adapter and falls back to the CPU
-    reference; and by ``Stage.sample`` and ``Stage.pdf`` with device="gpu", which run on the
-    CPU reference (there are no GPU samplers yet)."""
+    reference."""
 
 def device_name(device: Device = "auto") -> str:
     """The device a query with this ``device=`` argument runs on: the GPU adapter's name and
@@ -162,8 +161,8 @@ class Stage:
         int32 (N, K) (row of light_paths(lights), -1 where no light reaches the point)}``.
         ``normals`` (N, 3) or None (needed by ``selection="exact"``); ``seed`` 0 to 2**32 - 1;
         ``first_point``: the row of ``points[0]`` in a larger input (a slice draws what the
-        whole would). Runs on the CPU reference whatever ``device`` (``DeviceWarning`` for
-        "gpu")."""
+        whole would). ``device`` as ``emission`` (on a GPU the light is chosen on the host, the
+        direction drawn by the WGSL samplers; a textured dome's rows are the CPU reference's)."""
     def pdf(
         self,
         points: npt.ArrayLike,
@@ -179,5 +178,5 @@ class Stage:
     ) -> npt.NDArray[np.float32]:
         """The density ``sample`` draws each direction with (pairs of (M, 3); ``normals`` as
         given to ``sample``) → float32 (M,), or (L, M) with ``per_light=True`` (rows sum to the
-        total). Runs on the CPU reference whatever ``device``."""
+        total). ``device`` as ``sample``."""
     def __reduce__(self) -> tuple[type[Stage], tuple[str, Optional[float]]]: ...

@@ -30,8 +30,7 @@ create_exception!(
     DeviceWarning,
     PyRuntimeWarning,
     "Issued once per process when device=\"auto\" finds no GPU adapter and falls back to the CPU \
-reference; and by Stage.sample and Stage.pdf with device=\"gpu\", which run on the CPU reference \
-(there are no GPU samplers yet)."
+reference."
 );
 
 /// A library error as the exception its kind calls for; `file` (the stage) prefixes errors about

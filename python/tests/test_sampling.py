@@ -7,6 +7,7 @@ the one-call result bit for bit, ``pdf`` is the density the draws claim, ``luxev
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import numpy as np
@@ -283,19 +284,30 @@ def test_bad_rows_are_named_by_row():
         stage.pdf(FLOOR, UP, selection="exact")
 
 
-def test_device_gpu_says_sampling_runs_on_the_cpu():
+def test_device_gpu_draws_what_the_cpu_draws():
+    """device="gpu" samples with the WGSL twins: the same lights chosen, directions within 1e-3
+    rad and densities within 1e-4 of the CPU reference for all but a few rows on the samplers'
+    seams (tests/sample_conformance.rs bounds them); without a GPU adapter, DeviceError (a skip
+    outside CI)."""
     stage = _stage("sphere", 31)
-    with pytest.warns(luxeval.DeviceWarning, match="sampling runs on the CPU reference"):
-        g = stage.sample(FLOOR, UP, count=3, device="gpu")
-    _same(g, stage.sample(FLOOR, UP, count=3, device="cpu"))
-    with pytest.warns(luxeval.DeviceWarning, match="sampling runs on the CPU reference"):
-        p = stage.pdf(FLOOR, g["dirs"][:, 0], UP, device="gpu")
-    assert np.array_equal(p, stage.pdf(FLOOR, g["dirs"][:, 0], UP, device="cpu"))
-    # "auto" and "cpu" say nothing, and prepare the lights on the CPU only.
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        _same(g, stage.sample(FLOOR, UP, count=3))
-    assert {d for _, d, _, _ in stage.prepared} == {"cpu"}
+    try:
+        g = stage.sample(FLOOR, UP, count=64, device="gpu")
+    except luxeval.DeviceError:
+        if os.environ.get("CI") in ("true", "1"):
+            raise
+        pytest.skip("no GPU adapter")
+    c = stage.sample(FLOOR, UP, count=64, device="cpu")
+    assert np.array_equal(g["light"], c["light"])
+    assert np.array_equal(g["light_pdf"], c["light_pdf"])
+    lit = c["pdf"] > 0
+    cos = np.clip(np.sum(g["dirs"].astype(np.float64) * c["dirs"], axis=-1), -1.0, 1.0)
+    assert np.mean(np.arccos(cos[lit]) < 1e-3) > 0.98
+    rel = np.abs(g["pdf"][lit] - c["pdf"][lit]) / c["pdf"][lit]
+    assert np.mean(rel < 1e-4) > 0.98
+    p = stage.pdf(FLOOR, c["dirs"][:, 0], UP, device="gpu")
+    q = stage.pdf(FLOOR, c["dirs"][:, 0], UP, device="cpu")
+    ok = (q == 0) | (np.abs(p - q) <= 1e-4 * np.abs(q))
+    assert np.mean(ok) > 0.9
 
 
 def test_dask_refuses_bad_arguments_when_the_graph_is_built():
