@@ -274,31 +274,41 @@ def test_a_stage_pickles_by_path_and_time(tmp_path):
 
 
 def test_the_gil_is_released_while_the_device_works(stage):
-    pts = floor_points(4000, seed=14)
+    pts = floor_points(40000, seed=14)
     normals = np.tile(np.float32([0, 1, 0]), (len(pts), 1))
+    stage.irradiance(pts[:10], normals[:10], device="cpu")  # prepares (not timed: under load
+    # the preparation would make the rows look slower than they are, and the call too short)
     t0 = time.perf_counter()
-    stage.irradiance(pts[:100], normals[:100], device="cpu")  # prepares, and times 100 rows
-    n = min(len(pts), max(200, int(100 * 1.5 / (time.perf_counter() - t0))))  # about 1.5 s
-    done = threading.Event()
-    window = []
+    stage.irradiance(pts[:1000], normals[:1000], device="cpu")  # times 1000 rows
+    n = min(len(pts), max(200, int(1000 * 1.5 / (time.perf_counter() - t0))))  # about 1.5 s
 
-    def work():
-        t0 = time.perf_counter()
-        stage.irradiance(pts[:n], normals[:n], device="cpu")
-        window.append(time.perf_counter() - t0)
-        done.set()
+    def run(n):
+        done = threading.Event()
+        window = []
 
-    t = threading.Thread(target=work)
-    ticks = 0
-    t.start()
-    while not done.is_set():
-        time.sleep(0.002)  # needs the GIL to wake up
-        ticks += 1
-    t.join()
+        def work():
+            t0 = time.perf_counter()
+            stage.irradiance(pts[:n], normals[:n], device="cpu")
+            window.append(time.perf_counter() - t0)
+            done.set()
+
+        t = threading.Thread(target=work)
+        ticks = 0
+        t.start()
+        while not done.is_set():
+            time.sleep(0.002)  # needs the GIL to wake up
+            ticks += 1
+        t.join()
+        return window[0], ticks
+
+    window, ticks = run(n)
+    # A machine that sped up since the timing: once more with four times the rows.
+    if window <= 0.3 and n < len(pts):
+        window, ticks = run(min(len(pts), 4 * n))
     # Holding the GIL, the call would let this thread wake up only between its chunks (about
     # four per second); released, it wakes up every few milliseconds.
-    assert window[0] > 0.3, "the call must last long enough to tell"
-    assert ticks >= 20 * window[0], (ticks, window)
+    assert window > 0.3, "the call must last long enough to tell"
+    assert ticks >= 20 * window, (ticks, window)
 
 
 CHILD = textwrap.dedent(
