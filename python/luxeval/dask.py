@@ -395,8 +395,8 @@ def sample(
     ``"light"`` (N, K), K = ``count``. Each chunk is sampled with its first row's offset as
     ``first_point``, so the result is bitwise :meth:`luxeval.Stage.sample` on the whole input,
     however it is chunked. The five arrays share one sampling task per chunk: compute them
-    together (``dask.compute(result)[0]``) to sample each chunk once. Sampling runs on the CPU
-    reference whatever ``device`` says (``"gpu"`` warns in the worker's log). ``count``,
+    together (``dask.compute(result)[0]``) to sample each chunk once. Each worker samples where
+    ``device`` says, as the eager call does. ``count``,
     ``seed``, ``selection`` as :meth:`luxeval.Stage.sample`; other arguments as
     :func:`emission` (``chunks`` counts points).
     """

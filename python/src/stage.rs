@@ -163,14 +163,8 @@ impl Stage {
             Some(n) => Some(arrays::rows(py, n, "normals", RowKind::Directions)?),
             None => None,
         };
-        if let Some(n) = &n
-            && n.shape()[0] != p.shape()[0]
-        {
-            return Err(errors::input(format!(
-                "points/normals: {} points but {} normals; they pair up row by row",
-                p.shape()[0],
-                n.shape()[0]
-            )));
+        if let Some(n) = &n {
+            paired("points", p.shape()[0], "normals", n.shape()[0])?;
         }
         Ok((p, n))
     }
@@ -208,12 +202,8 @@ impl Stage {
             Some(b) => arrays::as_vec3(b)?,
             None => &[],
         };
-        if q != Query::Emission && b_rows.len() != a_rows.len() {
-            return Err(errors::input(format!(
-                "{a_name}/{b_name}: {} {a_name} but {} {b_name}; they pair up row by row",
-                a_rows.len(),
-                b_rows.len()
-            )));
+        if q != Query::Emission {
+            paired(a_name, a_rows.len(), b_name, b_rows.len())?;
         }
         let scene = self.prepare_for(py, &o)?;
         let n = a_rows.len();
@@ -764,13 +754,7 @@ impl Stage {
             Some(a) => Some(arrays::as_vec3(a)?),
             None => None,
         };
-        if d.len() != pts.len() {
-            return Err(errors::input(format!(
-                "points/dirs: {} points but {} dirs; they pair up row by row",
-                pts.len(),
-                d.len()
-            )));
-        }
+        paired("points", pts.len(), "dirs", d.len())?;
         let scene = self.prepare_for(py, &o)?;
         let m = pts.len();
         let l = scene.len();
@@ -841,4 +825,14 @@ impl Stage {
             evaluated
         )
     }
+}
+
+/// Two arrays that pair up row by row, or an `InputError` naming both and their lengths.
+fn paired(a_name: &str, a: usize, b_name: &str, b: usize) -> PyResult<()> {
+    if a != b {
+        return Err(errors::input(format!(
+            "{a_name}/{b_name}: {a} {a_name} but {b} {b_name}; they pair up row by row"
+        )));
+    }
+    Ok(())
 }

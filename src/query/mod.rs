@@ -313,3 +313,19 @@ pub(crate) fn check_pairs(
     }
     Ok(())
 }
+
+/// A GPU evaluator for the unit tests, or `None` (with a note) without an adapter; under
+/// `CI=true`, where CI installs lavapipe, a missing adapter fails the test instead.
+#[cfg(test)]
+pub(crate) fn test_gpu() -> Option<Evaluator> {
+    match Evaluator::gpu() {
+        Ok(e) => Some(e),
+        Err(e) if std::env::var("CI").is_ok_and(|v| v == "true" || v == "1") => {
+            panic!("CI=true but no GPU adapter: {e}")
+        }
+        Err(e) => {
+            eprintln!("skipping GPU test: {e}");
+            None
+        }
+    }
+}

@@ -2,7 +2,8 @@
 //! uncompressed as `numpy.savez` writes them. Rows are streamed: each array's data goes to its
 //! own anonymous temporary file as it comes (in order), and [`NpzWriter::finish`] copies them
 //! into the zip, which is written beside the output and renamed over it, so that memory stays
-//! bounded and nothing is left at the output on any error.
+//! bounded and nothing is left at the output on any error. [`FlatNpy`] does the same for one
+//! float32 `.npy` of light rows (`luxeval pdf --per-light`).
 
 use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
@@ -26,12 +27,50 @@ impl Dtype {
     }
 }
 
+/// The bytes of one array (or one light's row) as they come: an anonymous temporary file,
+/// appended to in order and copied out once.
+struct Spool {
+    data: BufWriter<File>,
+    bytes: u64,
+}
+
+impl Spool {
+    fn new(path: &Path) -> Result<Spool> {
+        let file = tempfile::tempfile().map_err(|source| LuxError::Write {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Ok(Spool {
+            data: BufWriter::new(file),
+            bytes: 0,
+        })
+    }
+
+    /// Appends 4-byte little-endian values.
+    fn append<const N: usize>(
+        &mut self,
+        values: impl Iterator<Item = [u8; N]>,
+    ) -> std::io::Result<()> {
+        let mut buf = Vec::new();
+        values.for_each(|v| buf.extend_from_slice(&v));
+        self.bytes += buf.len() as u64;
+        self.data.write_all(&buf)
+    }
+
+    /// Copies everything appended into `w`.
+    fn copy_into(self, w: &mut dyn Write) -> std::io::Result<()> {
+        let mut file = self.data.into_inner().map_err(|e| e.into_error())?;
+        file.seek(SeekFrom::Start(0))?;
+        std::io::copy(&mut file, w)?;
+        Ok(())
+    }
+}
+
 struct Array {
     name: String,
     dtype: Dtype,
     shape: Vec<u64>,
-    data: BufWriter<File>,
-    bytes: u64,
+    spool: Spool,
 }
 
 /// A streaming `.npz` writer (module docs).
@@ -80,37 +119,26 @@ impl NpzWriter {
     /// Adds an array; its rows are appended with [`NpzWriter::append_f32`] /
     /// [`NpzWriter::append_i32`] in order. Returns its index.
     pub fn add(&mut self, name: &str, dtype: Dtype, shape: &[u64]) -> Result<usize> {
-        let file = tempfile::tempfile().map_err(|e| self.write_err(e))?;
         self.arrays.push(Array {
             name: name.to_string(),
             dtype,
             shape: shape.to_vec(),
-            data: BufWriter::new(file),
-            bytes: 0,
+            spool: Spool::new(&self.path)?,
         });
         Ok(self.arrays.len() - 1)
     }
 
     pub fn append_f32(&mut self, array: usize, values: &[f32]) -> Result<()> {
-        let mut buf = Vec::with_capacity(values.len() * 4);
-        values
-            .iter()
-            .for_each(|v| buf.extend_from_slice(&v.to_le_bytes()));
-        self.append(array, &buf)
+        let r = self.arrays[array]
+            .spool
+            .append(values.iter().map(|v| v.to_le_bytes()));
+        r.map_err(|e| self.write_err(e))
     }
 
     pub fn append_i32(&mut self, array: usize, values: &[i32]) -> Result<()> {
-        let mut buf = Vec::with_capacity(values.len() * 4);
-        values
-            .iter()
-            .for_each(|v| buf.extend_from_slice(&v.to_le_bytes()));
-        self.append(array, &buf)
-    }
-
-    fn append(&mut self, array: usize, bytes: &[u8]) -> Result<()> {
-        let a = &mut self.arrays[array];
-        let r = a.data.write_all(bytes);
-        a.bytes += bytes.len() as u64;
+        let r = self.arrays[array]
+            .spool
+            .append(values.iter().map(|v| v.to_le_bytes()));
         r.map_err(|e| self.write_err(e))
     }
 
@@ -122,15 +150,17 @@ impl NpzWriter {
             source,
         };
         let zerr = |e: zip::result::ZipError| werr(std::io::Error::other(e));
+        // The zip writer seeks back to write each entry's sizes, so it takes the temporary
+        // file itself rather than `write_atomic`'s stream.
         let mut tmp = crate::io::temp_beside(&self.path)?;
         {
             let mut zip = zip::ZipWriter::new(BufWriter::new(tmp.as_file_mut()));
             for a in self.arrays {
                 let want: u64 = a.shape.iter().product::<u64>() * 4;
-                if want != a.bytes {
+                if want != a.spool.bytes {
                     return Err(werr(std::io::Error::other(format!(
                         "internal error: array {} has {} bytes, its shape {:?} holds {want}",
-                        a.name, a.bytes, a.shape
+                        a.name, a.spool.bytes, a.shape
                     ))));
                 }
                 let header = npy_header(a.dtype, &a.shape);
@@ -140,9 +170,7 @@ impl NpzWriter {
                 zip.start_file(format!("{}.npy", a.name), options)
                     .map_err(zerr)?;
                 zip.write_all(&header).map_err(werr)?;
-                let mut file = a.data.into_inner().map_err(|e| werr(e.into_error()))?;
-                file.seek(SeekFrom::Start(0)).map_err(werr)?;
-                std::io::copy(&mut file, &mut zip).map_err(werr)?;
+                a.spool.copy_into(&mut zip).map_err(werr)?;
             }
             let mut w = zip.finish().map_err(zerr)?;
             w.flush().map_err(werr)?;
@@ -157,41 +185,32 @@ impl NpzWriter {
 }
 
 /// A float32 `.npy` of shape (M,) or (L, M) streamed in order of M: each of the L rows goes
-/// to its own anonymous temporary file as it comes, and [`FlatNpy::finish`] writes the header
-/// and the rows one after the other beside the output and renames it over the output.
+/// to its own spool as it comes, and [`FlatNpy::finish`] writes the header and the rows one
+/// after the other atomically ([`crate::io::write_atomic`]).
 pub struct FlatNpy {
     path: PathBuf,
     shape: Vec<u64>,
-    rows: Vec<BufWriter<File>>,
+    rows: Vec<Spool>,
 }
 
 impl FlatNpy {
     /// `rows` light rows of `m` values each (shape (m,) when `per_row` is false and `rows` 1).
     pub fn new(path: &Path, rows: u64, m: u64, per_row: bool) -> Result<FlatNpy> {
         let shape = if per_row { vec![rows, m] } else { vec![m] };
-        let mut files = Vec::new();
-        for _ in 0..rows.max(1) {
-            let f = tempfile::tempfile().map_err(|source| LuxError::Write {
-                path: path.to_path_buf(),
-                source,
-            })?;
-            files.push(BufWriter::new(f));
-        }
+        let rows = (0..rows.max(1))
+            .map(|_| Spool::new(path))
+            .collect::<Result<_>>()?;
         Ok(FlatNpy {
             path: path.to_path_buf(),
             shape,
-            rows: files,
+            rows,
         })
     }
 
     /// Appends the next values of row `r`.
     pub fn append(&mut self, r: usize, values: &[f32]) -> Result<()> {
-        let mut buf = Vec::with_capacity(values.len() * 4);
-        values
-            .iter()
-            .for_each(|v| buf.extend_from_slice(&v.to_le_bytes()));
         self.rows[r]
-            .write_all(&buf)
+            .append(values.iter().map(|v| v.to_le_bytes()))
             .map_err(|source| LuxError::Write {
                 path: self.path.clone(),
                 source,
@@ -199,28 +218,11 @@ impl FlatNpy {
     }
 
     pub fn finish(self) -> Result<()> {
-        let werr = |source| LuxError::Write {
-            path: self.path.clone(),
-            source,
-        };
-        let mut tmp = crate::io::temp_beside(&self.path)?;
-        {
-            let mut w = BufWriter::new(tmp.as_file_mut());
-            w.write_all(&npy_header(Dtype::F32, &self.shape))
-                .map_err(werr)?;
-            for row in self.rows {
-                let mut f = row.into_inner().map_err(|e| werr(e.into_error()))?;
-                f.seek(SeekFrom::Start(0)).map_err(werr)?;
-                std::io::copy(&mut f, &mut w).map_err(werr)?;
-            }
-            w.flush().map_err(werr)?;
-        }
-        tmp.as_file().sync_all().map_err(werr)?;
-        tmp.persist(&self.path).map_err(|e| LuxError::Io {
-            path: self.path.clone(),
-            source: e.error,
-        })?;
-        Ok(())
+        let (path, shape, rows) = (self.path, self.shape, self.rows);
+        crate::io::write_atomic(&path, move |w| {
+            w.write_all(&npy_header(Dtype::F32, &shape))?;
+            rows.into_iter().try_for_each(|row| row.copy_into(w))
+        })
     }
 }
 

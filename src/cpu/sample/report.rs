@@ -44,15 +44,13 @@ pub struct StrategyVariance {
 /// of `x + t w`, world distance since `w` is unit) and their unit world normals. `w` comes from
 /// a point of the surface, so a quadric's discriminant is clamped at 0 (a ray to a rim point is
 /// tangent, and rounding must not lose the point it was aimed at).
-fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
-    out.clear();
+fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, mut hit: impl FnMut(f64, DVec3)) {
     let xl = p.to_local * (x - p.origin);
     let dl = p.to_local * w;
-    let world_normal = |nl: DVec3| (p.to_local.transpose() * nl).normalize();
-    let mut push = |t: f64, y: DVec3, nl: DVec3, on: bool| {
+    // Normals map to world by the inverse transpose, (M⁻¹)ᵀ.
+    let mut push = |t: f64, nl: DVec3, on: bool| {
         if t > 0.0 && on {
-            out.push((t, world_normal(nl)));
-            let _ = y;
+            hit(t, (p.to_local.transpose() * nl).normalize());
         }
     };
     match p.light.kind {
@@ -62,7 +60,6 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
                 let y = xl + t * dl;
                 push(
                     t,
-                    y,
                     -DVec3::Z,
                     y.x.abs() <= width / 2.0 && y.y.abs() <= height / 2.0,
                 );
@@ -72,17 +69,14 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
             if dl.z != 0.0 {
                 let t = -xl.z / dl.z;
                 let y = xl + t * dl;
-                push(t, y, -DVec3::Z, y.truncate().length() <= radius);
+                push(t, -DVec3::Z, y.truncate().length() <= radius);
             }
         }
         LightType::Sphere { radius: r, .. } => {
             let (a, b, c) = (dl.length_squared(), xl.dot(dl), xl.length_squared() - r * r);
             let disc = (b * b - a * c).max(0.0);
-            {
-                for t in [(-b - disc.sqrt()) / a, (-b + disc.sqrt()) / a] {
-                    let y = xl + t * dl;
-                    push(t, y, y / r, true);
-                }
+            for t in [(-b - disc.sqrt()) / a, (-b + disc.sqrt()) / a] {
+                push(t, (xl + t * dl) / r, true);
             }
         }
         LightType::Cylinder {
@@ -95,12 +89,7 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
             if a > 0.0 {
                 for t in [(-b - disc.sqrt()) / a, (-b + disc.sqrt()) / a] {
                     let y = xl + t * dl;
-                    push(
-                        t,
-                        y,
-                        DVec3::new(0.0, y.y, y.z) / r,
-                        y.x.abs() <= length / 2.0,
-                    );
+                    push(t, DVec3::new(0.0, y.y, y.z) / r, y.x.abs() <= length / 2.0);
                 }
             }
         }
@@ -109,16 +98,18 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, out: &mut Vec<(f64, DVec3)>) {
 }
 
 /// The area baseline's density of `w`: `Σ d² / (A |cos θ|)` over the surface's points along it.
-fn area_density(p: &Prepared, area: f64, x: DVec3, w: DVec3, hits: &mut Vec<(f64, DVec3)>) -> f64 {
-    surface_hits(p, x, w, hits);
-    hits.iter()
-        .map(|&(t, nw)| t * t / (area * nw.dot(w).abs().max(1e-300)))
-        .sum()
+fn area_density(p: &Prepared, area: f64, x: DVec3, w: DVec3) -> f64 {
+    let mut sum = 0.0;
+    surface_hits(p, x, w, |t, nw| {
+        sum += t * t / (area * nw.dot(w).abs().max(1e-300));
+    });
+    sum
 }
 
-/// The local point, outward normal and area element of a finite shape at parameters (a, b),
-/// with the parameter rectangle.
-fn surface_point(p: &Prepared, a: f64, b: f64) -> (DVec3, DVec3, f64) {
+/// The local point, outward normal and area element of a finite shape at parameters (a, b)
+/// of [`parameter_box`]: (x, y) for a rect, (ρ, φ) for a disk, (z, φ) for a sphere
+/// (Archimedes: dA = r dz dφ), (x, φ) for a cylinder.
+pub fn surface_point(p: &Prepared, a: f64, b: f64) -> (DVec3, DVec3, f64) {
     match p.light.kind {
         LightType::Rect { .. } => (DVec3::new(a, b, 0.0), -DVec3::Z, 1.0),
         LightType::Disk { .. } => (DVec3::new(a * b.cos(), a * b.sin(), 0.0), -DVec3::Z, a),
@@ -135,7 +126,8 @@ fn surface_point(p: &Prepared, a: f64, b: f64) -> (DVec3, DVec3, f64) {
     }
 }
 
-fn parameter_box(p: &Prepared) -> ((f64, f64), (f64, f64)) {
+/// The rectangle of parameters [`surface_point`] takes.
+pub fn parameter_box(p: &Prepared) -> ((f64, f64), (f64, f64)) {
     let tau = (0.0, 2.0 * PI);
     match p.light.kind {
         LightType::Rect { width, height } => {
@@ -160,9 +152,15 @@ pub fn strategy_variance(
     x: DVec3,
     n: DVec3,
 ) -> StrategyVariance {
-    let mut undiffused = p.clone();
-    undiffused.light.inputs.diffuse = 1.0;
-    let i = luminance(irradiance_with(&undiffused, x, n, &Adaptive::REFERENCE));
+    // I without `diffuse` (S1 (iii)); a light with diffuse 0 is evaluated as if it were 1.
+    let diffuse = p.light.inputs.diffuse;
+    let i = if diffuse > 0.0 {
+        luminance(irradiance_with(p, x, n, &Adaptive::REFERENCE)) / diffuse
+    } else {
+        let mut undiffused = p.clone();
+        undiffused.light.inputs.diffuse = 1.0;
+        luminance(irradiance_with(&undiffused, x, n, &Adaptive::REFERENCE))
+    };
     let mut out = StrategyVariance {
         irradiance: i,
         ..Default::default()
@@ -270,7 +268,7 @@ pub fn strategy_variance(
                 }
                 let pdf = match which {
                     0 => at.pdf(p, x, w),
-                    1 => area_density(p, area, x, w, &mut Vec::with_capacity(2)),
+                    1 => area_density(p, area, x, w),
                     _ => n.dot(w) / PI,
                 };
                 if pdf > 0.0 {

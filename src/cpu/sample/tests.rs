@@ -12,8 +12,11 @@ use std::f64::consts::PI;
 
 use super::cone::{Cone, basis};
 use super::cubature::integrate;
+use super::report::{parameter_box, surface_point};
 use super::rng::{uniform, uniform53};
+use super::select::world_bound_radius;
 use super::*;
+use crate::cpu::irradiance::Adaptive;
 use crate::cpu::irradiance::irradiance;
 use crate::model::{Light, LightType, Shaping};
 use crate::prepare::TemperatureMode;
@@ -195,58 +198,19 @@ fn chi2_critical(k: f64) -> f64 {
 /// to its silhouette, which no probing resolves, while per unit area it is constant.
 enum Chart {
     Cone(Cone),
-    /// Local parameters (a, b) ↦ local point and outward normal, with the area element.
-    Surface(
-        fn(&Prepared, f64, f64) -> (DVec3, DVec3, f64),
-        (f64, f64),
-        (f64, f64),
-    ),
-}
-
-fn rect_point(p: &Prepared, a: f64, b: f64) -> (DVec3, DVec3, f64) {
-    let _ = p;
-    (DVec3::new(a, b, 0.0), -DVec3::Z, 1.0)
-}
-fn disk_point(_: &Prepared, rho: f64, phi: f64) -> (DVec3, DVec3, f64) {
-    (
-        DVec3::new(rho * phi.cos(), rho * phi.sin(), 0.0),
-        -DVec3::Z,
-        rho,
-    )
-}
-fn sphere_point(p: &Prepared, z: f64, phi: f64) -> (DVec3, DVec3, f64) {
-    let LightType::Sphere { radius: r, .. } = p.light.kind else {
-        unreachable!()
-    };
-    let s = (r * r - z * z).max(0.0).sqrt();
-    let y = DVec3::new(s * phi.cos(), s * phi.sin(), z);
-    (y, y / r, r)
-}
-fn cylinder_point(p: &Prepared, x: f64, phi: f64) -> (DVec3, DVec3, f64) {
-    let LightType::Cylinder { radius: r, .. } = p.light.kind else {
-        unreachable!()
-    };
-    let n = DVec3::new(0.0, phi.cos(), phi.sin());
-    (DVec3::new(x, r * n.y, r * n.z), n, r)
+    /// Local parameters (a, b) over these ranges ↦ local point, outward normal and area
+    /// element (`report::surface_point`, `report::parameter_box`).
+    Surface((f64, f64), (f64, f64)),
 }
 
 fn chart(p: &Prepared, x: DVec3, at: &LightAt) -> Chart {
-    let tau = 2.0 * PI;
     match (&p.light.kind, at) {
         (_, LightAt::Cone(_)) | (&LightType::Dome | &LightType::Distant { .. }, _) => {
             Chart::Cone(bounding_cone(p, x))
         }
-        (&LightType::Rect { width, height }, _) => Chart::Surface(
-            rect_point,
-            (-width / 2.0, width / 2.0),
-            (-height / 2.0, height / 2.0),
-        ),
-        (&LightType::Disk { radius }, _) => Chart::Surface(disk_point, (0.0, radius), (0.0, tau)),
-        (&LightType::Sphere { radius, .. }, _) => {
-            Chart::Surface(sphere_point, (-radius, radius), (0.0, tau))
-        }
-        (&LightType::Cylinder { length, .. }, _) => {
-            Chart::Surface(cylinder_point, (-length / 2.0, length / 2.0), (0.0, tau))
+        _ => {
+            let (ra, rb) = parameter_box(p);
+            Chart::Surface(ra, rb)
         }
     }
 }
@@ -302,12 +266,12 @@ fn check_density(name: &str, p: &Prepared, x: DVec3, n: DVec3, seed: u32) {
             12,
             24,
         ),
-        Chart::Surface(point, ra, rb) => {
+        Chart::Surface(ra, rb) => {
             // pdf · dω/dA over the visible surface: dω = (cos_l / d_l²) dA_l / J (local solid
             // angle to world, area.rs `local_jacobian`); a point is visible iff it faces x
             // (planar shapes from their emitting side, convex ones by their normal).
             let g = |a: f64, b: f64| {
-                let (y, nl, da) = point(p, a, b);
+                let (y, nl, da) = surface_point(p, a, b);
                 let d = xl - y;
                 let dist = d.length();
                 let cos = nl.dot(d) / dist;
