@@ -57,8 +57,27 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The crate modules a source file names outside its test sections.
+/// Whether `path` is an out-of-line test module: a `tests.rs` that its parent module (`mod.rs`
+/// beside it, or the `<dir>.rs` it sits under) declares as `#[cfg(test)] mod tests;`.
+fn is_test_module(path: &Path) -> bool {
+    if path.file_name().is_none_or(|n| n != "tests.rs") {
+        return false;
+    }
+    let Some(dir) = path.parent() else {
+        return false;
+    };
+    let parents = [dir.join("mod.rs"), dir.with_extension("rs")];
+    parents.iter().any(|p| {
+        std::fs::read_to_string(p).is_ok_and(|t| t.contains("#[cfg(test)]\nmod tests;"))
+    })
+}
+
+/// The crate modules a source file names outside its test sections (an out-of-line test
+/// module is one whole test section).
 fn named_modules(path: &Path) -> BTreeSet<String> {
+    if is_test_module(path) {
+        return BTreeSet::new();
+    }
     let text = std::fs::read_to_string(path).unwrap();
     let code = match text.find("#[cfg(test)]") {
         Some(i) => &text[..i],
