@@ -14,6 +14,9 @@
 // draw is LightAt::new and LightAt::draw in one (WGSL has no enums to carry the strategy).
 // GPU-only drawn, fixed: Drawn's two constructors (a drawn density, or a fixed L).
 // GPU-only sample_main: the kernel's entry point (LightAt::sample's radiance step is inline).
+// GPU-only sample_resident_main: the GPU-resident kernel's entry point (PreparedScene::
+//   encode_sample): the light chosen on the device (sample/select.wgsl), then drawn as
+//   sample_main draws it.
 // GPU-only light_pdf, pdf_main: LightAt::new and LightAt::pdf in one (cone.wgsl's pdf holds the
 //   name), and the pdf kernel's entry point. A rect's Ω comes from rect_sample (its draw is
 //   discarded).
@@ -27,6 +30,7 @@
 // #import sample/rect.wgsl
 // #import sample/area.wgsl
 // #import sample/dome.wgsl
+// #import sample/select.wgsl
 
 struct Drawn {
     dir: vec3<f32>,
@@ -280,4 +284,55 @@ fn pdf_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let light = lights[bitcast<u32>(in_b[4u * i])];
     let w = vec3<f32>(in_b[4u * i + 1u], in_b[4u * i + 2u], in_b[4u * i + 3u]);
     out_rgb[i] = light_pdf(light, x, n, w);
+}
+
+// GPU-resident sampling (PreparedScene::encode_sample): params.count = points × K rows, row i is
+// sample j = i mod K of point p = i / K (params.per_point = K). in_a holds the caller's points and
+// in_b its normals (three packed f32 each; in_b is read only with SELECT_HAS_NORMALS, and a zero
+// normal stands for none). The point's key is params.first_point + p (wrapping, as the host's
+// u64 → u32 key). out_rgb gets 8 floats a row: ω xyz, P(l | x) · pdf_l (+∞ for a delta light, 0
+// where no light reaches the point), L rgb, and the light's index (−1 for none) as an f32.
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn sample_resident_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = sample_index(gid);
+    if i >= params.count {
+        return;
+    }
+    let p = i / params.per_point;
+    let j = i - p * params.per_point;
+    let x = load3(false, p);
+    var n = vec3<f32>(0.0);
+    if (params.select & SELECT_HAS_NORMALS) != 0u {
+        let m = load3(true, p);
+        if length(m) > 0.0 {
+            n = normalize(m);
+        }
+    }
+    let key = params.first_point + p;
+    let seed = params.seed;
+    let c = choose(x, n, rng_uniform(seed, key, j, 2u));
+    var dir = select(vec3<f32>(0.0, 1.0, 0.0), n, length(n) > 0.0);
+    var pdf = 0.0;
+    var l = vec3<f32>(0.0);
+    if c.x >= 0.0 {
+        let light = lights[u32(c.x)];
+        let u = vec2<f32>(rng_uniform(seed, key, j, 0u), rng_uniform(seed, key, j, 1u));
+        let s = draw(light, x, n, u);
+        dir = s.dir;
+        l = s.l;
+        if !s.has_l {
+            l = select(vec3<f32>(0.0), radiance(light, x, s.dir), s.pdf > 0.0);
+        }
+        // −1 stands for a delta light's +∞.
+        pdf = select(c.y * s.pdf, bitcast<f32>(0x7f800000u), s.pdf < 0.0);
+    }
+    let o = 8u * i;
+    out_rgb[o] = dir.x;
+    out_rgb[o + 1u] = dir.y;
+    out_rgb[o + 2u] = dir.z;
+    out_rgb[o + 3u] = pdf;
+    out_rgb[o + 4u] = l.x;
+    out_rgb[o + 5u] = l.y;
+    out_rgb[o + 6u] = l.z;
+    out_rgb[o + 7u] = c.x;
 }

@@ -37,6 +37,7 @@ mod rect_conformance;
 mod resident;
 mod robustness;
 mod sample_conformance;
+mod sample_resident;
 mod sampling;
 mod tolerance;
 mod twins;

@@ -11,9 +11,9 @@ use luxeval::wgpu;
 use luxeval::{Accumulate, Evaluator, Light, LuxError};
 
 /// What a renderer holds: its own device and queue.
-struct Renderer {
-    device: wgpu::Device,
-    queue: wgpu::Queue,
+pub(crate) struct Renderer {
+    pub(crate) device: wgpu::Device,
+    pub(crate) queue: wgpu::Queue,
     /// `None` for a device luxeval opened.
     adapter: Option<wgpu::Adapter>,
 }
@@ -21,7 +21,7 @@ struct Renderer {
 /// The renderer's device, opened the way a renderer would (luxeval's wgpu, the default
 /// high-performance adapter, `limits` or the adapter's own); `None` (a skip, as
 /// `common::gpu` does) without an adapter, a failure under CI=true.
-fn renderer_with(limits: Option<wgpu::Limits>) -> Option<Renderer> {
+pub(crate) fn renderer_with(limits: Option<wgpu::Limits>) -> Option<Renderer> {
     let instance =
         wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
     let adapter = match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
@@ -51,7 +51,7 @@ fn renderer_with(limits: Option<wgpu::Limits>) -> Option<Renderer> {
     })
 }
 
-fn renderer() -> Option<Renderer> {
+pub(crate) fn renderer() -> Option<Renderer> {
     renderer_with(None)
 }
 
@@ -70,7 +70,7 @@ impl Renderer {
         }
     }
 
-    fn buffer(&self, rows: &[[f32; 3]], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    pub(crate) fn buffer(&self, rows: &[[f32; 3]], usage: wgpu::BufferUsages) -> wgpu::Buffer {
         let b = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("renderer input"),
             size: (rows.len() * 12).max(12) as u64,
@@ -83,14 +83,14 @@ impl Renderer {
 
     /// An output of `rows` rows, filled with garbage (1e6) so that a row the call should have
     /// written but did not, or added to instead of writing, shows.
-    fn output(&self, rows: usize) -> wgpu::Buffer {
+    pub(crate) fn output(&self, rows: usize) -> wgpu::Buffer {
         self.buffer(
             &vec![[1.0e6; 3]; rows],
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         )
     }
 
-    fn encoder(&self) -> wgpu::CommandEncoder {
+    pub(crate) fn encoder(&self) -> wgpu::CommandEncoder {
         self.device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("renderer frame"),
@@ -100,11 +100,24 @@ impl Renderer {
     /// Submits `encoder` and reads the first `rows` rows of `out` back.
     fn finish(
         &self,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
         out: &wgpu::Buffer,
         rows: usize,
     ) -> Vec<[f32; 3]> {
-        let size = (rows * 12) as u64;
+        self.finish_floats(encoder, out, 3 * rows)
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect()
+    }
+
+    /// Submits `encoder` and reads the first `floats` f32 of `out` back.
+    pub(crate) fn finish_floats(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        out: &wgpu::Buffer,
+        floats: usize,
+    ) -> Vec<f32> {
+        let size = (floats * 4) as u64;
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
@@ -120,19 +133,18 @@ impl Renderer {
             .poll(wgpu::PollType::wait_indefinitely())
             .expect("the device finishes");
         rx.recv().unwrap().expect("the readback maps");
-        let data =
-            bytemuck::cast_slice::<u8, [f32; 3]>(&slice.get_mapped_range().unwrap()).to_vec();
+        let data = bytemuck::cast_slice::<u8, f32>(&slice.get_mapped_range().unwrap()).to_vec();
         staging.unmap();
         data
     }
 }
 
-fn unit_rows(rng: &mut Rng, n: usize) -> Vec<[f32; 3]> {
+pub(crate) fn unit_rows(rng: &mut Rng, n: usize) -> Vec<[f32; 3]> {
     (0..n).map(|_| rng.unit().as_vec3().to_array()).collect()
 }
 
 /// Points around the lights (synthetic lights sit within a few metres of the origin).
-fn points(rng: &mut Rng, n: usize) -> Vec<[f32; 3]> {
+pub(crate) fn points(rng: &mut Rng, n: usize) -> Vec<[f32; 3]> {
     (0..n)
         .map(|_| (rng.unit() * rng.range(0.5, 6.0)).as_vec3().to_array())
         .collect()
@@ -171,7 +183,7 @@ fn assert_same(what: &str, resident: &[[f32; 3]], host: &[[f32; 3]]) {
 
 /// Lights for emission and radiance: the benchmark's mix (shaped and not) and two IES-shaped
 /// lights, so the pipeline variant with the IES lookup runs too.
-fn lights_with_ies() -> Vec<Light> {
+pub(crate) fn lights_with_ies() -> Vec<Light> {
     let mut rng = Rng::new(11);
     let mut lights = synthetic_lights(12);
     lights.push(with_random_ies(
@@ -340,7 +352,7 @@ fn a_gpu_evaluators_device_serves_resident_calls_and_an_empty_scene_writes_zeros
     assert_eq!(r.finish(enc, &out, n), vec![[0.0; 3]; n]);
 }
 
-fn invalid_input(e: LuxError) -> (String, String) {
+pub(crate) fn invalid_input(e: LuxError) -> (String, String) {
     match e {
         LuxError::InvalidInput { what, reason } => (what, reason),
         other => panic!("expected InvalidInput, got {other:?}"),

@@ -161,6 +161,7 @@ fn record_layout_matches_naga() {
         ("flags", offset_of!(Record, flags)),
         ("pad0", offset_of!(Record, pad)),
         ("pad1", offset_of!(Record, pad) + 4),
+        ("select", offset_of!(Record, select)),
     ];
     assert_eq!(members.len(), rust.len(), "member count: {members:?}");
     for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
@@ -183,6 +184,10 @@ fn params_layout_matches_naga() {
         ("accumulate", offset_of!(Params, accumulate)),
         ("pad0", offset_of!(Params, pad)),
         ("pad1", offset_of!(Params, pad) + 4),
+        ("seed", offset_of!(Params, seed)),
+        ("per_point", offset_of!(Params, per_point)),
+        ("first_point", offset_of!(Params, first_point)),
+        ("select", offset_of!(Params, select)),
     ];
     assert_eq!(members.len(), rust.len(), "member count: {members:?}");
     for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {

@@ -4,13 +4,16 @@
 #     tools/lent_gpu.sh STEP...      (STEP: setup info tests resident cli bench)
 # with two carried folders, both ignored by git (.git/info/exclude):
 #   .gl/   the Vulkan loader's Debian packages (the machine has the NVIDIA driver, not the loader);
-#   .dev/  bins.tar.xz: x86-64 release binaries built here (luxeval, examples/resident and the
+#   .dev/  bins.tar.xz: x86-64 release binaries built here (luxeval, examples/resident,
+#          examples/resident_sampling and the
 #          GPU test binaries, `cargo test --release --no-run`), stripped; optionally
 #          luxeval_old, an earlier luxeval to compare with in the same run.
 # Making .dev, here (release builds; --tests builds every test binary, --lib the unit tests):
 #     cargo test --release --ignore-rust-version --no-run --lib --tests 2>&1 | tee /tmp/b.log
-#     cargo build --release --ignore-rust-version --bins --example resident
-#     mkdir -p /tmp/stage && cp target/release/luxeval target/release/examples/resident /tmp/stage
+#     cargo build --release --ignore-rust-version --features testkit --bins --example resident \
+#         --example resident_sampling
+#     mkdir -p /tmp/stage && cp target/release/luxeval target/release/examples/resident \
+#         target/release/examples/resident_sampling /tmp/stage
 #     for f in $(grep Executable /tmp/b.log | awk '{print $NF}' | tr -d '()'); do
 #         cp "$f" /tmp/stage/t_$(basename "$f" | sed 's/-[0-9a-f]*$//'); done
 #     strip /tmp/stage/*; (cd /tmp/stage && tar cf - * | xz -9) > .dev/bins.tar.xz
@@ -61,8 +64,13 @@ resident() {
             echo "=== resident $args"
             /tmp/bins/resident $args 2>&1
         done
+        # Light sampling (issue 23: 8 mixed lights × 4M samples, ≥ 1e9 samples/s GPU-resident).
+        for args in "8 65536 64 20 bound 10" "8 65536 64 20 power 10" "64 65536 64 10 bound 4"; do
+            echo "=== resident_sampling $args"
+            /tmp/bins/resident_sampling $args 2>&1
+        done
     } > "$OUT/resident.log" 2>&1
-    grep -E '^(===|emission)' "$OUT/resident.log"
+    grep -E '^(===|emission|sampling)' "$OUT/resident.log"
 }
 
 cli() {

@@ -48,6 +48,10 @@ struct Record {
     flags: u32,
     pad0: u32,
     pad1: u32,
+    // The light choice of GPU-resident sampling (sample/select.wgsl): (power weight, luminance
+    // weight of base, world bounding-sphere radius, 0), the weights divided by the scene's
+    // largest.
+    select: vec4<f32>,
 }
 
 struct Params {
@@ -65,6 +69,13 @@ struct Params {
     accumulate: u32,
     pad0: u32,
     pad1: u32,
+    // GPU-resident sampling (sample_resident_main): the generator's seed, samples per point, the
+    // first point's key (DESIGN.md §9 S3), the light choice (SELECT_POWER or SELECT_BOUND, plus
+    // SELECT_HAS_NORMALS). 0 for every other kernel.
+    seed: u32,
+    per_point: u32,
+    first_point: u32,
+    select: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;

@@ -450,11 +450,11 @@ impl GpuContext {
         (gx, wg.div_ceil(gx))
     }
 
-    /// The stride of the Params blocks in their uniform buffer: the device's dynamic offset
-    /// alignment, at least one block.
+    /// The stride of the Params blocks in their uniform buffer: one block rounded up to the
+    /// device's dynamic offset alignment (a multiple of it, as every offset must be).
     pub(super) fn params_align(&self) -> usize {
-        (self.limits.min_uniform_buffer_offset_alignment as usize)
-            .max(std::mem::size_of::<Params>())
+        let align = (self.limits.min_uniform_buffer_offset_alignment as usize).max(1);
+        std::mem::size_of::<Params>().div_ceil(align) * align
     }
 }
 
@@ -476,7 +476,7 @@ pub(super) fn params_block(
             per_light: per_light as u32,
             row_stride: gx * WORKGROUP_SIZE,
             accumulate: (g > 0) as u32,
-            pad: [0; 2],
+            ..Params::default()
         };
         block[g * align..g * align + std::mem::size_of::<Params>()]
             .copy_from_slice(bytemuck::bytes_of(&params));

@@ -77,6 +77,9 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_HOST_IRRADIANCE", FLAG_HOST_IRRADIANCE),
     ("FLAG_SHEARED_RECT", FLAG_SHEARED_RECT),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
+    ("SELECT_POWER", SELECT_POWER),
+    ("SELECT_BOUND", SELECT_BOUND),
+    ("SELECT_HAS_NORMALS", SELECT_HAS_NORMALS),
 ];
 
 /// One light as the kernels read it (see `shaders/shared/record.wgsl` for each field).
@@ -105,6 +108,11 @@ pub struct Record {
     pub kind: u32,
     pub flags: u32,
     pub pad: [u32; 2],
+    /// The light choice of GPU-resident sampling (`shaders/sample/select.wgsl`): (power weight,
+    /// the luminance weight of `base`, the world bounding-sphere radius, 0), each weight divided
+    /// by the scene's largest (`query::scene` fills them; `cpu::sample::select` has the f64
+    /// weights).
+    pub select: [f32; 4],
 }
 
 impl Record {
@@ -151,7 +159,21 @@ pub struct Params {
     pub row_stride: u32,
     pub accumulate: u32,
     pub pad: [u32; 2],
+    /// GPU-resident sampling (`sample_resident_main`): the generator's seed, samples per point,
+    /// the first point's key (DESIGN.md §9 S3) and the light choice ([`SELECT_POWER`] or
+    /// [`SELECT_BOUND`], plus [`SELECT_HAS_NORMALS`]). 0 for every other kernel.
+    pub seed: u32,
+    pub per_point: u32,
+    pub first_point: u32,
+    pub select: u32,
 }
+
+/// `Params::select`: choose lights by power.
+pub const SELECT_POWER: u32 = 0;
+/// `Params::select`: choose lights by the receiver-aware bound.
+pub const SELECT_BOUND: u32 = 1;
+/// `Params::select`: the normals buffer holds a normal per point.
+pub const SELECT_HAS_NORMALS: u32 = 16;
 
 fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
     [v.x as f32, v.y as f32, v.z as f32, w as f32]
@@ -176,6 +198,7 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
             v4(lin.z_axis, p.origin.z),
         ],
         irr: [p.light.inputs.diffuse as f32, p.det as f32, 0.0, 0.0],
+        select: [0.0, 0.0, p.bound_radius() as f32, 0.0],
         ..Record::default()
     };
     if p.similarity.is_some() {

@@ -10,7 +10,7 @@ use wgpu::util::DeviceExt;
 use crate::error::{LuxError, Result};
 
 use super::dispatch::{GpuLights, entry, params_block, params_entry, record_passes};
-use super::record::{Params, Record, WORKGROUP_SIZE};
+use super::record::{Params, Record, SELECT_HAS_NORMALS, WORKGROUP_SIZE};
 use super::{GpuContext, Kernel};
 
 /// One caller buffer and the name errors give it ("directions", "points", "out", ...).
@@ -20,8 +20,15 @@ pub(crate) struct Operand<'a> {
     pub buffer: &'a wgpu::Buffer,
 }
 
-/// Bytes per row of every input and output: three tightly packed f32.
+/// Bytes per row of every input and of the queries' outputs: three tightly packed f32.
 const ROW_BYTES: u64 = 12;
+
+/// An input or query output row, and the GPU-resident sampler's output row, for messages.
+const TRIPLE: (u64, &str) = (ROW_BYTES, "f32 x, y, z");
+const SAMPLE_ROW: (u64, &str) = (
+    SAMPLE_ROW_FLOATS * 4,
+    "f32 ω x, y, z, pdf, L r, g, b, light",
+);
 
 impl GpuContext {
     /// A context on a device the caller opened (a renderer's own device): its limits are those
@@ -90,13 +97,13 @@ impl GpuContext {
             .checked_mul(in_bytes)
             .ok_or_else(|| LuxError::input(out.name, "the output size overflows u64"))?;
         let limit = self.limits.max_storage_buffer_binding_size;
-        for (op, need, usage) in [
-            (Some(a), in_bytes, wgpu::BufferUsages::STORAGE),
-            (b, in_bytes, wgpu::BufferUsages::STORAGE),
-            (Some(out), out_bytes, wgpu::BufferUsages::STORAGE),
+        for (op, n) in [
+            (Some(a), count as u64),
+            (b, count as u64),
+            (Some(out), rows * count as u64),
         ] {
             let Some(op) = op else { continue };
-            check_buffer(op, need, usage, count)?;
+            check_buffer(op, wgpu::BufferUsages::STORAGE, n, TRIPLE)?;
         }
         for op in [Some(a), b].into_iter().flatten() {
             // A buffer bound both read-only and read-write in one pass is a wgpu usage conflict
@@ -151,21 +158,184 @@ impl GpuContext {
         } else {
             self.light_groups(kernel, n_lights)
         };
-        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
-
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        // One Params block per light group at the uniform offset alignment; a buffer of this
-        // call's own (written at creation, so that nothing goes through the queue), kept alive
-        // by the command buffer that uses it.
+        // One Params block per light group at the uniform offset alignment.
         let align = self.params_align();
         let block = params_block(&groups, align, count, per_light, grid);
+        // Emission and intensity read no second input; bind the first again (read-only
+        // aliasing is allowed).
+        let bound = [(a, in_bytes), (b.unwrap_or(a), in_bytes), (out, out_bytes)];
+        self.record_resident(encoder, kernel, lights, &block, groups.len(), bound, grid)?;
+        Ok(())
+    }
+}
+
+/// Floats per output row of the GPU-resident sampler: ω, pdf, L, the light.
+pub(crate) const SAMPLE_ROW_FLOATS: u64 = 8;
+
+/// The most lights the GPU-resident sampler chooses among on a CPU driver: its choice loops
+/// over the lights twice per row, and llvmpipe leaves an invocation's loops silently after
+/// 65,535 iterations in total ([`GpuContext::lights_per_dispatch`]); the rest is the samplers'
+/// own loops.
+pub(crate) const LLVMPIPE_SAMPLE_LIGHTS: usize = 16_384;
+
+/// What one GPU-resident sampling call draws (`PreparedScene::encode_sample`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ResidentDraw {
+    pub points: u32,
+    pub per_point: u32,
+    pub seed: u32,
+    pub first_point: u32,
+    /// `SELECT_POWER` or `SELECT_BOUND`.
+    pub selection: u32,
+}
+
+impl GpuContext {
+    /// Records the GPU-resident sampler (`sample_resident_main`) into `encoder`: `draw.points`
+    /// rows of `points` (and `normals`), `points × per_point` rows of [`SAMPLE_ROW_FLOATS`]
+    /// floats into `out`, point-major. Validates the buffers as [`GpuContext::encode`] does.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn encode_sample(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        lights: &GpuLights,
+        n_lights: usize,
+        points: Operand<'_>,
+        normals: Option<Operand<'_>>,
+        out: Operand<'_>,
+        draw: ResidentDraw,
+    ) -> Result<()> {
+        if draw.per_point == 0 {
+            return Err(LuxError::input(
+                "count",
+                "0: draw at least one sample per point",
+            ));
+        }
+        if self.is_llvmpipe() && n_lights > LLVMPIPE_SAMPLE_LIGHTS {
+            return Err(LuxError::input(
+                "lights",
+                format!(
+                    "{n_lights} lights: on a CPU driver ({}) the GPU-resident sampler chooses among \
+                     at most {LLVMPIPE_SAMPLE_LIGHTS} (its loops stop after 65,535 iterations); use \
+                     PreparedScene::sample",
+                    self.info.name
+                ),
+            ));
+        }
+        let in_bytes = draw.points as u64 * ROW_BYTES;
+        let rows = draw.points as u64 * draw.per_point as u64;
+        let out_bytes = rows * SAMPLE_ROW_FLOATS * 4;
+        for (op, n, row) in [
+            (Some(points), draw.points as u64, TRIPLE),
+            (normals, draw.points as u64, TRIPLE),
+            (Some(out), rows, SAMPLE_ROW),
+        ] {
+            let Some(op) = op else { continue };
+            check_buffer(op, wgpu::BufferUsages::STORAGE, n, row)?;
+        }
+        for op in [Some(points), normals].into_iter().flatten() {
+            if op.buffer == out.buffer {
+                return Err(LuxError::input(
+                    out.name,
+                    format!(
+                        "the output buffer is also the {} buffer; use distinct buffers",
+                        op.name
+                    ),
+                ));
+            }
+        }
+        // The kernel indexes the output as f32 with u32 arithmetic (8 · row + 7), and each
+        // binding must fit the device's storage binding limit.
+        let limit = self.limits.max_storage_buffer_binding_size;
+        let most_rows = (limit / (SAMPLE_ROW_FLOATS * 4)).min(u32::MAX as u64 / SAMPLE_ROW_FLOATS);
+        if rows > most_rows || in_bytes > limit {
+            return Err(LuxError::input(
+                "count",
+                format!(
+                    "{} points × {} samples need {out_bytes} bytes of output in one binding; this \
+                     device takes at most {most_rows} rows per call (storage binding limit \
+                     {limit} bytes): encode fewer points per call (first_point keeps the draws \
+                     of the whole input)",
+                    draw.points, draw.per_point
+                ),
+            ));
+        }
+        let count = rows as u32;
+        let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
+        let grid = self.grid(count);
+        if grid.1 > max_groups {
+            return Err(LuxError::input(
+                "count",
+                format!(
+                    "{count} rows need {} workgroups, over this device's {max_groups} × \
+                     {max_groups} dispatch grid; encode fewer points per call",
+                    count.div_ceil(WORKGROUP_SIZE)
+                ),
+            ));
+        }
+        if count == 0 {
+            return Ok(());
+        }
+        let align = self.params_align();
+        let mut block = params_block(&[(0, n_lights)], align, count, false, grid);
+        let params = Params {
+            seed: draw.seed,
+            per_point: draw.per_point,
+            first_point: draw.first_point,
+            select: draw.selection
+                | if normals.is_some() {
+                    SELECT_HAS_NORMALS
+                } else {
+                    0
+                },
+            ..*bytemuck::from_bytes::<Params>(&block[..std::mem::size_of::<Params>()])
+        };
+        block[..std::mem::size_of::<Params>()].copy_from_slice(bytemuck::bytes_of(&params));
+        // Without normals the kernel reads none; bind the points again.
+        let bound = [
+            (points, in_bytes),
+            (normals.unwrap_or(points), in_bytes),
+            (out, out_bytes),
+        ];
+        self.record_resident(
+            encoder,
+            Kernel::SampleResident,
+            lights,
+            &block,
+            1,
+            bound,
+            grid,
+        )?;
+        Ok(())
+    }
+}
+
+impl GpuContext {
+    /// Records `kernel` over the caller's buffers (`bound`: binding 2, 3 and 4 with the bytes
+    /// each call reads or writes), one pass per Params block of `block` (`passes` of them at
+    /// [`GpuContext::params_align`]). The Params buffer is this call's own, written at
+    /// creation (nothing goes through the queue) and kept alive by the command buffer that
+    /// uses it. The first call of a kernel builds its pipeline.
+    #[allow(clippy::too_many_arguments)]
+    fn record_resident(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        kernel: Kernel,
+        lights: &GpuLights,
+        block: &[u8],
+        passes: usize,
+        bound: [(Operand<'_>, u64); 3],
+        grid: (u32, u32),
+    ) -> Result<()> {
+        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let params = self
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("luxeval params (resident)"),
-                contents: &block,
+                contents: block,
                 usage: wgpu::BufferUsages::UNIFORM,
             });
+        let [(a, a_bytes), (b, b_bytes), (out, out_bytes)] = bound;
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("luxeval queries (resident)"),
             layout: &self.layout,
@@ -174,13 +344,11 @@ impl GpuContext {
                 entry(1, &lights.buffer),
                 wgpu::BindGroupEntry {
                     binding: 2,
-                    resource: range(a, in_bytes),
+                    resource: range(a, a_bytes),
                 },
-                // Emission and intensity read no second input; bind the first again
-                // (read-only aliasing is allowed).
                 wgpu::BindGroupEntry {
                     binding: 3,
-                    resource: range(b.unwrap_or(a), in_bytes),
+                    resource: range(b, b_bytes),
                 },
                 wgpu::BindGroupEntry {
                     binding: 4,
@@ -197,21 +365,19 @@ impl GpuContext {
                 e,
             ));
         }
-        record_passes(
-            encoder,
-            kernel,
-            &pipeline,
-            &bind_group,
-            groups.len(),
-            align,
-            grid,
-        );
+        let align = self.params_align();
+        record_passes(encoder, kernel, &pipeline, &bind_group, passes, align, grid);
         Ok(())
     }
 }
 
-/// The buffer has `usage` and holds at least `need` bytes (`count` rows).
-fn check_buffer(op: Operand<'_>, need: u64, usage: wgpu::BufferUsages, count: u32) -> Result<()> {
+/// The buffer has `usage` and holds at least `rows` rows of `row`: (bytes, layout in words).
+fn check_buffer(
+    op: Operand<'_>,
+    usage: wgpu::BufferUsages,
+    rows: u64,
+    row: (u64, &str),
+) -> Result<()> {
     if !op.buffer.usage().contains(usage) {
         return Err(LuxError::input(
             op.name,
@@ -221,14 +387,16 @@ fn check_buffer(op: Operand<'_>, need: u64, usage: wgpu::BufferUsages, count: u3
             ),
         ));
     }
+    let need = rows.saturating_mul(row.0);
     if op.buffer.size() < need {
         return Err(LuxError::input(
             op.name,
             format!(
-                "the buffer holds {} bytes; {count} samples need {need} ({} bytes a row: f32 \
-                 x, y, z, no padding)",
+                "the buffer holds {} bytes; {rows} rows need {need} ({} bytes a row: {}, no \
+                 padding)",
                 op.buffer.size(),
-                ROW_BYTES
+                row.0,
+                row.1
             ),
         ));
     }

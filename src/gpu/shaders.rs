@@ -104,6 +104,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         "sample/dome.wgsl",
         include_str!("../../shaders/sample/dome.wgsl"),
     ),
+    (
+        "sample/select.wgsl",
+        include_str!("../../shaders/sample/select.wgsl"),
+    ),
 ];
 
 /// A compute kernel: the file that holds its entry point, and the entry point's name.
@@ -117,17 +121,21 @@ pub enum Kernel {
     Sample,
     /// The density of one direction per row for a given light (the same file).
     Pdf,
+    /// GPU-resident sampling: the light chosen on the device, then one direction per row (the
+    /// same file; buffers in gpu::resident).
+    SampleResident,
 }
 
 impl Kernel {
     /// Every kernel (tests/wgsl.rs validates each, through the `testkit` feature).
-    pub const ALL: [Kernel; 6] = [
+    pub const ALL: [Kernel; 7] = [
         Kernel::Emission,
         Kernel::Radiance,
         Kernel::Irradiance,
         Kernel::Intensity,
         Kernel::Sample,
         Kernel::Pdf,
+        Kernel::SampleResident,
     ];
 
     pub fn file(self) -> &'static str {
@@ -136,7 +144,7 @@ impl Kernel {
             Kernel::Radiance => "radiance.wgsl",
             Kernel::Irradiance => "irradiance.wgsl",
             Kernel::Intensity => "intensity.wgsl",
-            Kernel::Sample | Kernel::Pdf => "sample.wgsl",
+            Kernel::Sample | Kernel::Pdf | Kernel::SampleResident => "sample.wgsl",
         }
     }
 
@@ -148,6 +156,7 @@ impl Kernel {
             Kernel::Intensity => "intensity_main",
             Kernel::Sample => "sample_main",
             Kernel::Pdf => "pdf_main",
+            Kernel::SampleResident => "sample_resident_main",
         }
     }
 }

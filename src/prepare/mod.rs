@@ -164,6 +164,22 @@ impl Prepared {
         }
     }
 
+    /// The radius of a sphere about the light's origin holding its world shape (0 for a dome
+    /// or distant light): `Σ |half extent_i| |M e_i|` bounds `|M v|` over the local shape's box.
+    /// The receiver-aware light choice of sampling bounds a light by it (DESIGN.md §9 S1).
+    pub fn bound_radius(&self) -> f64 {
+        let ext = match self.light.kind {
+            LightType::Rect { width, height } => DVec3::new(width / 2.0, height / 2.0, 0.0),
+            LightType::Disk { radius } => DVec3::new(radius, radius, 0.0),
+            LightType::Sphere { radius, .. } => DVec3::splat(radius),
+            LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
+            LightType::Dome | LightType::Distant { .. } => DVec3::ZERO,
+        };
+        ext.x * self.linear.x_axis.length()
+            + ext.y * self.linear.y_axis.length()
+            + ext.z * self.linear.z_axis.length()
+    }
+
     /// A dome's environment map, where authored.
     pub fn dome_texture(&self) -> Option<&texture::PreparedTexture> {
         match &self.kind {

@@ -4,10 +4,12 @@
 //! The buffer contract is in the docs of `PreparedScene::encode_emission` (public, unlike this
 //! module's).
 
+use super::sample::{SampleOptions, Selection};
 use super::{Accumulate, Backend, Evaluator, PreparedScene};
 use crate::error::{LuxError, Result};
-use crate::gpu::resident::Operand;
-use crate::gpu::{GpuContext, Kernel};
+use crate::gpu::record::{SELECT_BOUND, SELECT_POWER};
+use crate::gpu::resident::{Operand, ResidentDraw};
+use crate::gpu::{GpuContext, GpuLights, Kernel};
 use crate::prepare::IrradiancePath;
 
 impl Evaluator {
@@ -197,6 +199,112 @@ impl PreparedScene {
         )
     }
 
+    /// Records [`PreparedScene::sample`] into `encoder` for points and normals already on the
+    /// device: `count` directions toward the scene's lights for each of `n_points` points, the
+    /// light chosen on the device. GPU-resident sampling for renderers; nothing is uploaded,
+    /// submitted or read back, and the buffers follow [`PreparedScene::encode_emission`]'s
+    /// contract (`STORAGE`, this scene's device, only the first rows read and written).
+    ///
+    /// # Buffers
+    ///
+    /// `points` and `normals` hold `n_points` rows of three packed `f32`. `normals` is optional;
+    /// where given, a zero row stands for "no normal" at that point (the host path refuses one)
+    /// and the others need not be unit length. `out` receives `n_points × count` rows,
+    /// point-major (row `i·count + j` is sample j of point i), of 8 `f32` (32 bytes):
+    /// `ω.x, ω.y, ω.z, pdf, L.r, L.g, L.b, light` — the fields of [`Samples`] but
+    /// `light_pdf`: `pdf` is `P(l | x) · pdf_l(ω)` (`+∞` for a delta light, 0 where no light
+    /// reaches the point) and `light` the chosen light's index as an `f32` (exact below 2²⁴),
+    /// `−1` for none.
+    ///
+    /// # What it draws
+    ///
+    /// The rows [`PreparedScene::sample`] draws with the same [`SampleOptions`], up to f32:
+    /// the generator is keyed alike (DESIGN.md §9 S3, `opts.first_point` the key of the first
+    /// point), and the light is chosen by the same weights, evaluated in f32 on the device
+    /// (`shaders/sample/select.wgsl`), so that a row whose dimension-2 uniform falls within
+    /// f32 rounding of the border between two lights' shares may name the other light.
+    /// `Selection::Power` and `Selection::Bound` (the default) run on the device;
+    /// `Selection::Exact` integrates each light's irradiance per receiver on the host, and is
+    /// refused here.
+    ///
+    /// # Errors
+    ///
+    /// [`LuxError::InvalidInput`] for `count` 0, `Selection::Exact`, a buffer that lacks
+    /// `STORAGE` or is too small, an output that is an input, more rows than one binding or
+    /// dispatch holds (the message gives the most one call takes; split the points and set
+    /// `first_point`), more than 16,384 lights on a CPU driver such as lavapipe (whose loops
+    /// stop after 65,535 iterations), and a scene on the CPU reference.
+    /// [`LuxError::NotOnDevice`] for a scene with a textured dome (its rows are drawn on the
+    /// host; use [`PreparedScene::sample`]). [`LuxError::Gpu`] as
+    /// [`PreparedScene::encode_emission`].
+    ///
+    /// [`Samples`]: super::sample::Samples
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_sample(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        points: &wgpu::Buffer,
+        normals: Option<&wgpu::Buffer>,
+        out: &wgpu::Buffer,
+        n_points: u32,
+        count: u32,
+        opts: &SampleOptions,
+    ) -> Result<()> {
+        let Backend::Gpu(g) = &self.backend else {
+            return Err(no_device());
+        };
+        let selection = match opts.selection {
+            Selection::Power => SELECT_POWER,
+            Selection::Bound => SELECT_BOUND,
+            Selection::Exact => {
+                return Err(LuxError::input(
+                    "selection",
+                    "exact: choosing by each light's exact irradiance integrates it per receiver \
+                     on the host; use PreparedScene::sample, or Selection::Bound on the device",
+                ));
+            }
+        };
+        if let Some(p) = self.lights.iter().find(|p| p.sample_on_host()) {
+            return Err(LuxError::NotOnDevice {
+                light: p.light.path.clone(),
+                query: "sample".into(),
+                reason: "a textured dome's directions are drawn on the host (its alias tables \
+                         are not on the device); use PreparedScene::sample"
+                    .into(),
+            });
+        }
+        let mut placeholder = None;
+        let lights = self.device_lights(g, &mut placeholder)?;
+        let points = Operand {
+            name: "points",
+            buffer: points,
+        };
+        let normals = normals.map(|buffer| Operand {
+            name: "normals",
+            buffer,
+        });
+        let out = Operand {
+            name: "out",
+            buffer: out,
+        };
+        let draw = ResidentDraw {
+            points: n_points,
+            per_point: count,
+            seed: opts.seed,
+            first_point: opts.first_point as u32,
+            selection,
+        };
+        g.encode_sample(
+            encoder,
+            lights,
+            self.lights.len(),
+            points,
+            normals,
+            out,
+            draw,
+        )
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn encode(
         &self,
@@ -209,26 +317,15 @@ impl PreparedScene {
         acc: Accumulate,
     ) -> Result<()> {
         let Backend::Gpu(g) = &self.backend else {
-            return Err(LuxError::input(
-                "backend",
-                "this scene was prepared on the CPU reference, which has no device; prepare it \
-                 with Evaluator::from_wgpu or Evaluator::gpu",
-            ));
+            return Err(no_device());
         };
         let out = Operand {
             name: "out",
             buffer: out,
         };
         let per_light = acc == Accumulate::PerLight;
-        // A scene with no lights uploads none; the kernel still needs a record array bound.
-        let placeholder;
-        let lights = match &self.gpu {
-            Some(l) => l,
-            None => {
-                placeholder = g.no_lights()?;
-                &placeholder
-            }
-        };
+        let mut placeholder = None;
+        let lights = self.device_lights(g, &mut placeholder)?;
         g.encode(
             encoder,
             kernel,
@@ -241,4 +338,28 @@ impl PreparedScene {
             per_light,
         )
     }
+}
+
+impl PreparedScene {
+    /// The scene's lights on the device; a scene with no lights uploads none, and the kernels
+    /// still need a record array bound (`placeholder` holds it).
+    fn device_lights<'a>(
+        &'a self,
+        g: &GpuContext,
+        placeholder: &'a mut Option<GpuLights>,
+    ) -> Result<&'a GpuLights> {
+        match &self.gpu {
+            Some(l) => Ok(l),
+            None => Ok(placeholder.insert(g.no_lights()?)),
+        }
+    }
+}
+
+/// The refusal of GPU-resident work on a scene prepared on the CPU reference.
+fn no_device() -> LuxError {
+    LuxError::input(
+        "backend",
+        "this scene was prepared on the CPU reference, which has no device; prepare it with \
+         Evaluator::from_wgpu or Evaluator::gpu",
+    )
 }

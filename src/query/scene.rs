@@ -81,12 +81,13 @@ impl PreparedScene {
                         r.path, r.from.0, r.from.1, r.to.0, r.to.1
                     ));
                 }
-                let records: Vec<record::Record> = lights
+                let mut records: Vec<record::Record> = lights
                     .iter()
                     .zip(bases)
                     .zip(offsets)
                     .map(|((p, base), offset)| record::pack(p, base, offset))
                     .collect();
+                selection_weights_into(&lights, &mut records);
                 g.upload(&records, &atlas.data, &tex_atlas)?
             }
         };
@@ -326,6 +327,45 @@ fn unit_row(r: [f32; 3]) -> [f32; 3] {
     }
     let u = (d / m).normalize();
     [u.x as f32, u.y as f32, u.z as f32]
+}
+
+/// The light-choice weights GPU-resident sampling reads from the records (`Record::select`):
+/// each light's power weight and the luminance weight of its base (`cpu::sample::select`, in
+/// f64), each divided by the scene's largest so that f32 holds their ratios whatever the
+/// scene's units; a positive weight stays positive (at least the least normal f32).
+fn selection_weights_into(lights: &[Prepared], records: &mut [record::Record]) {
+    use crate::cpu::sample::select::{power_weight, weight_of};
+    let power: Vec<f64> = lights.iter().map(power_weight).collect();
+    let luma: Vec<f64> = lights
+        .iter()
+        .map(|p| {
+            if p.profile.dark {
+                0.0
+            } else {
+                weight_of(p.base)
+            }
+        })
+        .collect();
+    let scaled = |w: &[f64]| -> Vec<f32> {
+        let top = w
+            .iter()
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        w.iter()
+            .map(|&v| {
+                if !(v > 0.0 && v.is_finite() && top > 0.0) {
+                    0.0
+                } else {
+                    ((v / top) as f32).max(f32::MIN_POSITIVE)
+                }
+            })
+            .collect()
+    };
+    for ((r, p), y) in records.iter_mut().zip(scaled(&power)).zip(scaled(&luma)) {
+        r.select[0] = p;
+        r.select[1] = y;
+    }
 }
 
 #[cfg(test)]

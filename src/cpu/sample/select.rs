@@ -31,24 +31,9 @@ pub enum Selection {
 /// A weight that is positive whenever any channel is: the luminance, or where that is 0 (a
 /// colour with luminance 0 but a positive channel cannot occur for non-negative colours, but a
 /// tint can cancel), the largest channel.
-fn weight_of(c: DVec3) -> f64 {
+pub(crate) fn weight_of(c: DVec3) -> f64 {
     let y = luminance(c);
     if y > 0.0 { y } else { c.max_element().max(0.0) }
-}
-
-/// The bounding-sphere radius of a light's shape in world units: `Σ |half extent_i| |M e_i|`
-/// bounds `|M v|` over the local shape's box.
-pub(crate) fn world_bound_radius(p: &Prepared) -> f64 {
-    let ext = match p.light.kind {
-        LightType::Rect { width, height } => DVec3::new(width / 2.0, height / 2.0, 0.0),
-        LightType::Disk { radius } => DVec3::new(radius, radius, 0.0),
-        LightType::Sphere { radius, .. } => DVec3::splat(radius),
-        LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
-        LightType::Dome | LightType::Distant { .. } => DVec3::ZERO,
-    };
-    ext.x * p.linear.x_axis.length()
-        + ext.y * p.linear.y_axis.length()
-        + ext.z * p.linear.z_axis.length()
 }
 
 /// The per-light data of a scene's sampler: the dome tables and, for `Selection::Exact`, the
@@ -133,7 +118,7 @@ impl SceneTables {
 }
 
 /// Power as a selection weight (constant over receivers).
-fn power_weight(p: &Prepared) -> f64 {
+pub(crate) fn power_weight(p: &Prepared) -> f64 {
     let facing = match p.light.kind {
         // A uniform dome's irradiance on a receiver facing anywhere: π L.
         LightType::Dome => Some(std::f64::consts::PI),
@@ -188,13 +173,15 @@ fn bound_weight(p: &Prepared, x: DVec3, n: Option<DVec3>) -> f64 {
         return 0.0;
     }
     let y = weight_of(p.base);
-    let (axis, alpha, omega) = match p.light.kind {
+    // The bound's cone: its axis toward the light, half-angle α with (cos α, sin α), and Ω̃.
+    let (axis, alpha, (cos_a, sin_a), omega) = match p.light.kind {
         LightType::Dome => return y * std::f64::consts::PI,
         LightType::Distant { .. } => {
             let t = p.distant_half_angle();
             (
                 -p.axis,
                 t,
+                (t.cos(), t.sin()),
                 if t == 0.0 {
                     1.0
                 } else {
@@ -213,27 +200,38 @@ fn bound_weight(p: &Prepared, x: DVec3, n: Option<DVec3>) -> f64 {
             }
             let w = p.origin - x;
             let d = w.length();
-            let r = world_bound_radius(p);
+            let r = p.bound_radius();
             if !(d > r) {
                 (
                     w.normalize_or(DVec3::Y),
                     std::f64::consts::PI,
+                    (-1.0, 0.0),
                     2.0 * std::f64::consts::PI,
                 )
             } else {
                 let c = Cone::subtended(w / d, r, d);
+                let s = r / d;
                 (
                     (w / d),
-                    (r / d).asin(),
+                    s.asin(),
+                    ((1.0 - s * s).max(0.0).sqrt(), s),
                     c.solid_angle().max(f64::MIN_POSITIVE),
                 )
             }
         }
     };
+    // cos(max(θ − α, 0)) for θ the angle between n and the axis: 1 where θ ≤ α (cos θ ≥
+    // cos α), else cos θ cos α + sin θ sin α, with sin θ = |n × axis| — no acos, whose f32
+    // twin loses ~1e-4 rad near the axis and whose error grows without bound relative to a
+    // cosine near 0.
     let cos = match n {
         Some(n) => {
-            let theta = n.dot(axis).clamp(-1.0, 1.0).acos();
-            (theta - alpha).max(0.0).cos().max(0.0)
+            let (c, s) = (n.dot(axis), n.cross(axis).length());
+            if c >= cos_a {
+                1.0
+            } else {
+                (c * cos_a + s * sin_a).max(0.0)
+            }
         }
         None => 1.0,
     };

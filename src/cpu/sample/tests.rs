@@ -14,7 +14,6 @@ use super::cone::{Cone, basis};
 use super::cubature::integrate;
 use super::report::{parameter_box, surface_point};
 use super::rng::{uniform, uniform53};
-use super::select::world_bound_radius;
 use super::*;
 use crate::cpu::irradiance::Adaptive;
 use crate::cpu::irradiance::irradiance;
@@ -107,7 +106,7 @@ fn receivers() -> Vec<(DVec3, DVec3)> {
 /// bounding sphere's cone for finite lights (the whole sphere from inside it), the whole
 /// sphere for domes and distant lights.
 fn bounding_cone(p: &Prepared, x: DVec3) -> Cone {
-    let r = world_bound_radius(p);
+    let r = p.bound_radius();
     let w = p.origin - x;
     let d = w.length();
     match p.light.kind {
