@@ -67,9 +67,9 @@ fn is_test_module(path: &Path) -> bool {
         return false;
     };
     let parents = [dir.join("mod.rs"), dir.with_extension("rs")];
-    parents.iter().any(|p| {
-        std::fs::read_to_string(p).is_ok_and(|t| t.contains("#[cfg(test)]\nmod tests;"))
-    })
+    parents
+        .iter()
+        .any(|p| std::fs::read_to_string(p).is_ok_and(|t| t.contains("#[cfg(test)]\nmod tests;")))
 }
 
 /// The crate modules a source file names outside its test sections (an out-of-line test

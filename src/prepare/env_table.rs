@@ -52,7 +52,7 @@ use super::texture::{
 
 mod tiles;
 
-pub use tiles::{ReceiverTiles, Tiles};
+pub use tiles::{HORIZON_FLOOR, ReceiverTiles, Tiles};
 
 const PI: f64 = std::f64::consts::PI;
 

@@ -35,6 +35,9 @@ pub struct PreparedScene {
     pub(super) sampling_env:
         std::sync::OnceLock<std::sync::Arc<Vec<Option<crate::prepare::env_table::EnvTable>>>>,
     pub(super) sampling_tables: [std::sync::OnceLock<crate::cpu::sample::SceneTables>; 3],
+    /// On a GPU, the sample and pdf kernels' records and texture atlas with the textured domes'
+    /// sampling tables appended (`gpu::sample::SampleLights`), built on first use.
+    pub(super) sampling_gpu: std::sync::OnceLock<crate::gpu::sample::SampleLights>,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -106,6 +109,7 @@ impl PreparedScene {
             rule: Adaptive::REFERENCE,
             sampling_env: Default::default(),
             sampling_tables: Default::default(),
+            sampling_gpu: Default::default(),
         })
     }
 

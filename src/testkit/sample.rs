@@ -26,11 +26,18 @@ pub use crate::cpu::sample::rng::{pcg_hash, uniform};
 ///   (the silhouette, where the density `∝ 1/cos` is unbounded), and the receiver's height
 ///   over its surface, `(ρ − r)/ρ` scaled by [`SURFACE_SCALE`];
 /// - a rect or disk: the receiver's elevation over the light's plane (its sine, seen from the
-///   light's centre) scaled by [`SURFACE_SCALE`].
+///   light's centre) scaled by [`SURFACE_SCALE`];
+/// - a textured dome: the draw's distance from its texel's edge in the texel's chart,
+///   `min(u[0], 1 − u[0], u[1], 1 − u[1])` (the density jumps from texel to texel).
 pub fn sampler_margin(r: &Reference, x: [f32; 3], n: Option<[f32; 3]>, u: [f64; 2]) -> f64 {
     let p = &r.p;
     let x = dvec(x);
     let n = n.map(|n| dvec(n).normalize());
+    if p.dome_texture().is_some() {
+        // The point within the drawn texel's chart comes from u: this close to a texel edge the
+        // f32 direction's lookup may name the neighbouring texel, whose density differs.
+        return u[0].min(1.0 - u[0]).min(u[1]).min(1.0 - u[1]);
+    }
     let at = LightAt::new(p, None, x, n);
     if at.is_delta() {
         return f64::INFINITY;

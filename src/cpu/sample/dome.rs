@@ -86,14 +86,14 @@ pub fn sample_dome(
     }
 }
 
-/// The texel drawn by u[2] (53 bits), u[3] — within the tile u[4], u[5] draw by the
-/// receiver's product where `rt` is given (the plain table's otherwise, or for a tile of
-/// weight 0, which the product never draws).
+/// The texel drawn by u[2] (53 bits), u[3] — within the tile u[4] + u[5]·2⁻²⁴ draws from the
+/// receiver's product where `rt` is given ([`ReceiverTiles::pick`]; the plain table's
+/// otherwise, or for a tile of weight 0, which the product never draws).
 #[inline]
 fn pick_texel(t: &EnvTable, rt: Option<&ReceiverTiles>, u: &[f64; 6]) -> usize {
     match rt {
         Some(rt) if !t.tiles.inner.is_empty() => {
-            let tile = rt.alias.pick(u[4], u[5]);
+            let tile = rt.pick(u[4], u[5]);
             match &t.tiles.inner[tile] {
                 Some(inner) => t.texel_of(tile, inner.pick(u[2], u[3])),
                 None => t.table.pick(u[2], u[3]),
@@ -111,7 +111,7 @@ fn texel_pmf(t: &EnvTable, rt: Option<&ReceiverTiles>, k: usize) -> f64 {
         Some(rt) if !t.tiles.inner.is_empty() => {
             let (tile, local) = t.tile_of(k);
             match &t.tiles.inner[tile] {
-                Some(inner) => rt.alias.pmf(tile) * inner.pmf(local),
+                Some(inner) => rt.pmf(tile) * inner.pmf(local),
                 None => 0.0,
             }
         }
