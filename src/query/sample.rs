@@ -294,13 +294,13 @@ impl PreparedScene {
                     return (per, device);
                 }
                 let total: f64 = weights.iter().sum();
-                for k in 0..l {
-                    if !(total > 0.0 && weights[k] > 0.0) {
+                for (k, &wk) in weights.iter().enumerate() {
+                    if !(total > 0.0 && wk > 0.0) {
                         continue;
                     }
                     device.push((
                         k,
-                        weights[k] / total,
+                        wk / total,
                         PdfRow {
                             point: pt,
                             normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
