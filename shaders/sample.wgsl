@@ -9,7 +9,8 @@
 // out_rgb holds (ω xyz, pdf_l, L rgb) per row, pdf_l = −1 standing for +∞ (a delta light).
 // pdf_main's rows: in_a as sample_main's, in_b the u32 bits of the light index and the unit ω
 // (f32) per row; out_rgb one pdf_l per row (0 for delta lights, S1).
-// Textured domes are never sent here (prepare::Prepared::sample_on_host).
+// A textured dome draws its texel and tile from dimensions 3–6 of the same keys (draw passes
+// them on), reading its sampling table from the texture atlas (sample/dome.wgsl).
 //
 // draw is LightAt::new and LightAt::draw in one (WGSL has no enums to carry the strategy).
 // GPU-only drawn, fixed: Drawn's two constructors (a drawn density, or a fixed L).
@@ -49,8 +50,9 @@ fn fixed(dir: vec3<f32>, pdf: f32, l: vec3<f32>) -> Drawn {
     return Drawn(dir, pdf, l, true);
 }
 
-// The light's strategy set up for the receiver at x (normal n, zero for none) and drawn for u.
-fn draw(light: Record, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>) -> Drawn {
+// The light's strategy set up for the receiver at x (normal n, zero for none) and drawn for u;
+// `keys` (seed, point key, sample key) give a textured dome its further dimensions.
+fn draw(light: Record, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>, keys: vec3<u32>) -> Drawn {
     let o = world_origin(light);
     let to = o - x;
     var toward = vec3<f32>(0.0, 1.0, 0.0);
@@ -67,7 +69,7 @@ fn draw(light: Record, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>) -> Drawn {
     let base = light.base.xyz;
     switch light.kind {
         case KIND_DOME: {
-            let s = sample_dome(n, u);
+            let s = sample_dome(light, n, u, keys);
             return drawn(s.xyz, s.w);
         }
         case KIND_DISTANT: {
@@ -185,7 +187,7 @@ fn sample_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let smp = bitcast<u32>(in_b[4u * i + 2u]);
     let seed = bitcast<u32>(in_b[4u * i + 3u]);
     let u = vec2<f32>(rng_uniform(seed, point, smp, 0u), rng_uniform(seed, point, smp, 1u));
-    let s = draw(light, x, n, u);
+    let s = draw(light, x, n, u, vec3<u32>(seed, point, smp));
     var l = s.l;
     if !s.has_l {
         l = select(vec3<f32>(0.0), radiance(light, x, s.dir), s.pdf > 0.0);
@@ -209,7 +211,7 @@ fn light_pdf(light: Record, x: vec3<f32>, n: vec3<f32>, w: vec3<f32>) -> f32 {
     let xl = to_local_point(light, x);
     switch light.kind {
         case KIND_DOME: {
-            return pdf_dome(n, w);
+            return pdf_dome(light, n, w);
         }
         case KIND_DISTANT: {
             let theta = light.axis.w;
@@ -317,7 +319,7 @@ fn sample_resident_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if c.x >= 0.0 {
         let light = lights[u32(c.x)];
         let u = vec2<f32>(rng_uniform(seed, key, j, 0u), rng_uniform(seed, key, j, 1u));
-        let s = draw(light, x, n, u);
+        let s = draw(light, x, n, u, vec3<u32>(seed, key, j));
         dir = s.dir;
         l = s.l;
         if !s.has_l {

@@ -10,7 +10,7 @@ use crate::resident::{Renderer, invalid_input, lights_with_ies, points, renderer
 
 use luxeval::testkit::Rng;
 use luxeval::wgpu;
-use luxeval::{Asset, Evaluator, Light, LuxError, SampleOptions, Selection, Texture};
+use luxeval::{Asset, Evaluator, Light, SampleOptions, Selection, Texture};
 
 /// Floats per output row: ω, pdf, L, light.
 const ROW: usize = 8;
@@ -246,19 +246,6 @@ fn resident_sampling_refusals_are_typed() {
             .unwrap_err(),
     );
     assert_eq!(what, "out");
-    // A textured dome is drawn on the host: refused by name.
-    let img = image::RgbImage::from_pixel(4, 2, image::Rgb([200, 100, 50]));
-    let mut bytes = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-    let texture = Texture::new(Asset::from_bytes("env.png", bytes.into_inner()));
-    let dome = Light::dome().with_path("/env").with_texture(texture);
-    let textured = eval.prepare(&[dome]).unwrap();
-    match textured.encode_sample(&mut enc, &pts, None, &out, n as u32, 1, &opts) {
-        Err(LuxError::NotOnDevice { light, query, .. }) => {
-            assert_eq!((light.as_str(), query.as_str()), ("/env", "sample"));
-        }
-        other => panic!("expected NotOnDevice, got {other:?}"),
-    }
     // A scene on the CPU reference has no device.
     let cpu = Evaluator::cpu().prepare(&[Light::sphere(0.5)]).unwrap();
     let (what, _) = invalid_input(
@@ -268,4 +255,50 @@ fn resident_sampling_refusals_are_typed() {
     assert_eq!(what, "backend");
     r.queue.submit([enc.finish()]);
     r.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+}
+
+/// A textured dome beside a sphere: the dome's rows come from its sampling tables on the device
+/// (uploaded on the first sampling call), as the host path's do.
+#[test]
+fn resident_samples_of_a_textured_dome_match_the_host_path() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let mut rng = Rng::new(29);
+    let img = image::RgbImage::from_fn(16, 8, |_, _| {
+        image::Rgb([0, 1, 2].map(|_| 64 + rng.below(192) as u8))
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    let dome = Light::dome()
+        .with_path("/env")
+        .with_texture(Texture::new(Asset::from_bytes(
+            "env.png",
+            bytes.into_inner(),
+        )));
+    let sphere = Light::sphere(0.3)
+        .with_path("/key")
+        .with_intensity(20.0)
+        .with_transform(glam::DMat4::from_translation(glam::DVec3::new(
+            0.0, 3.0, 0.0,
+        )));
+    let scene = eval.prepare(&[dome, sphere]).unwrap();
+    let pts = points(&mut rng, 48);
+    let nrm = unit_rows(&mut rng, 48);
+    for normals in [Some(&nrm[..]), None] {
+        let opts = SampleOptions {
+            seed: 5,
+            selection: Selection::Bound,
+            first_point: 0,
+        };
+        let host = scene.sample(&pts, normals, 16, &opts).unwrap();
+        let resident = resident_rows(&r, &scene, &pts, normals, 16, &opts);
+        let other = compare(
+            &format!("textured dome, normals {}", normals.is_some()),
+            &resident,
+            &host,
+            0.25,
+        );
+        assert_eq!(other, 0);
+        assert!(host.light.contains(&0), "the dome is drawn");
+    }
 }

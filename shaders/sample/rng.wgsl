@@ -4,8 +4,9 @@
 // Bit-identical to the CPU: the same wrapping u32 arithmetic (WGSL's u32 `*` and `+` wrap), and
 // the top 24 bits × 2⁻²⁴ are exact in f32, so both paths see the very same u.
 // GPU-only rng_uniform: `uniform` is a WGSL reserved word; this is rng::uniform.
-// uniform53 has no GPU twin: only a textured dome's texel pick uses it, and textured domes are
-//   sampled on the host (prepare::Prepared::sample_on_host).
+// uniform53 returns the 53 bits as two u32 words (the 32-bit hash, then the 21 bits of the next
+// round), not a float: f32 cannot hold them, and the texel pick (sample/env_table.wgsl's
+// cell53) uses them in exact integer arithmetic.
 
 fn pcg_hash(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
@@ -17,4 +18,10 @@ fn pcg_hash(v: u32) -> u32 {
 fn rng_uniform(seed: u32, point: u32, sample: u32, dim: u32) -> f32 {
     let h = pcg_hash(dim + pcg_hash(sample + pcg_hash(point + pcg_hash(seed))));
     return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// The 53-bit uniform's bits for the four keys: (h, l) with the uniform = (h·2²¹ + l)·2⁻⁵³.
+fn uniform53(seed: u32, point: u32, sample: u32, dim: u32) -> vec2<u32> {
+    let h = pcg_hash(dim + pcg_hash(sample + pcg_hash(point + pcg_hash(seed))));
+    return vec2<u32>(h, pcg_hash(h) >> 11u);
 }

@@ -42,7 +42,9 @@ struct Record {
     tex_inv0: vec4<f32>,
     tex_inv1: vec4<f32>,
     tex_inv2: vec4<f32>,
-    // Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0).
+    // Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0); in the
+    // sample and pdf kernels' copy a textured dome's z is its sampling table's offset (0: none;
+    // gpu::sample::SampleLights).
     tex: vec4<u32>,
     kind: u32,
     flags: u32,

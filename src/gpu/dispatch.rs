@@ -18,6 +18,11 @@ pub(crate) struct GpuLights {
     pub(super) buffer: wgpu::Buffer,
     pub(super) ies_atlas: wgpu::Buffer,
     pub(super) tex_atlas: wgpu::Buffer,
+    /// The records as uploaded and the texture atlas's length in f32 words: the sample and pdf
+    /// kernels' copy with textured domes' sampling tables appended starts from them
+    /// (`GpuContext::sample_lights`).
+    pub(super) records: Vec<Record>,
+    pub(super) tex_words: usize,
     count: usize,
     /// The optional kernel parts any of the lights needs (`Record::features`).
     features: Features,
@@ -156,7 +161,10 @@ impl GpuContext {
         let tex_atlas_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("texture atlas"),
             size: tex_bytes.max(4),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            // COPY_SRC: the sampling kernels' atlas starts as a device-side copy of this one.
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         // Each image straight to its offset: no concatenated host copy.
@@ -173,6 +181,8 @@ impl GpuContext {
             buffer,
             ies_atlas: ies_atlas_buffer,
             tex_atlas: tex_atlas_buffer,
+            records: records.to_vec(),
+            tex_words: tex_atlas.len(),
             count: records.len(),
             features: records
                 .iter()

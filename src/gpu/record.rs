@@ -103,7 +103,9 @@ pub struct Record {
     /// Textured dome (FLAG_DOME_TEXTURE): columns of `A_eff⁻¹` (world → dome, §6 D1); w: 0.
     /// Textured rect (FLAG_RECT_TEXTURE): `tex_inv[0]` is the texture's mean colour.
     pub tex_inv: [[f32; 4]; 3],
-    /// Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0).
+    /// Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0); in the
+    /// sample and pdf kernels' copy a textured dome's `tex[2]` is its sampling table's offset
+    /// (0: none; `gpu::sample::SampleLights`).
     pub tex: [u32; 4],
     pub kind: u32,
     pub flags: u32,

@@ -11,6 +11,7 @@ use crate::error::{LuxError, Result};
 
 use super::dispatch::{GpuLights, entry, params_block, params_entry, record_passes};
 use super::record::{Params, Record, SELECT_HAS_NORMALS, WORKGROUP_SIZE};
+use super::sample::SampleLights;
 use super::{GpuContext, Kernel};
 
 /// One caller buffer and the name errors give it ("directions", "points", "out", ...).
@@ -164,7 +165,16 @@ impl GpuContext {
         // Emission and intensity read no second input; bind the first again (read-only
         // aliasing is allowed).
         let bound = [(a, in_bytes), (b.unwrap_or(a), in_bytes), (out, out_bytes)];
-        self.record_resident(encoder, kernel, lights, &block, groups.len(), bound, grid)?;
+        self.record_resident(
+            encoder,
+            kernel,
+            lights,
+            None,
+            &block,
+            groups.len(),
+            bound,
+            grid,
+        )?;
         Ok(())
     }
 }
@@ -190,7 +200,9 @@ pub(crate) struct ResidentDraw {
 }
 
 impl GpuContext {
-    /// Records the GPU-resident sampler (`sample_resident_main`) into `encoder`: `draw.points`
+    /// Records the GPU-resident sampler (`sample_resident_main`) into `encoder`, with the
+    /// sampling kernels' records and atlas (`sampling`: textured domes' tables appended):
+    /// `draw.points`
     /// rows of `points` (and `normals`), `points × per_point` rows of [`SAMPLE_ROW_FLOATS`]
     /// floats into `out`, point-major. Validates the buffers as [`GpuContext::encode`] does.
     #[allow(clippy::too_many_arguments)]
@@ -198,6 +210,7 @@ impl GpuContext {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         lights: &GpuLights,
+        sampling: &SampleLights,
         n_lights: usize,
         points: Operand<'_>,
         normals: Option<Operand<'_>>,
@@ -300,6 +313,7 @@ impl GpuContext {
             encoder,
             Kernel::SampleResident,
             lights,
+            Some(sampling),
             &block,
             1,
             bound,
@@ -311,7 +325,8 @@ impl GpuContext {
 
 impl GpuContext {
     /// Records `kernel` over the caller's buffers (`bound`: binding 2, 3 and 4 with the bytes
-    /// each call reads or writes), one pass per Params block of `block` (`passes` of them at
+    /// each call reads or writes; the records and texture atlas of `sampling` where given, in
+    /// place of the scene's), one pass per Params block of `block` (`passes` of them at
     /// [`GpuContext::params_align`]). The Params buffer is this call's own, written at
     /// creation (nothing goes through the queue) and kept alive by the command buffer that
     /// uses it. The first call of a kernel builds its pipeline.
@@ -321,6 +336,7 @@ impl GpuContext {
         encoder: &mut wgpu::CommandEncoder,
         kernel: Kernel,
         lights: &GpuLights,
+        sampling: Option<&SampleLights>,
         block: &[u8],
         passes: usize,
         bound: [(Operand<'_>, u64); 3],
@@ -336,12 +352,16 @@ impl GpuContext {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
         let [(a, a_bytes), (b, b_bytes), (out, out_bytes)] = bound;
+        let (records, tex_atlas) = match sampling {
+            Some(s) => (&s.buffer, &s.tex_atlas),
+            None => (&lights.buffer, &lights.tex_atlas),
+        };
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("luxeval queries (resident)"),
             layout: &self.layout,
             entries: &[
                 params_entry(&params),
-                entry(1, &lights.buffer),
+                entry(1, records),
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: range(a, a_bytes),
@@ -355,7 +375,7 @@ impl GpuContext {
                     resource: range(out, out_bytes),
                 },
                 entry(5, &lights.ies_atlas),
-                entry(6, &lights.tex_atlas),
+                entry(6, tex_atlas),
             ],
         });
         // Buffers of another device, for one, fail here.

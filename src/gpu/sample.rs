@@ -4,9 +4,21 @@
 //! u from the same counter-based keys (S3), so a row gives the same direction on any chunking.
 
 use crate::error::{GpuFailure, LuxError, Result};
+use crate::prepare::env_table::EnvTable;
 
 use super::dispatch::{GpuLights, entry, params_block, params_entry, record_passes};
+use super::texture_atlas::env_table_words;
 use super::{GpuContext, Kernel};
+
+/// What the sample and pdf kernels bind at 1 and 6 in place of the scene's records and texture
+/// atlas: the same, plus each textured dome's sampling table appended to the atlas and its
+/// offset in the dome's record (`tex[2]`; 0 for a dome without a table, which samples as
+/// untextured, as the CPU's `EnvTable::new` = None does). Built on the first sampling call
+/// (the tables cost a pass over the texels), so scenes that are never sampled pay nothing.
+pub(crate) struct SampleLights {
+    pub(crate) buffer: wgpu::Buffer,
+    pub(crate) tex_atlas: wgpu::Buffer,
+}
 
 /// One row of the sample kernel's input.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -46,10 +58,86 @@ pub struct PdfRow {
 const OUT_FLOATS: usize = 7;
 
 impl GpuContext {
+    /// The records and atlas of [`SampleLights`] for `lights` and the lights' sampling tables
+    /// (`tables[k]` light k's, None for every light that is not a textured dome with one);
+    /// `Err(bytes)` where the textures and tables need `bytes`, over the device's storage
+    /// binding limit.
+    pub(crate) fn sample_lights(
+        &self,
+        lights: &GpuLights,
+        tables: &[Option<EnvTable>],
+    ) -> std::result::Result<SampleLights, u64> {
+        if tables.iter().all(Option::is_none) {
+            return Ok(SampleLights {
+                buffer: lights.buffer.clone(),
+                tex_atlas: lights.tex_atlas.clone(),
+            });
+        }
+        let mut records = lights.records.clone();
+        // Each table at the next multiple of 4 after the texture atlas.
+        let mut chunks: Vec<(usize, Vec<f32>)> = Vec::new();
+        let mut end = lights.tex_words;
+        for (record, table) in records.iter_mut().zip(tables) {
+            let Some(t) = table else { continue };
+            let base = end.next_multiple_of(4).max(4);
+            let words = u32::try_from(base)
+                .ok()
+                .filter(|b| (*b as usize) < u32::MAX as usize / 2)
+                .map(|b| env_table_words(t, b));
+            let Some(words) = words else {
+                return Err(base as u64 * 4);
+            };
+            end = base + words.len();
+            record.tex[2] = base as u32;
+            chunks.push((base, words));
+        }
+        let bytes = (end * 4) as u64;
+        if bytes > self.limits.max_storage_buffer_binding_size || end > u32::MAX as usize {
+            return Err(end as u64 * 4);
+        }
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lights (sampling)"),
+            size: std::mem::size_of_val(records.as_slice()) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        self.queue
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(&records));
+        let tex_atlas = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("texture atlas (sampling)"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        // The textures by a device-side copy (no second host copy of the texels).
+        let copy = (lights.tex_words * 4) as u64;
+        if copy > 0 {
+            let mut enc = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("texture atlas (sampling)"),
+                });
+            enc.copy_buffer_to_buffer(
+                &lights.tex_atlas,
+                0,
+                &tex_atlas,
+                0,
+                copy.next_multiple_of(4),
+            );
+            self.queue.submit([enc.finish()]);
+        }
+        for (base, words) in &chunks {
+            self.queue
+                .write_buffer(&tex_atlas, (*base * 4) as u64, bytemuck::cast_slice(words));
+        }
+        Ok(SampleLights { buffer, tex_atlas })
+    }
+
     /// Runs the sample kernel over `rows`, in chunks that fit the device's limits.
     pub(crate) fn run_sample(
         &self,
         lights: &GpuLights,
+        sampling: &SampleLights,
         rows: &[SampleRow],
     ) -> Result<Vec<SampleOut>> {
         let a: Vec<f32> = rows
@@ -60,7 +148,15 @@ impl GpuContext {
             .iter()
             .flat_map(|r| [r.light, r.point_key, r.sample_key, r.seed])
             .collect();
-        let values = self.run_rows(Kernel::Sample, lights, rows.len(), &a, &b, OUT_FLOATS)?;
+        let values = self.run_rows(
+            Kernel::Sample,
+            lights,
+            sampling,
+            rows.len(),
+            &a,
+            &b,
+            OUT_FLOATS,
+        )?;
         Ok(values
             .chunks_exact(OUT_FLOATS)
             .map(|v| SampleOut {
@@ -73,7 +169,12 @@ impl GpuContext {
     }
 
     /// Runs the pdf kernel over `rows`: each row's light's density of its direction.
-    pub(crate) fn run_pdf(&self, lights: &GpuLights, rows: &[PdfRow]) -> Result<Vec<f32>> {
+    pub(crate) fn run_pdf(
+        &self,
+        lights: &GpuLights,
+        sampling: &SampleLights,
+        rows: &[PdfRow],
+    ) -> Result<Vec<f32>> {
         let a: Vec<f32> = rows
             .iter()
             .flat_map(|r| r.point.into_iter().chain(r.normal))
@@ -89,15 +190,17 @@ impl GpuContext {
                 ]
             })
             .collect();
-        self.run_rows(Kernel::Pdf, lights, rows.len(), &a, &b, 1)
+        self.run_rows(Kernel::Pdf, lights, sampling, rows.len(), &a, &b, 1)
     }
 
     /// Runs `kernel` (sample or pdf) over `n` rows of 6 floats in `a` and 4 words in `b`,
     /// `out_floats` floats out per row, in chunks that fit the device's limits.
+    #[allow(clippy::too_many_arguments)]
     fn run_rows(
         &self,
         kernel: Kernel,
         lights: &GpuLights,
+        sampling: &SampleLights,
         n: usize,
         a: &[f32],
         b: &[u32],
@@ -145,12 +248,12 @@ impl GpuContext {
             layout: &self.layout,
             entries: &[
                 params_entry(&params),
-                entry(1, &lights.buffer),
+                entry(1, &sampling.buffer),
                 entry(2, &buf_a),
                 entry(3, &buf_b),
                 entry(4, &buf_out),
                 entry(5, &lights.ies_atlas),
-                entry(6, &lights.tex_atlas),
+                entry(6, &sampling.tex_atlas),
             ],
         });
         let mut result = Ok(());

@@ -101,6 +101,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/sample/area.wgsl"),
     ),
     (
+        "sample/env_table.wgsl",
+        include_str!("../../shaders/sample/env_table.wgsl"),
+    ),
+    (
         "sample/dome.wgsl",
         include_str!("../../shaders/sample/dome.wgsl"),
     ),
@@ -292,7 +296,10 @@ pub fn prelude() -> String {
     {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }
-    for (name, value) in rules::wgsl_f32_constants() {
+    for (name, value) in rules::wgsl_f32_constants()
+        .into_iter()
+        .chain(texture_atlas::wgsl_f32_constants())
+    {
         s.push_str(&format!("const {name}: f32 = {};\n", f32_literal(value)));
     }
     for (name, values) in rules::wgsl_f32_arrays()

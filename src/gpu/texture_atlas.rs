@@ -19,6 +19,7 @@
 use std::sync::Arc;
 
 use crate::prepare::Prepared;
+use crate::prepare::env_table::EnvTable;
 use crate::prepare::texture::{
     CROSS_FACES, FILTER_BILINEAR, FILTER_NEAREST, FORMAT_ANGULAR, FORMAT_CROSS, FORMAT_LATLONG,
     FORMAT_MIRRORED_BALL, FORMAT_RECT, Image,
@@ -128,7 +129,107 @@ pub fn wgsl_constants() -> Vec<(&'static str, u32)> {
         ("FILTER_NEAREST", FILTER_NEAREST),
         ("TEX_HEADER_WORDS", HEADER_WORDS as u32),
         ("CROSS_FACE_STRIDE", CROSS_FACE_STRIDE as u32),
+        ("ENV_HEADER_WORDS", ENV_HEADER_WORDS as u32),
+        ("ENV_TEXEL_WORDS", ENV_TEXEL_WORDS as u32),
+        ("ENV_TILE_WORDS", ENV_TILE_WORDS as u32),
+        ("ENV_INNER_WORDS", ENV_INNER_WORDS as u32),
+        ("ENV_NO_INNER", ENV_NO_INNER),
     ]
+}
+
+/// The `f32` constants the sampling kernels read, for the generated prelude: the receiver tiles'
+/// floor (`prepare::env_table::HORIZON_FLOOR`).
+pub fn wgsl_f32_constants() -> Vec<(&'static str, f64)> {
+    vec![("HORIZON_FLOOR", crate::prepare::env_table::HORIZON_FLOOR)]
+}
+
+/// Words of an environment table's header ([`env_table_words`]).
+pub const ENV_HEADER_WORDS: usize = 20;
+/// Words per texel of an environment table: keep threshold, alias, pmf.
+pub const ENV_TEXEL_WORDS: usize = 3;
+/// Words per tile: `W_t`, the cap's centre (3), `cos r`, `sin r`, its inner table's offset, 0.
+pub const ENV_TILE_WORDS: usize = 8;
+/// Words per texel of a tile's inner table: keep threshold, local alias.
+pub const ENV_INNER_WORDS: usize = 2;
+/// The inner-table offset of a tile of weight 0 (never drawn).
+pub const ENV_NO_INNER: u32 = u32::MAX;
+
+/// A textured dome's sampling table (`prepare::env_table::EnvTable`) as the sample and pdf
+/// kernels read it (`shaders/sample/env_table.wgsl`), to be placed at atlas offset `base` (a
+/// multiple of 4; the inner tables' offsets are absolute). u32 values are stored as their bit
+/// patterns. Layout, in f32 words from `base`:
+/// - header ([`ENV_HEADER_WORDS`]): width, height, format code, tile side, tiles per row, tile
+///   count (u32; 0 tiles for a table without them), `|det A|`, 0, then `A_eff`'s columns (dome →
+///   world, 9 floats), 0, 0, 0. The table's size is the file's even where the GPU holds the
+///   texture reduced (`scene_atlas`): the sampler is the reference's;
+/// - per texel k ([`ENV_TEXEL_WORDS`]): the alias cell's keep threshold
+///   (`AliasTable::keep_threshold`), its alias, `pmf(k)`;
+/// - per tile ([`ENV_TILE_WORDS`]): `W_t`, the cap's centre, `cos r`, `sin r`, the absolute
+///   offset of its inner table ([`ENV_NO_INNER`] for none), 0;
+/// - the tiles' inner tables in tile order, per local texel ([`ENV_INNER_WORDS`]): keep
+///   threshold, local alias. A texel's probability within its tile is `pmf(k) / W_t`, as the
+///   inner table was built from.
+pub fn env_table_words(t: &EnvTable, base: u32) -> Vec<f32> {
+    let n = t.width as usize * t.height as usize;
+    let tl = &t.tiles;
+    let tiles = tl.inner.len();
+    let bits = f32::from_bits;
+    let a = t.frame.a_eff;
+    let mut v: Vec<f32> = vec![
+        bits(t.width),
+        bits(t.height),
+        bits(t.format.code()),
+        bits(tl.side),
+        bits(tl.nx),
+        bits(tiles as u32),
+        t.frame.det_abs as f32,
+        0.0,
+    ];
+    v.extend(
+        [a.x_axis, a.y_axis, a.z_axis]
+            .iter()
+            .flat_map(|c| [c.x as f32, c.y as f32, c.z as f32]),
+    );
+    v.extend([0.0; 3]);
+    debug_assert_eq!(v.len(), ENV_HEADER_WORDS);
+    v.reserve(n * (ENV_TEXEL_WORDS + ENV_INNER_WORDS) + tiles * ENV_TILE_WORDS);
+    for k in 0..n {
+        v.extend([
+            bits(t.table.keep_threshold(k)),
+            bits(t.table.alias(k)),
+            t.table.pmf(k) as f32,
+        ]);
+    }
+    let mut inner_at = base as usize + v.len() + tiles * ENV_TILE_WORDS;
+    for (i, inner) in tl.inner.iter().enumerate() {
+        let (c, r) = tl.cap[i];
+        let (sin_r, cos_r) = r.sin_cos();
+        let at = match inner {
+            Some(inner) => {
+                let at = inner_at as u32;
+                inner_at += inner.len() * ENV_INNER_WORDS;
+                at
+            }
+            None => ENV_NO_INNER,
+        };
+        v.extend([
+            tl.weight[i] as f32,
+            c.x as f32,
+            c.y as f32,
+            c.z as f32,
+            cos_r as f32,
+            sin_r as f32,
+            bits(at),
+            0.0,
+        ]);
+    }
+    for inner in tl.inner.iter().flatten() {
+        for k in 0..inner.len() {
+            v.extend([bits(inner.keep_threshold(k)), bits(inner.alias(k))]);
+        }
+    }
+    debug_assert_eq!(base as usize + v.len(), inner_at);
+    v
 }
 
 /// Floats per face of [`CROSS_FACES`] in the generated `CROSS_FACE_TABLE`: F, R, U, block.

@@ -26,6 +26,9 @@ pub struct AliasTable {
 /// The largest f64 below 1 (a uniform in [0, 1) must stay below 1 after rescaling).
 const ONE_MINUS_EPS: f64 = 1.0 - f64::EPSILON / 2.0;
 
+/// 2⁵³: a 53-bit uniform's resolution.
+const TWO_53: f64 = 9_007_199_254_740_992.0;
+
 impl AliasTable {
     /// The table of `weights` (index i drawn with probability `w_i / Σw`). `None` when no
     /// weight is positive, or any is negative or not finite, or there are more than `u32::MAX`
@@ -86,7 +89,6 @@ impl AliasTable {
     }
 
     /// The number of indices.
-    #[cfg(test)]
     #[allow(clippy::len_without_is_empty)]
     pub fn len(&self) -> usize {
         self.pmf.len()
@@ -101,15 +103,36 @@ impl AliasTable {
     /// Index i with probability `pmf(i)` from two uniforms: `cell` picks the cell (give it 53
     /// bits for large tables, `cpu::sample::rng::uniform53`), `coin` keeps it or takes its
     /// alias.
+    ///
+    /// The cell is `⌊X·n / 2⁵³⌋` for `X = ⌊cell·2⁵³⌋` in exact integer arithmetic (not the
+    /// rounded product `cell·n`, which names the next cell when it rounds up to an integer), so
+    /// that the WGSL twin (`shaders/sample/dome.wgsl`), which holds the 53 bits as two u32
+    /// words, names the very same cell.
     #[inline]
     pub fn pick(&self, cell: f64, coin: f64) -> usize {
         let n = self.prob.len();
-        let i = ((cell.clamp(0.0, ONE_MINUS_EPS) * n as f64) as usize).min(n - 1);
+        let x = (cell.clamp(0.0, ONE_MINUS_EPS) * TWO_53) as u64;
+        let i = ((x as u128 * n as u128) >> 53) as usize;
         if coin < self.prob[i] {
             i
         } else {
             self.alias[i] as usize
         }
+    }
+
+    /// Cell i's keep-probability as the integer threshold `T = ⌈prob·2²⁴⌉`: for a coin that is
+    /// a multiple of 2⁻²⁴ (`cpu::sample::rng::uniform`), `coin < prob` exactly when
+    /// `coin·2²⁴ < T` (both sides integers), so the GPU compares integers and keeps the
+    /// cell exactly when the CPU does.
+    #[inline]
+    pub fn keep_threshold(&self, i: usize) -> u32 {
+        (self.prob[i] * 16_777_216.0).ceil() as u32
+    }
+
+    /// The index cell i gives when it does not keep its own.
+    #[inline]
+    pub fn alias(&self, i: usize) -> u32 {
+        self.alias[i]
     }
 
     /// The cells' keep-probabilities, aliases and pmf (f64 on the CPU).

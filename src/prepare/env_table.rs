@@ -52,7 +52,7 @@ use super::texture::{
 
 mod tiles;
 
-pub use tiles::{ReceiverTiles, Tiles};
+pub use tiles::{HORIZON_FLOOR, ReceiverTiles, Tiles};
 
 const PI: f64 = std::f64::consts::PI;
 
@@ -163,6 +163,24 @@ impl EnvTable {
         };
         let hm = (1.0 - m * m).max(0.0).sqrt();
         (a0.max(-hm), a1.min(hm))
+    }
+
+    /// How well f32 holds the density of disk texel k at chart point `q` (`f64::INFINITY` for
+    /// latlong and cross tables): the chord's length `c(a)` through the texel times
+    /// `h/|a|`, h = √(1 − a²) the rim's height at a, in chart units. The density is
+    /// `1 / (L_a · c(a))`, and where the rim bounds the chord, an error δa in a moves its end
+    /// by `|a|/h · δa`: the density's relative error is δa over this margin. Near the rim it
+    /// shrinks to 0 (the chord to 0, and the rim's slope to infinity at a = ±1).
+    #[cfg(any(test, feature = "testkit"))]
+    pub fn rim_margin(&self, k: usize, q: DVec2) -> f64 {
+        if !self.is_disk() {
+            return f64::INFINITY;
+        }
+        let r = self.disk_rect(k);
+        let (lo, hi) = Self::chord(r, q.x);
+        let h = (1.0 - q.x * q.x).max(0.0).sqrt();
+        let c = (hi - lo).max(0.0);
+        if q.x == 0.0 { c } else { c * h / q.x.abs() }
     }
 
     /// The chord of the disk at `a` within the texel's b-range.

@@ -202,13 +202,6 @@ impl Prepared {
         matches!(self.irradiance_path, IrradiancePath::Host(_))
     }
 
-    /// Whether light sampling takes this light on the host even on a GPU evaluator: a textured
-    /// dome, whose alias table and 53-bit texel pick stay with the CPU reference
-    /// (`cpu::sample::dome`); every other light has a WGSL sampler (shaders/sample.wgsl).
-    pub fn sample_on_host(&self) -> bool {
-        self.dome_texture().is_some()
-    }
-
     /// Validates `light` and computes its constants for `mode`.
     pub fn new(light: &Light, mode: TemperatureMode) -> Result<Self> {
         Self::with_assets(light, mode, &mut AssetCache::default())

@@ -234,9 +234,13 @@ impl PreparedScene {
     /// dispatch holds (the message gives the most one call takes; split the points and set
     /// `first_point`), more than 16,384 lights on a CPU driver such as lavapipe (whose loops
     /// stop after 65,535 iterations), and a scene on the CPU reference.
-    /// [`LuxError::NotOnDevice`] for a scene with a textured dome (its rows are drawn on the
-    /// host; use [`PreparedScene::sample`]). [`LuxError::Gpu`] as
-    /// [`PreparedScene::encode_emission`].
+    /// [`LuxError::Gpu`] as [`PreparedScene::encode_emission`].
+    ///
+    /// The first sampling call of a scene with a textured dome (here or on the host path)
+    /// builds its sampling tables and uploads them with the textures beside the scene's
+    /// (a queue write and a copy submitted on the device's queue, once); a scene whose
+    /// textures and tables exceed the device's storage binding limit is refused here
+    /// ([`LuxError::InvalidInput`]; the host path samples it on the CPU reference).
     ///
     /// [`Samples`]: super::sample::Samples
     #[allow(clippy::too_many_arguments)]
@@ -264,17 +268,33 @@ impl PreparedScene {
                 ));
             }
         };
-        if let Some(p) = self.lights.iter().find(|p| p.sample_on_host()) {
-            return Err(LuxError::NotOnDevice {
-                light: p.light.path.clone(),
-                query: "sample".into(),
-                reason: "a textured dome's directions are drawn on the host (its alias tables \
-                         are not on the device); use PreparedScene::sample"
-                    .into(),
-            });
-        }
+        // The scene's records and the sampling kernels' copy (textured domes' tables appended,
+        // uploaded on the first sampling call); a scene with no lights binds a placeholder.
         let mut placeholder = None;
-        let lights = self.device_lights(g, &mut placeholder)?;
+        let own;
+        let (lights, sampling) = match self.sampling_gpu() {
+            Some((_, lights, sampling)) => (lights, sampling),
+            None => {
+                if let Some(bytes) = self.sampling_tables_too_large() {
+                    return Err(LuxError::input(
+                        "dome textures",
+                        format!(
+                            "the scene's textures and textured domes' sampling tables need \
+                             {bytes} bytes, over this device's storage binding limit of {} \
+                             bytes; use PreparedScene::sample (it samples such a scene on the \
+                             CPU reference)",
+                            g.device_limits().max_storage_buffer_binding_size
+                        ),
+                    ));
+                }
+                let lights = self.device_lights(g, &mut placeholder)?;
+                // No tables: the scene's own buffers (never too large).
+                own = g.sample_lights(lights, &[]).map_err(|bytes| {
+                    LuxError::input("lights", format!("{bytes} bytes over the binding limit"))
+                })?;
+                (lights, &own)
+            }
+        };
         let points = Operand {
             name: "points",
             buffer: points,
@@ -297,6 +317,7 @@ impl PreparedScene {
         g.encode_sample(
             encoder,
             lights,
+            sampling,
             self.lights.len(),
             points,
             normals,

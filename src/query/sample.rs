@@ -4,11 +4,10 @@
 //! On a GPU evaluator `sample` chooses each row's light on the host (the CPU's `P(l | x)`, from
 //! the generator's dimension 2) and draws the direction, its density `pdf_l` and the radiance
 //! with the WGSL samplers (shaders/sample.wgsl, keyed by the same (seed, point, sample) as the
-//! CPU, dimensions 0 and 1), except for the lights [`Prepared::sample_on_host`] names (textured
-//! domes), whose rows come from the CPU reference. `pdf` likewise: `P(l | x)` on the host,
-//! each light's `pdf_l(ω)` on the device (shaders/sample.wgsl `pdf_main`) but for those lights.
-//!
-//! [`Prepared::sample_on_host`]: crate::prepare::Prepared::sample_on_host
+//! CPU). Every light is drawn on the device, textured domes included: their sampling tables
+//! (`prepare::env_table::EnvTable`, built on the first sampling call) go to the device with
+//! the texture atlas (`gpu::sample::SampleLights`). `pdf` likewise: `P(l | x)` on the host,
+//! each light's `pdf_l(ω)` on the device (shaders/sample.wgsl `pdf_main`).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -19,7 +18,7 @@ use crate::cpu::sample::{
     LightAt, SceneTables, choose, env_tables, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
-use crate::gpu::sample::{PdfRow, SampleRow};
+use crate::gpu::sample::{PdfRow, SampleLights, SampleRow};
 
 pub use crate::cpu::sample::Selection;
 pub use crate::cpu::sample::report::StrategyVariance;
@@ -111,13 +110,49 @@ impl Row {
 
 impl PreparedScene {
     /// Where `sample` draws directions and `pdf` evaluates densities: `"gpu"` on a GPU evaluator
-    /// with a light the WGSL samplers take (the host fills the rows of textured domes), else
-    /// `"cpu"`.
+    /// with lights, else `"cpu"` — also on a GPU whose storage binding limit cannot hold the
+    /// scene's textures with its textured domes' sampling tables (built by this call if no
+    /// sampling call has built them yet).
     pub fn sampling_device(&self) -> &'static str {
-        match self.backend {
-            Backend::Gpu(_) if self.lights.iter().any(|p| !p.sample_on_host()) => "gpu",
-            _ => "cpu",
+        match self.sampling_gpu() {
+            Some(_) => "gpu",
+            None => "cpu",
         }
+    }
+
+    /// The bytes the scene's textures and sampling tables would need on the device where they
+    /// exceed its storage binding limit (then sampling runs on the CPU reference); None
+    /// elsewhere.
+    pub(super) fn sampling_tables_too_large(&self) -> Option<u64> {
+        self.sampling_gpu();
+        self.sampling_gpu
+            .get()
+            .and_then(|r| r.as_ref().err().copied())
+    }
+
+    /// The device, the scene's lights on it and the sample kernels' records and atlas (textured
+    /// domes' sampling tables appended, built on the first call and kept); None on the CPU
+    /// reference, and where the textures and tables exceed the device's storage binding limit
+    /// (the rows are then the CPU reference's: a textured dome's tables must be whole to be
+    /// drawn from).
+    #[allow(clippy::type_complexity)]
+    pub(super) fn sampling_gpu(
+        &self,
+    ) -> Option<(
+        &crate::gpu::GpuContext,
+        &crate::gpu::dispatch::GpuLights,
+        &SampleLights,
+    )> {
+        let (Backend::Gpu(g), Some(lights)) = (&self.backend, &self.gpu) else {
+            return None;
+        };
+        let built = self.sampling_gpu.get_or_init(|| {
+            let env = self
+                .sampling_env
+                .get_or_init(|| std::sync::Arc::new(env_tables(&self.lights)));
+            g.sample_lights(lights, env)
+        });
+        built.as_ref().ok().map(|s| (&**g, lights, s))
     }
 
     /// The strategy light `k` is sampled with, in words (DESIGN.md §9 S2).
@@ -144,12 +179,8 @@ impl PreparedScene {
             ));
         }
         let tables = self.sampling_tables(opts.selection);
-        // The rows the GPU draws (a light it samples, on a GPU evaluator).
-        let gpu = match (&self.backend, &self.gpu) {
-            (Backend::Gpu(g), Some(lights)) => Some((g, lights)),
-            _ => None,
-        };
-        let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
+        // On a GPU evaluator the device draws every row.
+        let gpu = self.sampling_gpu();
         let rows: Vec<Vec<Row>> = points
             .par_iter()
             .enumerate()
@@ -172,12 +203,13 @@ impl PreparedScene {
                 (0..count)
                     .map(|j| {
                         // Dimensions (S3): 0, 1 the point on the light, 2 the light, 3 (53
-                        // bits) and 4 an environment map's texel, 5 and 6 its tile.
+                        // bits) and 4 an environment map's texel, 5 and 6 (48 bits together)
+                        // its tile.
                         let u = |d: u32| rng::uniform(opts.seed, key, j as u32, d);
                         let Some((k, pk)) = choose(&weights, total, u(2)) else {
                             return Row::done(n.unwrap_or(DVec3::Y), 0.0, DVec3::ZERO, 0.0, -1);
                         };
-                        if on_gpu(k) {
+                        if gpu.is_some() {
                             // Drawn on the device below.
                             return Row {
                                 pk,
@@ -203,13 +235,13 @@ impl PreparedScene {
             })
             .collect();
         let mut rows: Vec<Row> = rows.into_iter().flatten().collect();
-        if let Some((g, lights)) = gpu {
+        if let Some((g, lights, sampling)) = gpu {
             let (index, input): (Vec<usize>, Vec<SampleRow>) = rows
                 .iter()
                 .enumerate()
                 .filter_map(|(r, row)| row.gpu.map(|g| (r, g)))
                 .unzip();
-            let drawn = g.run_sample(lights, &input)?;
+            let drawn = g.run_sample(lights, sampling, &input)?;
             for (r, d) in index.into_iter().zip(drawn) {
                 let row = &mut rows[r];
                 row.dir = DVec3::from_array(d.dir.map(f64::from));
@@ -246,13 +278,9 @@ impl PreparedScene {
         check_pairs(points, "points", dirs, "directions")?;
         let tables = self.sampling_tables(selection);
         let l = self.lights.len();
-        let gpu = match (&self.backend, &self.gpu) {
-            (Backend::Gpu(g), Some(lights)) => Some((g, lights)),
-            _ => None,
-        };
-        let on_gpu = |k: usize| gpu.is_some() && !self.lights[k].sample_on_host();
-        // Per point: P(l | x) · pdf_l(ω) per light and the sum (row l), the GPU's lights left
-        // for the device with their P(l | x).
+        let gpu = self.sampling_gpu();
+        // Per point: P(l | x) · pdf_l(ω) per light and the sum (row l) on the CPU; on a GPU
+        // evaluator the lights' rows left for the device with their P(l | x).
         let mut rows: Vec<PointPdf> = points
             .par_iter()
             .enumerate()
@@ -277,35 +305,30 @@ impl PreparedScene {
                     return (per, device);
                 }
                 let total: f64 = weights.iter().sum();
-                for (k, p) in self.lights.iter().enumerate() {
-                    if !(total > 0.0 && weights[k] > 0.0) {
+                for (k, &wk) in weights.iter().enumerate() {
+                    if !(total > 0.0 && wk > 0.0) {
                         continue;
                     }
-                    let pk = weights[k] / total;
-                    if on_gpu(k) {
-                        device.push((
-                            k,
-                            pk,
-                            PdfRow {
-                                point: pt,
-                                normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
-                                light: k as u32,
-                                dir: w.as_vec3().to_array(),
-                            },
-                        ));
-                    } else {
-                        per[k] = pk * tables.light_at(k, p, x, n).pdf(p, x, w);
-                    }
+                    device.push((
+                        k,
+                        wk / total,
+                        PdfRow {
+                            point: pt,
+                            normal: n.map_or([0.0; 3], |n| n.as_vec3().to_array()),
+                            light: k as u32,
+                            dir: w.as_vec3().to_array(),
+                        },
+                    ));
                 }
                 (per, device)
             })
             .collect();
-        if let Some((g, lights)) = gpu {
+        if let Some((g, lights, sampling)) = gpu {
             let input: Vec<PdfRow> = rows
                 .iter()
                 .flat_map(|(_, d)| d.iter().map(|r| r.2))
                 .collect();
-            let mut values = g.run_pdf(lights, &input)?.into_iter();
+            let mut values = g.run_pdf(lights, sampling, &input)?.into_iter();
             for (per, device) in &mut rows {
                 for &(k, pk, _) in device.iter() {
                     per[k] = pk * values.next().unwrap_or(0.0) as f64;

@@ -35,6 +35,11 @@ pub struct PreparedScene {
     pub(super) sampling_env:
         std::sync::OnceLock<std::sync::Arc<Vec<Option<crate::prepare::env_table::EnvTable>>>>,
     pub(super) sampling_tables: [std::sync::OnceLock<crate::cpu::sample::SceneTables>; 3],
+    /// On a GPU, the sample and pdf kernels' records and texture atlas with the textured domes'
+    /// sampling tables appended (`gpu::sample::SampleLights`), built on first use; or the bytes
+    /// they would need, over the device's storage binding limit.
+    pub(super) sampling_gpu:
+        std::sync::OnceLock<std::result::Result<crate::gpu::sample::SampleLights, u64>>,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -107,6 +112,7 @@ impl PreparedScene {
             rule: Adaptive::REFERENCE,
             sampling_env: Default::default(),
             sampling_tables: Default::default(),
+            sampling_gpu: Default::default(),
         })
     }
 

@@ -26,11 +26,18 @@ pub use crate::cpu::sample::rng::{pcg_hash, uniform};
 ///   (the silhouette, where the density `∝ 1/cos` is unbounded), and the receiver's height
 ///   over its surface, `(ρ − r)/ρ` scaled by [`SURFACE_SCALE`];
 /// - a rect or disk: the receiver's elevation over the light's plane (its sine, seen from the
-///   light's centre) scaled by [`SURFACE_SCALE`].
+///   light's centre) scaled by [`SURFACE_SCALE`];
+/// - a textured dome: the draw's distance from its texel's edge in the texel's chart,
+///   `min(u[0], 1 − u[0], u[1], 1 − u[1])` (the density jumps from texel to texel).
 pub fn sampler_margin(r: &Reference, x: [f32; 3], n: Option<[f32; 3]>, u: [f64; 2]) -> f64 {
     let p = &r.p;
     let x = dvec(x);
     let n = n.map(|n| dvec(n).normalize());
+    if p.dome_texture().is_some() {
+        // The point within the drawn texel's chart comes from u: this close to a texel edge the
+        // f32 direction's lookup may name the neighbouring texel, whose density differs.
+        return u[0].min(1.0 - u[0]).min(u[1]).min(1.0 - u[1]);
+    }
     let at = LightAt::new(p, None, x, n);
     if at.is_delta() {
         return f64::INFINITY;
@@ -107,4 +114,27 @@ fn radius(p: &crate::prepare::Prepared) -> f64 {
 pub fn angle(a: DVec3, b: DVec3) -> f64 {
     let (a, b) = (a.normalize(), b.normalize());
     a.cross(b).length().atan2(a.dot(b))
+}
+
+/// For a textured dome of a disk format (mirroredBall, angular): how well f32 holds the density
+/// at the chart point of world direction `w` (`EnvTable::rim_margin`, chart units: the chord
+/// through the texel times the rim's `h/|a|`); `f64::INFINITY` for every other light. The
+/// density's relative error on the GPU is the f32 chart coordinate's error (~1e-7) over it.
+pub fn rim_margin(r: &Reference, w: [f32; 3]) -> f64 {
+    let Some(t) =
+        r.p.dome_texture()
+            .and_then(crate::prepare::env_table::EnvTable::new)
+    else {
+        return f64::INFINITY;
+    };
+    let v = t.frame.inv * dvec(w).normalize();
+    let (k, q) = crate::cpu::sample::dome::locate(&t, v.normalize());
+    t.rim_margin(k, q)
+}
+
+/// The radiance conformance's comparison floor for the light along world direction `w`
+/// ([`crate::conformance::band::texture_floor`]: for a textured dome, the largest texel the
+/// lookup may blend there; 0 for other lights).
+pub fn radiance_floor(r: &Reference, w: [f32; 3]) -> f64 {
+    crate::conformance::band::texture_floor(&r.p, dvec(w))
 }

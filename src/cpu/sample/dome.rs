@@ -86,14 +86,14 @@ pub fn sample_dome(
     }
 }
 
-/// The texel drawn by u[2] (53 bits), u[3] — within the tile u[4], u[5] draw by the
-/// receiver's product where `rt` is given (the plain table's otherwise, or for a tile of
-/// weight 0, which the product never draws).
+/// The texel drawn by u[2] (53 bits), u[3] — within the tile u[4] + u[5]·2⁻²⁴ draws from the
+/// receiver's product where `rt` is given ([`ReceiverTiles::pick`]; the plain table's
+/// otherwise, or for a tile of weight 0, which the product never draws).
 #[inline]
 fn pick_texel(t: &EnvTable, rt: Option<&ReceiverTiles>, u: &[f64; 6]) -> usize {
     match rt {
         Some(rt) if !t.tiles.inner.is_empty() => {
-            let tile = rt.alias.pick(u[4], u[5]);
+            let tile = rt.pick(u[4], u[5]);
             match &t.tiles.inner[tile] {
                 Some(inner) => t.texel_of(tile, inner.pick(u[2], u[3])),
                 None => t.table.pick(u[2], u[3]),
@@ -111,7 +111,7 @@ fn texel_pmf(t: &EnvTable, rt: Option<&ReceiverTiles>, k: usize) -> f64 {
         Some(rt) if !t.tiles.inner.is_empty() => {
             let (tile, local) = t.tile_of(k);
             match &t.tiles.inner[tile] {
-                Some(inner) => rt.alias.pmf(tile) * inner.pmf(local),
+                Some(inner) => rt.pmf(tile) * inner.pmf(local),
                 None => 0.0,
             }
         }
@@ -169,7 +169,7 @@ fn density(t: &EnvTable, rt: Option<&ReceiverTiles>, k: usize, q: DVec2, d: DVec
 /// `cpu::texture`) and §6 D1's texel rule: texel `(⌊px⌋, ⌊py⌋)` with latlong columns wrapped,
 /// everything else clamped (for the cross within the face's block).
 #[inline]
-fn locate(t: &EnvTable, d: DVec3) -> (usize, DVec2) {
+pub(crate) fn locate(t: &EnvTable, d: DVec3) -> (usize, DVec2) {
     let (w, h) = (t.width as f64, t.height as f64);
     let texel = |x: f64, y: f64, wrap: bool| -> usize {
         let i = if wrap {

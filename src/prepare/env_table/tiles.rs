@@ -14,7 +14,7 @@ use crate::prepare::texture::DomeFormat;
 const PI: f64 = std::f64::consts::PI;
 
 /// Square tiles of `side` texels (the last row and column may be narrower; for a cross `side`
-/// divides the face size, so a tile never straddles faces), about 1024 of them: each with the
+/// divides the face size, so a tile never straddles faces), about 4096 of them: each with the
 /// sum of its texels' probabilities, a cap of world directions holding its image, and an alias
 /// table over its texels.
 #[derive(Clone, Debug, Default)]
@@ -31,10 +31,56 @@ pub struct Tiles {
     pub inner: Vec<Option<AliasTable>>,
 }
 
-/// A receiver's tile probabilities: `P(t | n) ∝ W_t · max(cos_bound_t(n), FLOOR)`.
+/// A receiver's tile probabilities: `P(t | n) = q_t / Σq`, `q_t` the weight
+/// `W_t · max(cos_bound_t(n), FLOOR)` in 48-bit fixed point (`⌊w·2⁴⁸⌋`), drawn by inverting
+/// the running sum of the `q_t` in exact integer arithmetic. Not an alias table: the GPU twin
+/// recomputes the weights per receiver in a loop over the tiles, where a Vose construction
+/// does not fit; and integers, so that both backends' running sums and totals are exact and
+/// they differ only by their weights' own rounding (f32 vs f64), not by a rounded sum of
+/// thousands of terms (whose ~1e-6 would move every boundary of the running sum).
 #[derive(Clone, Debug)]
 pub struct ReceiverTiles {
-    pub alias: AliasTable,
+    /// The running sum of the `q_t` in tile order (its last entry is the total).
+    cdf: Vec<u64>,
+}
+
+/// 2⁴⁸, the tile weights' fixed point.
+const FIXED: f64 = 281_474_976_710_656.0;
+
+impl ReceiverTiles {
+    /// The receiver's tile probabilities for `weights` (each in [0, 1]); `None` where none is
+    /// positive in 48-bit fixed point.
+    fn new(weights: impl Iterator<Item = f64>) -> Option<ReceiverTiles> {
+        let mut sum = 0u64;
+        let cdf: Vec<u64> = weights
+            .map(|w| {
+                sum += (w.clamp(0.0, 1.0) * FIXED).floor() as u64;
+                sum
+            })
+            .collect();
+        (sum > 0).then_some(ReceiverTiles { cdf })
+    }
+
+    /// `P(t | n)`.
+    #[inline]
+    pub fn pmf(&self, t: usize) -> f64 {
+        let below = if t == 0 { 0 } else { self.cdf[t - 1] };
+        (self.cdf[t] - below) as f64 / self.cdf[self.cdf.len() - 1] as f64
+    }
+
+    /// The tile drawn by two 24-bit uniforms `hi`, `lo` (48 bits, `U = ⌊hi·2²⁴⌋·2²⁴ +
+    /// ⌊lo·2²⁴⌋`: a tile of probability 10⁻⁸ under the horizon floor is still drawn in
+    /// proportion): the first tile whose running sum exceeds `⌊U·total / 2⁴⁸⌋`; a tile of
+    /// weight 0 never (its sum equals its predecessor's).
+    #[inline]
+    pub fn pick(&self, hi: f64, lo: f64) -> usize {
+        let digit = |v: f64| ((v * 16_777_216.0) as u64).min(0xFF_FFFF);
+        let u = (digit(hi) << 24) | digit(lo);
+        let total = self.cdf[self.cdf.len() - 1];
+        let target = ((u as u128 * total as u128) >> 48) as u64;
+        // target < total (u < 2⁴⁸), so some running sum exceeds it.
+        self.cdf.partition_point(|&c| c <= target)
+    }
 }
 
 /// The least factor a tile's weight keeps below the receiver's horizon: a tile whose cap bound
@@ -43,8 +89,30 @@ pub struct ReceiverTiles {
 /// cosine-weighted weight above (≈ 2·10⁻⁴ for an even map).
 pub const HORIZON_FLOOR: f64 = 1e-4;
 
+/// The most tiles a table keeps: the GPU twin walks every tile twice per draw (the total, then
+/// the pick), and lavapipe ends an invocation's loops silently after 65,535 iterations in
+/// all. Only a map whose tile grid would be larger (a cross whose face size has no divisor near
+/// the target side, e.g. a prime; an extreme aspect ratio) has none: its receivers draw from
+/// the plain table, as without a normal.
+pub const MAX_TILES: u32 = 16_384;
+
+/// The largest cosine a cap of centre `c` and angular radius `r` (given as `cos r`, `sin r`)
+/// can have with the unit normal n: 1 when n lies in the cap (`θ ≤ r`, θ = angle(n, c)), else
+/// `cos(θ − r) = cos θ cos r + sin θ sin r` where that is positive, else 0 — written without
+/// acos so that the f32 twin keeps its accuracy (f32 acos loses ~1e-4 rad near ±1; `sin θ =
+/// |n × c|` keeps its relative precision).
+#[inline]
+pub fn cos_bound(n: DVec3, c: DVec3, cos_r: f64, sin_r: f64) -> f64 {
+    let cos_t = n.dot(c).clamp(-1.0, 1.0);
+    if cos_t >= cos_r {
+        return 1.0;
+    }
+    let sin_t = n.cross(c).length().min(1.0);
+    (cos_t * cos_r + sin_t * sin_r).max(0.0)
+}
+
 impl EnvTable {
-    /// The tile side: about 1024 tiles (a receiver's table is one pass over them); for a cross, the largest divisor of the face size N not
+    /// The tile side: about 4096 tiles (a receiver's table is one pass over them); for a cross, the largest divisor of the face size N not
     /// above that.
     fn tile_side(&self) -> u32 {
         let target = ((self.width as f64 * self.height as f64 / 4096.0)
@@ -99,6 +167,9 @@ impl EnvTable {
     pub(super) fn build_tiles(&self) -> Tiles {
         let side = self.tile_side();
         let (nx, ny) = (self.width.div_ceil(side), self.height.div_ceil(side));
+        if nx as u64 * ny as u64 > MAX_TILES as u64 {
+            return Tiles::default();
+        }
         let per_tile: Vec<(f64, (DVec3, f64), Option<AliasTable>)> = (0..(nx * ny) as usize)
             .into_par_iter()
             .map(|t| {
@@ -159,25 +230,20 @@ impl EnvTable {
     }
 
     /// The tile probabilities for a receiver with unit world normal `n`: `W_t` times the
-    /// largest cosine the tile's cap can have with n (0 for a cap wholly below the horizon),
-    /// floored at [`HORIZON_FLOOR`] (module docs).
+    /// largest cosine the tile's cap can have with n ([`cos_bound`], 0 for a cap wholly below
+    /// the horizon), floored at [`HORIZON_FLOOR`] (module docs). `None` for a table without
+    /// tiles ([`MAX_TILES`]).
     pub fn receiver_tiles(&self, n: DVec3) -> Option<ReceiverTiles> {
-        let w: Vec<f64> = self
-            .tiles
-            .weight
-            .iter()
-            .zip(&self.tiles.cap)
-            .map(|(&wt, &(c, r))| {
-                let theta = n.dot(c).clamp(-1.0, 1.0).acos();
-                let cos = if theta - r < PI / 2.0 {
-                    (theta - r).max(0.0).cos()
-                } else {
-                    0.0
-                };
-                wt * cos.max(HORIZON_FLOOR)
-            })
-            .collect();
-        AliasTable::new(&w).map(|alias| ReceiverTiles { alias })
+        ReceiverTiles::new(
+            self.tiles
+                .weight
+                .iter()
+                .zip(&self.tiles.cap)
+                .map(|(&wt, &(c, r))| {
+                    let (sin_r, cos_r) = r.sin_cos();
+                    wt * cos_bound(n, c, cos_r, sin_r).max(HORIZON_FLOOR)
+                }),
+        )
     }
 }
 
@@ -243,7 +309,7 @@ mod tests {
                     let (c, r) = tl.cap[i];
                     n.dot(c).clamp(-1.0, 1.0).acos() - r >= PI / 2.0
                 })
-                .map(|i| rt.alias.pmf(i))
+                .map(|i| rt.pmf(i))
                 .sum();
             // Tiles below the horizon keep only the floor: a fraction ≤ 1e-3 of the draws here.
             assert!(
