@@ -162,7 +162,7 @@ class Stage:
         ``normals`` (N, 3) or None (needed by ``selection="exact"``); ``seed`` 0 to 2**32 - 1;
         ``first_point``: the row of ``points[0]`` in a larger input (a slice draws what the
         whole would). ``device`` as ``emission`` (on a GPU the light is chosen on the host, the
-        direction drawn by the WGSL samplers; a textured dome's rows are the CPU reference's)."""
+        direction drawn by the WGSL samplers, textured domes' included)."""
     def pdf(
         self,
         points: npt.ArrayLike,

@@ -125,8 +125,7 @@ impl Stage {
     }
 
     /// The options of `sample` and `pdf`, checked as every query's (sampling runs where
-    /// `device` says, as the other queries; a textured dome's rows are the CPU reference's on
-    /// every device).
+    /// `device` says, as the other queries).
     fn sampling_options(
         &self,
         _py: Python<'_>,
