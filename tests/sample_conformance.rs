@@ -22,14 +22,15 @@
 //!   within [`RECT_EDGE`] (tests/rect_conformance.rs's band), and rows where the reference's own
 //!   radiance along the GPU's direction differs from that along the CPU's by more than half the
 //!   tolerance (the radiance is too steep there for two directions ~1e-6 rad apart);
-//! A textured dome's radiance is compared against the largest texel its lookup blends (the
-//! radiance conformance's floor, `check::texture_floor`).
 //! - of the density, for the pdf query only: rows where the reference's pdf query along the
 //!   direction turned by [`PERTURB`] rad (two ways; the GPU's effective direction error: the
 //!   f32 direction, the world → local map and the receiver's local position) moves by more than
 //!   half the tolerance. A disk's or cylinder's density follows the hit point, `∝ d²/cos θ_l`,
 //!   which is steep toward the silhouette (for a cylinder 20 radii away, 1e-4 per 3e-7 rad over
 //!   the outer tenth of the visible band).
+//!
+//! A textured dome's radiance is compared against the largest texel its lookup blends (the
+//! radiance conformance's floor, `check::texture_floor`).
 
 use crate::common;
 

@@ -106,19 +106,7 @@ impl GpuContext {
             let Some(op) = op else { continue };
             check_buffer(op, wgpu::BufferUsages::STORAGE, n, TRIPLE)?;
         }
-        for op in [Some(a), b].into_iter().flatten() {
-            // A buffer bound both read-only and read-write in one pass is a wgpu usage conflict
-            // that would only surface when the caller finishes the encoder.
-            if op.buffer == out.buffer {
-                return Err(LuxError::input(
-                    out.name,
-                    format!(
-                        "the output buffer is also the {} buffer; use distinct buffers",
-                        op.name
-                    ),
-                ));
-            }
-        }
+        check_distinct([Some(a), b], out)?;
         // The kernels index the output as f32 with u32 arithmetic (3 · row + 2), and each
         // binding must fit the device's storage binding limit.
         let per_call = limit.min(4 * u32::MAX as u64) / (ROW_BYTES * rows.max(1));
@@ -245,17 +233,7 @@ impl GpuContext {
             let Some(op) = op else { continue };
             check_buffer(op, wgpu::BufferUsages::STORAGE, n, row)?;
         }
-        for op in [Some(points), normals].into_iter().flatten() {
-            if op.buffer == out.buffer {
-                return Err(LuxError::input(
-                    out.name,
-                    format!(
-                        "the output buffer is also the {} buffer; use distinct buffers",
-                        op.name
-                    ),
-                ));
-            }
-        }
+        check_distinct([Some(points), normals], out)?;
         // The kernel indexes the output as f32 with u32 arithmetic (8 · row + 7), and each
         // binding must fit the device's storage binding limit.
         let limit = self.limits.max_storage_buffer_binding_size;
@@ -389,6 +367,23 @@ impl GpuContext {
         record_passes(encoder, kernel, &pipeline, &bind_group, passes, align, grid);
         Ok(())
     }
+}
+
+/// The output is none of the inputs: a buffer bound both read-only and read-write in one pass
+/// is a wgpu usage conflict that would only surface when the caller finishes the encoder.
+fn check_distinct(inputs: [Option<Operand<'_>>; 2], out: Operand<'_>) -> Result<()> {
+    for op in inputs.into_iter().flatten() {
+        if op.buffer == out.buffer {
+            return Err(LuxError::input(
+                out.name,
+                format!(
+                    "the output buffer is also the {} buffer; use distinct buffers",
+                    op.name
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The buffer has `usage` and holds at least `rows` rows of `row`: (bytes, layout in words).
