@@ -79,8 +79,9 @@ pub use gpu::{AdapterSummary, CacheStatus, DeviceLimits, Startup, adapters};
 pub use input::{BadRow, RowKind, RowProblem};
 pub use limits::Limits;
 pub use model::{
-    Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter,
-    TextureFormat, UpAxis, Value, schema,
+    Asset, Ies, Input, Light, LightInputs, LightType, MeshGeometry, MeshLight, MeshTopology,
+    MeshTriangle, PoleAxis, Portal, Shaping, Texture, TextureFilter, TextureFormat, Tint,
+    TopologyError, UpAxis, Value, schema,
 };
 pub use prepare::TemperatureMode;
 pub use prepare::ies::{
