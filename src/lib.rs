@@ -89,7 +89,7 @@ pub use prepare::ies::{
     Spread as IesSpread, VFold as IesVFold,
 };
 #[cfg(feature = "usd")]
-pub use query::lights_json;
+pub use query::{lights_json, portal_multiplier};
 pub use query::{
     Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, SamplerCheck, Samples,
     Selection, StrategyVariance,
@@ -98,6 +98,7 @@ pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]
 pub use usd::{
     LightList, LinkCollection, RefusedInput, Stage, StageInfo, StageLight, TimeRule, UsdStage,
+    cage_only,
 };
 /// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
 /// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that

@@ -33,6 +33,6 @@ mod values;
 mod xform;
 
 pub use light::RefusedInput;
-pub use scene::{Stage, StageLight, TimeRule};
+pub use scene::{Stage, StageLight, TimeRule, cage_only};
 pub use stage::{StageInfo, UsdStage};
 pub use unapplied::{LightList, LinkCollection};

@@ -481,7 +481,7 @@ fn attach_portals(lights: &mut [StageLight]) {
             add_warning(
                 &mut l.warning,
                 format!(
-                    "{dome}: portals names {}, not a PortalLight of the stage: changes nothing                      (DESIGN.md §8 P1)",
+                    "{dome}: portals names {}, not a PortalLight of the stage: changes nothing (DESIGN.md §8 P1)",
                     not_portals.join(", ")
                 ),
             );
@@ -492,7 +492,7 @@ fn attach_portals(lights: &mut [StageLight]) {
             && p.domes.is_empty()
         {
             let w = format!(
-                "{}: no dome's portals relationship names this portal: it changes nothing                  (DESIGN.md §8 P1)",
+                "{}: no dome's portals relationship names this portal: it changes nothing (DESIGN.md §8 P1)",
                 l.path
             );
             add_warning(&mut l.warning, w);
@@ -522,7 +522,7 @@ impl StageLight {
             // Read, and skipped by every query until they are evaluated: said on every query.
             Ok((Read::Mesh(m), caveat)) => {
                 let read = format!(
-                    "{}: mesh light read ({} triangles, area {}), not evaluated yet: skipped",
+                    "{}: mesh light ({} triangles, area {}) read, not evaluated yet: skipped",
                     p.path,
                     m.geometry.triangles.len(),
                     m.geometry.area
