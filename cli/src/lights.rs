@@ -124,13 +124,8 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
                 m.double_sided
             );
             let [r, gr, b] = m.tint.rgb.to_array();
+            // The subdivision note is the light's warning (once per prim, M1).
             put!("  tint  ({r}, {gr}, {b}) from {}", m.tint.source);
-            if luxeval::cage_only(&m.subdivision_scheme) {
-                put!(
-                    "  subdivisionScheme {:?}: not applied, the control cage is evaluated as polygons",
-                    m.subdivision_scheme
-                );
-            }
         }
         // DESIGN.md §8 P1, P2.
         if let Some(p) = &l.portal {
