@@ -88,12 +88,12 @@ pub use prepare::ies::{
     FluxCheck, HFold as IesHFold, Peak as IesPeak, Plane as IesPlane, Profile as IesProfile,
     Spread as IesSpread, VFold as IesVFold,
 };
-#[cfg(feature = "usd")]
-pub use query::{lights_json, portal_multiplier};
 pub use query::{
     Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, SamplerCheck, Samples,
     Selection, StrategyVariance,
 };
+#[cfg(feature = "usd")]
+pub use query::{lights_json, portal_multiplier};
 pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]
 pub use usd::{

@@ -949,7 +949,10 @@ fn mesh_lights_and_portals_match_usd_core() {
                 other => panic!("unknown tint kind {other}"),
             };
             if !m.tint.source.starts_with(prefix) {
-                bad(format!("{p}: tint source {:?}, want {prefix}…", m.tint.source));
+                bad(format!(
+                    "{p}: tint source {:?}, want {prefix}…",
+                    m.tint.source
+                ));
             }
             if m.double_sided != e["double_sided"].as_bool().unwrap() {
                 bad(format!("{p}: doubleSided {}", m.double_sided));
@@ -1014,13 +1017,19 @@ fn mesh_lights_and_portals_match_usd_core() {
                 .iter()
                 .map(|d| d.as_str().unwrap())
                 .collect();
-            if l.portals.as_deref().map(|v| v.iter().map(String::as_str).collect::<Vec<_>>())
+            if l.portals
+                .as_deref()
+                .map(|v| v.iter().map(String::as_str).collect::<Vec<_>>())
                 != Some(targets.clone())
             {
                 bad(format!("{p}: portals {:?} vs {targets:?}", l.portals));
             }
             // The dome's own portals that are PortalLights, in the relationship's order.
-            let portals: Vec<&str> = scene.portals_of(p).iter().map(|p| p.path.as_str()).collect();
+            let portals: Vec<&str> = scene
+                .portals_of(p)
+                .iter()
+                .map(|p| p.path.as_str())
+                .collect();
             let named: Vec<&str> = targets
                 .iter()
                 .copied()
@@ -1044,7 +1053,8 @@ fn mesh_lights_and_portals_match_usd_core() {
             .count();
         assert_eq!(
             skipped,
-            sample["meshes"].as_array().unwrap().len() + sample["portals"].as_array().unwrap().len(),
+            sample["meshes"].as_array().unwrap().len()
+                + sample["portals"].as_array().unwrap().len(),
             "{ctx}: {warnings:#?}"
         );
         // A dome's target that is not a PortalLight is said on the dome.
@@ -1074,11 +1084,17 @@ fn bad_mesh_topology_is_refused_naming_the_attribute() {
         let scene = Stage::load(&path, None).unwrap_or_else(|e| panic!("{name}: {e}"));
         let l = &scene.lights[0];
         assert!(l.mesh.is_none() && l.light.is_none(), "{name}");
-        assert!(l.warning.as_deref().unwrap().contains(attr), "{name}: {:?}", l.warning);
+        assert!(
+            l.warning.as_deref().unwrap().contains(attr),
+            "{name}: {:?}",
+            l.warning
+        );
         let e = scene.evaluable(&[]).unwrap_err();
         let text = e.to_string();
         assert!(
-            matches!(e, LuxError::InvalidAttribute { .. }) && text.contains("/Bad") && text.contains(attr),
+            matches!(e, LuxError::InvalidAttribute { .. })
+                && text.contains("/Bad")
+                && text.contains(attr),
             "{name}: {text}"
         );
     }

@@ -334,7 +334,10 @@ fn lights_lists_mesh_lights_and_portals() {
             let t = m["tint"][k].as_f64().unwrap();
             assert!((t - e["tint"][k].as_f64().unwrap()).abs() <= 1e-6, "{l}");
         }
-        assert!(m["tint_source"].as_str().is_some_and(|s| !s.is_empty()), "{l}");
+        assert!(
+            m["tint_source"].as_str().is_some_and(|s| !s.is_empty()),
+            "{l}"
+        );
     }
     for e in earliest["portals"].as_array().unwrap() {
         let l = record(e["path"].as_str().unwrap());
@@ -369,7 +372,10 @@ fn lights_lists_mesh_lights_and_portals() {
     }
 
     // Bad topology: listed with the attribute named, refused by the queries.
-    let o = luxeval(&["lights", &repo_file("tests/data/usd/mesh/bad/count_below_3.usda")]);
+    let o = luxeval(&[
+        "lights",
+        &repo_file("tests/data/usd/mesh/bad/count_below_3.usda"),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(

@@ -22,7 +22,9 @@ pub struct MeshTriangle {
 impl MeshTriangle {
     /// The triangle's world-space area.
     pub fn area(&self) -> f64 {
-        0.5 * (self.p[1] - self.p[0]).cross(self.p[2] - self.p[0]).length()
+        0.5 * (self.p[1] - self.p[0])
+            .cross(self.p[2] - self.p[0])
+            .length()
     }
 }
 
@@ -177,10 +179,7 @@ fn hole_mask(t: &MeshTopology) -> Result<Vec<bool>, TopologyError> {
                 return Err(TopologyError {
                     attr: "holeIndices",
                     value: format!("[{i}] = {h}"),
-                    reason: format!(
-                        "not an index of the {} faces",
-                        t.face_vertex_counts.len()
-                    ),
+                    reason: format!("not an index of the {} faces", t.face_vertex_counts.len()),
                 });
             }
         }

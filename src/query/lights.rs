@@ -20,8 +20,9 @@ pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
         for (json, l) in records.iter_mut().zip(&scene.lights) {
             json["power"] = serde_json::Value::Null;
             if let Some(p) = &l.portal {
-                json["portal"]["multiplier"] =
-                    serde_json::to_value(portal_multiplier(p, TemperatureMode::default()).to_array())?;
+                json["portal"]["multiplier"] = serde_json::to_value(
+                    portal_multiplier(p, TemperatureMode::default()).to_array(),
+                )?;
             }
             let Some(light) = &l.light else { continue };
             match Reference::new(light, TemperatureMode::default()) {

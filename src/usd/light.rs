@@ -183,9 +183,7 @@ fn portal(r: &Reader) -> std::result::Result<(Portal, Vec<String>), NotEvaluated
 }
 
 /// LightAPI's inputs and, where ShapingAPI is applied, the shaping (every light type's).
-fn light_inputs(
-    r: &Reader,
-) -> std::result::Result<(LightInputs, Option<Shaping>), NotEvaluated> {
+fn light_inputs(r: &Reader) -> std::result::Result<(LightInputs, Option<Shaping>), NotEvaluated> {
     let inputs = LightInputs {
         intensity: r.float("inputs:intensity")?,
         exposure: r.float("inputs:exposure")?,

@@ -111,7 +111,11 @@ fn points(v: sdf::Value) -> std::result::Result<Vec<[f64; 3]>, String> {
         sdf::Value::Vec3dVec(v) => Ok(v.into_iter().map(<[f64; 3]>::from).collect()),
         sdf::Value::Vec3hVec(v) => v
             .into_iter()
-            .map(|p| sdf::Value::Vec3h(p).cast::<[f64; 3]>().map_err(|e| e.to_string()))
+            .map(|p| {
+                sdf::Value::Vec3h(p)
+                    .cast::<[f64; 3]>()
+                    .map_err(|e| e.to_string())
+            })
             .collect(),
         other => Err(short(&other)),
     }
@@ -158,7 +162,9 @@ fn glow(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<Glow> {
         return Ok(Glow::NoMaterial);
     };
     let stage = prim.stage();
-    let mat = stage.prim(&material).map_err(|err| openusd::Error::from(err))?;
+    let mat = stage
+        .prim(&material)
+        .map_err(openusd::Error::from)?;
     let material_name = material.to_string();
     let not = |what: String| Ok(Glow::NotEvaluated(what));
     let mat_type = mat.type_name()?.map(|t| t.as_str().to_string());
@@ -176,9 +182,13 @@ fn glow(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<Glow> {
     let shader_path = source.prim_path();
     let shader = stage
         .prim(&shader_path)
-        .map_err(|err| openusd::Error::from(err))?;
+        .map_err(openusd::Error::from)?;
     let shader_name = shader_path.to_string();
-    match shader.type_name()?.map(|t| t.as_str().to_string()).as_deref() {
+    match shader
+        .type_name()?
+        .map(|t| t.as_str().to_string())
+        .as_deref()
+    {
         Some("Shader") => {}
         Some("NodeGraph") => {
             return not(format!(

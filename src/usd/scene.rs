@@ -582,7 +582,8 @@ mod tests {
 
     #[test]
     fn evaluable_filters_and_rejects_unknown_selection() {
-        let mut hidden = StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y, max_triangles());
+        let mut hidden =
+            StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y, max_triangles());
         hidden.path = "/Lights/Hidden".into();
         hidden.visible = false;
         let scene = Stage {

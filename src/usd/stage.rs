@@ -312,7 +312,9 @@ impl UsdStage {
                 .map(|t| t.as_str())
                 .filter(|n| {
                     // The Mesh rows are geometry any Gprim may author, not light inputs.
-                    schema::TABLE.iter().any(|a| a.name == *n && a.schema != "Mesh")
+                    schema::TABLE
+                        .iter()
+                        .any(|a| a.name == *n && a.schema != "Mesh")
                         && !attrs.iter().any(|a| a.name == *n)
                 })
                 .map(str::to_string)
