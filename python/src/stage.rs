@@ -333,7 +333,7 @@ impl Stage {
     /// ``includes``, ``excludes``, ``expansion_rule``, ``membership_expression``) and
     /// ``shaping_without_api`` (``inputs:shaping:*`` authored without ShapingAPI: the light is
     /// evaluated unshaped)); a mesh light's ``mesh`` (``triangles``, ``area``, ``holes``,
-    /// ``degenerate_triangles``, ``tint``, ``tint_source``, ``double_sided``,
+    /// ``degenerate_triangles``, ``folded_faces``, ``tint``, ``tint_source``, ``double_sided``,
     /// ``subdivision_scheme``, ``subdivision``), a portal's ``portal`` (``width``, ``height``,
     /// its multiplier inputs, ``multiplier``, ``domes``) and a dome's ``portals`` (read, not
     /// evaluated yet). A new list on each access.

@@ -62,6 +62,10 @@ pub struct MeshGeometry {
     pub degenerate: usize,
     /// Faces removed because `holeIndices` names them (each counted once).
     pub holes: usize,
+    /// Faces whose fan folds over itself (a non-convex polygon whose fan has triangles facing
+    /// opposite ways), in face order: evaluated as that fan, as Hydra renders it, and said
+    /// (M1).
+    pub folded_faces: Vec<u32>,
 }
 
 /// A triangle whose world area is at most this fraction of the mesh's largest triangle is
@@ -163,10 +167,25 @@ impl MeshGeometry {
         Ok(MeshGeometry {
             degenerate: before - triangles.len(),
             area,
+            folded_faces: folded_faces(&triangles),
             triangles,
             holes: holes.iter().filter(|h| **h).count(),
         })
     }
+}
+
+/// The faces among `triangles` (in face order, degenerate ones already dropped) with a triangle
+/// facing against the face's summed normal: their fan folds over itself.
+fn folded_faces(triangles: &[MeshTriangle]) -> Vec<u32> {
+    let cross = |t: &MeshTriangle| (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
+    triangles
+        .chunk_by(|a, b| a.face == b.face)
+        .filter(|fan| {
+            let sum: DVec3 = fan.iter().map(cross).sum();
+            fan.iter().any(|t| cross(t).dot(sum) < 0.0)
+        })
+        .map(|fan| fan[0].face)
+        .collect()
 }
 
 /// Per face: whether `holeIndices` names it; an index that names no face is bad topology.
@@ -286,6 +305,29 @@ mod tests {
         .unwrap();
         assert_eq!((g.triangles.len(), g.degenerate, g.holes), (2, 1, 1));
         assert_eq!(g.area, 1.0);
+    }
+
+    #[test]
+    fn a_fan_that_folds_over_itself_is_kept_and_named() {
+        // A dart whose fan from v0 has a triangle facing the other way.
+        let dart = [
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 2.0, 0.0],
+            [1.0, 0.5, 0.0],
+        ];
+        let g = MeshGeometry::triangulate(
+            &topo(&dart, &[4, 4], &[0, 1, 2, 3, 0, 1, 2, 3], &[]),
+            DMat4::IDENTITY,
+        )
+        .unwrap();
+        assert_eq!(g.triangles.len(), 4);
+        assert_eq!(g.folded_faces, vec![0, 1]);
+        // One side each: |T1| + |T2| = 2 + 0.5.
+        assert_eq!(g.area, 5.0);
+        let square =
+            MeshGeometry::triangulate(&topo(&QUAD, &[4], &[0, 1, 2, 3], &[]), DMat4::IDENTITY);
+        assert!(square.unwrap().folded_faces.is_empty());
     }
 
     #[test]

@@ -125,7 +125,9 @@ fn points(v: sdf::Value) -> std::result::Result<Vec<[f64; 3]>, String> {
 /// on the prim or an ancestor, then the UsdPreviewSurface driving its `outputs:surface`.
 /// Collection bindings and `bindMaterialAs` strengths, which can override the nearest direct
 /// binding (UsdShadeMaterialBindingAPI's resolution), are not resolved: where any prim on the
-/// way authors one the glow is [`Glow::NotEvaluated`].
+/// way authors one the glow is [`Glow::NotEvaluated`]. A binding counts whether or not
+/// MaterialBindingAPI is applied to its prim, as usd-core 26.11's `ComputeBoundMaterial` counts
+/// it (with a warning).
 fn glow(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<Glow> {
     let mut bound: Option<sdf::Path> = None;
     let mut cur = Some(prim.clone());
@@ -162,9 +164,7 @@ fn glow(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<Glow> {
         return Ok(Glow::NoMaterial);
     };
     let stage = prim.stage();
-    let mat = stage
-        .prim(&material)
-        .map_err(openusd::Error::from)?;
+    let mat = stage.prim(&material).map_err(openusd::Error::from)?;
     let material_name = material.to_string();
     let not = |what: String| Ok(Glow::NotEvaluated(what));
     let mat_type = mat.type_name()?.map(|t| t.as_str().to_string());
@@ -180,9 +180,7 @@ fn glow(prim: &ousd::Prim, tc: TimeCode) -> openusd::Result<Glow> {
         ));
     };
     let shader_path = source.prim_path();
-    let shader = stage
-        .prim(&shader_path)
-        .map_err(openusd::Error::from)?;
+    let shader = stage.prim(&shader_path).map_err(openusd::Error::from)?;
     let shader_name = shader_path.to_string();
     match shader
         .type_name()?
@@ -300,6 +298,23 @@ pub(super) fn convert(
         warnings.push(format!(
             "{path}: subdivisionScheme {subdivision_scheme:?}: its control cage is evaluated as \
              polygons (no subdivision, DESIGN.md §7 M1)"
+        ));
+    }
+    if !geometry.folded_faces.is_empty() {
+        const SHOWN: usize = 8;
+        let mut faces: Vec<String> = geometry
+            .folded_faces
+            .iter()
+            .take(SHOWN)
+            .map(u32::to_string)
+            .collect();
+        if geometry.folded_faces.len() > SHOWN {
+            faces.push(format!("{} more", geometry.folded_faces.len() - SHOWN));
+        }
+        warnings.push(format!(
+            "{path}: the fan of face {} folds over itself (a non-convex polygon): evaluated as \
+             that fan, as Hydra renders it (DESIGN.md §7 M1)",
+            faces.join(", ")
         ));
     }
     if geometry.triangles.is_empty() {

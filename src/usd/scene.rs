@@ -102,6 +102,7 @@ fn mesh_summary<S: serde::Serializer>(
         "area": g.area,
         "holes": g.holes,
         "degenerate_triangles": g.degenerate,
+        "folded_faces": g.folded_faces.len(),
         "tint": m.tint.rgb.to_array(),
         "tint_source": m.tint.source,
         "double_sided": m.double_sided,
