@@ -79,20 +79,21 @@ pub use gpu::{AdapterSummary, CacheStatus, DeviceLimits, Startup, adapters};
 pub use input::{BadRow, RowKind, RowProblem};
 pub use limits::Limits;
 pub use model::{
-    Asset, Ies, Input, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter,
-    TextureFormat, UpAxis, Value, schema,
+    Asset, Ies, Input, Light, LightInputs, LightType, MeshGeometry, MeshLight, MeshTopology,
+    MeshTriangle, PoleAxis, Portal, Shaping, Texture, TextureFilter, TextureFormat, Tint,
+    TopologyError, UpAxis, Value, schema,
 };
 pub use prepare::TemperatureMode;
 pub use prepare::ies::{
     FluxCheck, HFold as IesHFold, Peak as IesPeak, Plane as IesPlane, Profile as IesProfile,
     Spread as IesSpread, VFold as IesVFold,
 };
-#[cfg(feature = "usd")]
-pub use query::lights_json;
 pub use query::{
     Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, SamplerCheck, Samples,
     Selection, StrategyVariance,
 };
+#[cfg(feature = "usd")]
+pub use query::{lights_json, portal_multiplier};
 pub use synthetic::{Rng, synthetic_lights};
 #[cfg(feature = "usd")]
 pub use usd::{

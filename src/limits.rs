@@ -24,6 +24,9 @@ pub struct Limits {
     /// The deepest namespace a stage may compose to (`/a/b/c` is 3 deep), arcs included.
     /// `LUXEVAL_MAX_PRIM_DEPTH`.
     pub max_prim_depth: u64,
+    /// The most triangles of one mesh light (its faces' fans, holes removed; DESIGN.md §7 M3).
+    /// `LUXEVAL_MAX_MESH_TRIANGLES`.
+    pub max_mesh_triangles: u64,
 }
 
 // Environment variables, in the order of the fields of [`Limits`] (also its associated
@@ -32,6 +35,7 @@ pub(crate) const ENV_MAX_FILE_BYTES: &str = "LUXEVAL_MAX_FILE_BYTES";
 pub(crate) const ENV_MAX_SAMPLES: &str = "LUXEVAL_MAX_SAMPLES";
 pub(crate) const ENV_MAX_PRIMS: &str = "LUXEVAL_MAX_PRIMS";
 pub(crate) const ENV_MAX_PRIM_DEPTH: &str = "LUXEVAL_MAX_PRIM_DEPTH";
+pub(crate) const ENV_MAX_MESH_TRIANGLES: &str = "LUXEVAL_MAX_MESH_TRIANGLES";
 
 /// The longest chain of nested composition arcs (references, payloads, inherits, specializes)
 /// openusd 0.8 composes: measured, a prim at the head of a chain of 98 references composes and
@@ -52,6 +56,10 @@ impl Default for Limits {
             // references, ~0.4 ms each: a stage at the limit needs a few GB and tens of seconds.
             max_prims: 1_000_000,
             max_prim_depth: 1_000,
+            // 2^22 triangles: 300 MiB of f64 world-space vertices, and a mesh 40 times the
+            // 100,000 triangles the benchmark prepares. The points behind them are
+            // already bounded by the file limit.
+            max_mesh_triangles: 1 << 22,
         }
     }
 }
@@ -65,6 +73,8 @@ impl Limits {
     pub const ENV_MAX_PRIMS: &str = ENV_MAX_PRIMS;
     /// The variable that sets [`Limits::max_prim_depth`].
     pub const ENV_MAX_PRIM_DEPTH: &str = ENV_MAX_PRIM_DEPTH;
+    /// The variable that sets [`Limits::max_mesh_triangles`].
+    pub const ENV_MAX_MESH_TRIANGLES: &str = ENV_MAX_MESH_TRIANGLES;
 
     /// "set NAME to raise it; see docs/INPUTS.md": the end of every message about a limit.
     pub fn raise_hint(env: &str) -> String {
@@ -86,6 +96,7 @@ impl Limits {
             max_samples: var(ENV_MAX_SAMPLES, d.max_samples)?,
             max_prims: var(ENV_MAX_PRIMS, d.max_prims)?,
             max_prim_depth: var(ENV_MAX_PRIM_DEPTH, d.max_prim_depth)?,
+            max_mesh_triangles: var(ENV_MAX_MESH_TRIANGLES, d.max_mesh_triangles)?,
         })
     }
 

@@ -981,8 +981,15 @@ def light_record(prim, time, xf_cache):
         t = str(attr.GetTypeName())
         if t not in SCALAR_TYPES:
             continue
-        if not (name.startswith("inputs:") or name in ("treatAsPoint", "treatAsLine", "guideRadius", "poleAxis")):
-            continue
+        if not (name.startswith("inputs:") or name in (
+                "treatAsPoint", "treatAsLine", "guideRadius", "poleAxis",
+                # A mesh light's uniform attributes (luxeval's schema table rows for Mesh and
+                # MeshLightAPI); other Gprims' (a Volume light's) are recorded and not compared.
+                "orientation", "doubleSided", "subdivisionScheme")):
+            # LightAPI declares light:materialSyncMode too (fallback noMaterialResponse), but
+            # luxeval reads it only where MeshLightAPI overrides it (materialGlowTintsLight).
+            if not (name == "light:materialSyncMode" and prim.HasAPI(UsdLux.MeshLightAPI)):
+                continue
         inputs.append({
             "name": name,
             "type": t,
@@ -1455,6 +1462,289 @@ def unapplied():
     dump_unapplied("usd/unapplied/unapplied.usda", "unapplied_links", UNAPPLIED_TIMES)
 
 
+# Mesh lights and portals (DESIGN.md §7 M1–M2, §8 P1; tests/usd_fixtures.rs "mesh"): written
+# with usd-core's API, and what they must read as computed here, by usd-core and NumPy, never by
+# luxeval: each mesh light's fan triangle count and world-space area (holes removed, degenerate
+# triangles dropped), its emitting front (a world-space normal per triangle), its tint and the
+# kind of its source; each portal's size, world matrix and the domes that name it.
+MESH_TIMES = [0, 5, 10]
+
+
+def write_mesh_lights():
+    from pxr import Gf, UsdShade, Vt
+
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y)
+    world = UsdGeom.Xform.Define(stage, "/World")
+
+    looks = "/World/Looks"
+    UsdGeom.Scope.Define(stage, looks)
+
+    def material(name, shader_id, emissive=None, connect_emissive=False, through_graph=False):
+        mat = UsdShade.Material.Define(stage, f"{looks}/{name}")
+        shader = UsdShade.Shader.Define(stage, f"{looks}/{name}/Surface")
+        shader.CreateIdAttr(shader_id)
+        out = shader.CreateOutput("surface", Sdf.ValueTypeNames.Token)
+        if emissive is not None:
+            shader.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*emissive))
+        if connect_emissive:
+            tex = UsdShade.Shader.Define(stage, f"{looks}/{name}/Texture")
+            tex.CreateIdAttr("UsdUVTexture")
+            rgb = tex.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
+            shader.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(rgb)
+        if through_graph:
+            graph = UsdShade.NodeGraph.Define(stage, f"{looks}/{name}/Graph")
+            gout = graph.CreateOutput("surface", Sdf.ValueTypeNames.Token)
+            gout.ConnectToSource(out)
+            mat.CreateSurfaceOutput().ConnectToSource(gout)
+        else:
+            mat.CreateSurfaceOutput().ConnectToSource(out)
+        return mat
+
+    glow = material("Glow", "UsdPreviewSurface", emissive=(2.0, 1.0, 0.5))
+    dark = material("Dark", "UsdPreviewSurface")
+    custom = material("Custom", "ND_standard_surface_surfaceshader", emissive=(1.0, 1.0, 1.0))
+    connected = material("Connected", "UsdPreviewSurface", connect_emissive=True)
+    graph = material("Graph", "UsdPreviewSurface", emissive=(3.0, 3.0, 3.0), through_graph=True)
+
+    def bind(prim, mat):
+        UsdShade.MaterialBindingAPI.Apply(prim).Bind(mat)
+
+    def mesh(path, points, counts, indices, **kw):
+        m = UsdGeom.Mesh.Define(stage, path)
+        UsdLux.MeshLightAPI.Apply(m.GetPrim())
+        if isinstance(points, dict):
+            for t, pts in points.items():
+                m.CreatePointsAttr().Set(Vt.Vec3fArray([Gf.Vec3f(*p) for p in pts]), t)
+        else:
+            m.CreatePointsAttr(Vt.Vec3fArray([Gf.Vec3f(*p) for p in points]))
+        m.CreateFaceVertexCountsAttr(Vt.IntArray(counts))
+        m.CreateFaceVertexIndicesAttr(Vt.IntArray(indices))
+        if "holes" in kw:
+            m.CreateHoleIndicesAttr(Vt.IntArray(kw["holes"]))
+        if "orientation" in kw:
+            m.CreateOrientationAttr(kw["orientation"])
+        if "double_sided" in kw:
+            m.CreateDoubleSidedAttr(kw["double_sided"])
+        if "scheme" in kw:
+            m.CreateSubdivisionSchemeAttr(kw["scheme"])
+        light = UsdLux.LightAPI(m.GetPrim())
+        light.CreateIntensityAttr(kw.get("intensity", 10.0))
+        if "sync" in kw:
+            m.GetPrim().CreateAttribute("light:materialSyncMode", Sdf.ValueTypeNames.Token,
+                                        variability=Sdf.VariabilityUniform).Set(kw["sync"])
+        return m
+
+    # An ancestor binds Glow: the meshes below without their own binding inherit it.
+    signs = UsdGeom.Xform.Define(stage, "/World/Signs")
+    signs.AddTranslateOp().Set(Gf.Vec3d(0.0, 2.0, -3.0))
+    bind(signs.GetPrim(), glow)
+    # Two quads sharing an edge, 2 × 1 each.
+    mesh("/World/Signs/Quads",
+         [(0, 0, 0), (2, 0, 0), (2, 1, 0), (0, 1, 0), (4, 0, 0), (4, 1, 0)],
+         [4, 4], [0, 1, 2, 3, 1, 4, 5, 2], scheme="none")
+    # A regular pentagon (a fan of three), leftHanded and double-sided, rotated.
+    import math
+    pent = [(math.cos(2 * math.pi * k / 5), math.sin(2 * math.pi * k / 5), 0.0) for k in range(5)]
+    p = mesh("/World/Signs/Pentagon", pent, [5], [0, 1, 2, 3, 4],
+             orientation="leftHanded", double_sided=True)
+    p.AddRotateXYZOp().Set(Gf.Vec3f(30.0, 45.0, 0.0))
+    # A 3 × 1 strip of unit quads with the middle one a hole, and a quad whose fan has a
+    # degenerate triangle (three collinear vertices).
+    mesh("/World/Signs/Holes",
+         [(0, 0, 0), (1, 0, 0), (2, 0, 0), (3, 0, 0), (0, 1, 0), (1, 1, 0), (2, 1, 0), (3, 1, 0),
+          (5, 0, 0), (6, 0, 0), (7, 0, 0), (6, 1, 0)],
+         [4, 4, 4, 4], [0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 8, 9, 10, 11], holes=[1])
+    # A mirroring, scaling, rotating transform; its own binding (Dark) wins over the ancestor's.
+    mir = mesh("/World/Signs/Mirrored", [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [4], [0, 1, 2, 3])
+    mir.AddScaleOp().Set(Gf.Vec3f(-1.0, 2.0, 0.5))
+    mir.AddRotateYOp().Set(20.0)
+    bind(mir.GetPrim(), dark)
+    # Time-sampled points (the quad grows from 1 × 1 to 3 × 1) and a shader that is not
+    # UsdPreviewSurface.
+    anim = mesh("/World/Signs/Animated",
+                {0: [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)],
+                 10: [(0, 0, 0), (3, 0, 0), (3, 1, 0), (0, 1, 0)]},
+                [4], [0, 1, 2, 3])
+    bind(anim.GetPrim(), custom)
+    conn = mesh("/World/Signs/Connected", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [3], [0, 1, 2])
+    bind(conn.GetPrim(), connected)
+    gr = mesh("/World/Signs/Routed", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [3], [0, 1, 2])
+    bind(gr.GetPrim(), graph)
+    mesh("/World/Signs/Independent", [(0, 0, 0), (1, 0, 0), (0, 1, 0)], [3], [0, 1, 2],
+         sync="independent")
+    # No binding anywhere above.
+    UsdGeom.Xform.Define(stage, "/World/Bare")
+    mesh("/World/Bare/Strip", [(0, 0, 0), (1, 0, 0), (1, 0, 1), (0, 0, 1)], [4], [0, 1, 2, 3])
+
+    # Portals: a dome names a portal and a prim that is not one; another portal no dome names.
+    sky = UsdLux.DomeLight_1.Define(stage, "/World/Sky")
+    window = UsdLux.PortalLight.Define(stage, "/World/Window")
+    window.CreateWidthAttr(2.0)
+    window.CreateHeightAttr(1.5)
+    window.CreateIntensityAttr(2.0)
+    window.CreateExposureAttr(1.0)
+    window.CreateColorAttr(Gf.Vec3f(1.0, 0.5, 0.25))
+    wx = UsdGeom.Xformable(window.GetPrim())
+    wx.AddTranslateOp().Set(Gf.Vec3d(1.0, 2.0, 3.0))
+    wx.AddRotateYOp().Set(90.0)
+    skylight = UsdLux.PortalLight.Define(stage, "/World/Skylight")
+    UsdGeom.Xformable(skylight.GetPrim()).AddTranslateOp().Set(Gf.Vec3d(0.0, 5.0, 0.0))
+    sky.CreatePortalsRel().SetTargets([window.GetPath(), Sdf.Path("/World/Signs/Quads")])
+    return stage
+
+
+def mesh_expectations(stage, times):
+    """Every mesh light and portal at every time, computed by usd-core and NumPy."""
+    import numpy as np
+    from pxr import UsdShade
+
+    def tint_of(prim, tc):
+        sync = prim.GetAttribute("light:materialSyncMode")
+        mode = sync.Get() if sync and sync.HasAuthoredValue() else "materialGlowTintsLight"
+        if mode != "materialGlowTintsLight":
+            return [1.0, 1.0, 1.0], "mode"
+        mat, _rel = UsdShade.MaterialBindingAPI(prim).ComputeBoundMaterial()
+        if not mat:
+            return [1.0, 1.0, 1.0], "no_material"
+        out = mat.GetSurfaceOutput()
+        sources = out.GetConnectedSources()[0]
+        if not sources:
+            return [1.0, 1.0, 1.0], "not_evaluated"
+        src = sources[0].source.GetPrim()
+        if src.GetTypeName() != "Shader":
+            return [1.0, 1.0, 1.0], "not_evaluated"
+        shader = UsdShade.Shader(src)
+        if shader.GetIdAttr().Get() != "UsdPreviewSurface":
+            return [1.0, 1.0, 1.0], "not_evaluated"
+        emissive = shader.GetInput("emissiveColor")
+        if emissive and emissive.HasConnectedSource():
+            return [1.0, 1.0, 1.0], "not_evaluated"
+        v = emissive.Get(tc) if emissive else None
+        return ([0.0, 0.0, 0.0] if v is None else [float(x) for x in v]), "emissive"
+
+    samples = []
+    for t in [None] + list(times):
+        tc = Usd.TimeCode.EarliestTime() if t is None else Usd.TimeCode(t)
+        cache = UsdGeom.XformCache(tc)
+        meshes, portals = [], []
+        for prim in stage.Traverse():
+            m = np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64)
+            if prim.HasAPI(UsdLux.MeshLightAPI):
+                mesh = UsdGeom.Mesh(prim)
+                pts = np.array(mesh.GetPointsAttr().Get(tc), dtype=np.float64)
+                counts = list(mesh.GetFaceVertexCountsAttr().Get(tc))
+                idx = list(mesh.GetFaceVertexIndicesAttr().Get(tc))
+                holes = set(mesh.GetHoleIndicesAttr().Get(tc) or [])
+                left = mesh.GetOrientationAttr().Get(tc) == UsdGeom.Tokens.leftHanded
+                # USD row vectors: p_world = [p 1] · M.
+                wp = np.hstack([pts, np.ones((len(pts), 1))]) @ m
+                wp = wp[:, :3]
+                tris, start = [], 0
+                for face, n in enumerate(counts):
+                    ids = idx[start:start + n]
+                    start += n
+                    if face in holes:
+                        continue
+                    for i in range(1, n - 1):
+                        tris.append((ids[0], ids[i], ids[i + 1]))
+                # The object-space front, −n for leftHanded, carried by the inverse transpose.
+                normal_matrix = np.linalg.inv(m[:3, :3])  # rows: (M^-1) for row vectors
+                areas, normals = [], []
+                for a, b, c in tris:
+                    areas.append(0.5 * np.linalg.norm(np.cross(wp[b] - wp[a], wp[c] - wp[a])))
+                    n_obj = np.cross(pts[b] - pts[a], pts[c] - pts[a]) * (-1.0 if left else 1.0)
+                    n_world = normal_matrix @ n_obj
+                    with np.errstate(invalid="ignore"):  # a degenerate triangle, dropped below
+                        normals.append(n_world / np.linalg.norm(n_world))
+                largest = max(areas) if areas else 0.0
+                kept = [i for i, ar in enumerate(areas) if ar > 1e-12 * largest]
+                rgb, kind = tint_of(prim, tc)
+                meshes.append({
+                    "path": str(prim.GetPath()),
+                    "triangles": len(kept),
+                    "area": float(sum(areas[i] for i in kept)),
+                    "normals": [[float(x) for x in normals[i]] for i in kept],
+                    "tint": rgb,
+                    "tint_kind": kind,
+                    "double_sided": bool(mesh.GetDoubleSidedAttr().Get(tc)),
+                    "subdivision_scheme": str(mesh.GetSubdivisionSchemeAttr().Get(tc)),
+                })
+            elif prim.IsA(UsdLux.PortalLight):
+                portal = UsdLux.PortalLight(prim)
+                domes = []
+                for d in stage.Traverse():
+                    if d.IsA(UsdLux.DomeLight_1) or d.IsA(UsdLux.DomeLight):
+                        rel = d.GetRelationship("portals")
+                        if rel and prim.GetPath() in rel.GetTargets():
+                            domes.append(str(d.GetPath()))
+                portals.append({
+                    "path": str(prim.GetPath()),
+                    "width": float(portal.GetWidthAttr().Get(tc)),
+                    "height": float(portal.GetHeightAttr().Get(tc)),
+                    "world": [[float(m[r][c]) for c in range(4)] for r in range(4)],
+                    "domes": domes,
+                })
+        domes = []
+        for d in stage.Traverse():
+            if d.IsA(UsdLux.DomeLight_1) or d.IsA(UsdLux.DomeLight):
+                rel = d.GetRelationship("portals")
+                domes.append({
+                    "path": str(d.GetPath()),
+                    "portals": [str(p) for p in rel.GetTargets()] if rel else [],
+                })
+        samples.append({"time": t, "meshes": meshes, "portals": portals, "domes": domes})
+    return samples
+
+
+# Bad topology (DESIGN.md §7 M1): each a mesh light whose one attribute is wrong; the CLI
+# refuses a query on it with exit 2 naming the prim and the attribute (cli/tests/bad_inputs.rs).
+BAD_MESHES = {
+    "count_below_3": ("faceVertexCounts", [4, 2], [0, 1, 2, 3, 0, 1], [], [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]),
+    "index_out_of_range": ("faceVertexIndices", [4], [0, 1, 2, 7], [], [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]),
+    "negative_index": ("faceVertexIndices", [4], [0, 1, -2, 3], [], [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]),
+    "counts_not_summing": ("faceVertexIndices", [4], [0, 1, 2], [], [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]),
+    "non_finite_point": ("points", [4], [0, 1, 2, 3], [], [(0, 0, 0), (1, 0, 0), (1, float("nan"), 0), (0, 1, 0)]),
+    "hole_out_of_range": ("holeIndices", [4], [0, 1, 2, 3], [3], [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]),
+}
+
+
+def write_bad_meshes():
+    from pxr import Gf, Vt
+    for name, (_attr, counts, indices, holes, points) in BAD_MESHES.items():
+        stage = Usd.Stage.CreateInMemory()
+        m = UsdGeom.Mesh.Define(stage, "/Bad")
+        UsdLux.MeshLightAPI.Apply(m.GetPrim())
+        m.CreatePointsAttr(Vt.Vec3fArray([Gf.Vec3f(*p) for p in points]))
+        m.CreateFaceVertexCountsAttr(Vt.IntArray(counts))
+        m.CreateFaceVertexIndicesAttr(Vt.IntArray(indices))
+        if holes:
+            m.CreateHoleIndicesAttr(Vt.IntArray(holes))
+        write(os.path.join(DATA, "usd", "mesh", "bad", f"{name}.usda"),
+              stage.GetRootLayer().ExportToString())
+
+
+def mesh_lights():
+    stage = write_mesh_lights()
+    path = os.path.join(DATA, "usd", "mesh", "mesh_lights.usda")
+    write(path, stage.GetRootLayer().ExportToString())
+    reopened = Usd.Stage.Open(path)
+    out = {
+        "generator": "tools/gen_usd_fixtures.py",
+        "usd_version": ".".join(str(x) for x in Usd.GetVersion()),
+        "scene": "usd/mesh/mesh_lights.usda",
+        "samples": mesh_expectations(reopened, MESH_TIMES),
+    }
+    dst = os.path.join(DATA, "usd", "expected", "mesh_lights.json")
+    with open(dst, "w") as f:
+        json.dump(out, f, indent=None, separators=(",", ":"))
+        f.write("\n")
+    print(f"{dst}: {len(out['samples'][0]['meshes'])} mesh lights, "
+          f"{len(out['samples'][0]['portals'])} portals x {len(out['samples'])} times")
+    dump("usd/mesh/mesh_lights.usda", "mesh_lights_inputs", MESH_TIMES)
+    write_bad_meshes()
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--luxtest-src", default="/work/shared/data/luxtest", help="the research/data/luxtest copy")
@@ -1468,6 +1758,8 @@ def main():
                     help="an OpenUSD git repository, for the files --openusd-src lacks (LICENSE.txt)")
     ap.add_argument("--only-openusd", action="store_true",
                     help="copy and dump only the OpenUSD parity corpus (leaves the others as they are)")
+    ap.add_argument("--only-mesh", action="store_true",
+                    help="write and dump only the mesh-light and portal fixtures (leaves the others as they are)")
     ap.add_argument("--only-unapplied", action="store_true",
                     help="write and dump only the filters / linking / light-list fixture (leaves the others as they are)")
     args = ap.parse_args()
@@ -1488,6 +1780,9 @@ def main():
         return
     if args.only_unapplied:
         unapplied()
+        return
+    if args.only_mesh:
+        mesh_lights()
         return
 
     copy_luxtest(args.luxtest_src)
@@ -1511,6 +1806,7 @@ def main():
     copy_openusd(args.openusd_src, args.openusd_git)
     dump_openusd()
     unapplied()
+    mesh_lights()
 
 
 if __name__ == "__main__":

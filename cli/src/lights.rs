@@ -6,7 +6,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use luxeval::{Power, Reference, StageLight, TemperatureMode};
+use luxeval::{Power, Reference, StageLight, TemperatureMode, portal_multiplier};
 
 use crate::exit::{CliResult, Failure};
 
@@ -66,9 +66,11 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
                 let _ = writeln!(block, $($arg)*);
             }};
         }
+        let read_only = l.mesh.is_some() || l.portal.is_some();
         let status = match (&l.light, l.visible) {
             (Some(_), true) => "evaluated",
             (_, false) => "invisible: skipped",
+            (None, true) if read_only => "read, not evaluated yet",
             (None, true) => "not evaluated",
         };
         put!("\n{} ({}) [{}]", l.path, l.usd_type, status);
@@ -108,6 +110,41 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
             ),
             Ok(None) => {}
             Err(e) => put!("  power  cannot be computed: {e}"),
+        }
+        // DESIGN.md §7 M1, M2: what the mesh light's evaluation will read.
+        if let Some(m) = &l.mesh {
+            let g = &m.geometry;
+            put!(
+                "  mesh  {} triangles ({} hole faces removed, {} degenerate triangles dropped), \
+                 area {:.6}, doubleSided {}",
+                g.triangles.len(),
+                g.holes,
+                g.degenerate,
+                g.area,
+                m.double_sided
+            );
+            let [r, gr, b] = m.tint.rgb.to_array();
+            // The subdivision note is the light's warning (once per prim, M1).
+            put!("  tint  ({r}, {gr}, {b}) from {}", m.tint.source);
+        }
+        // DESIGN.md §8 P1, P2.
+        if let Some(p) = &l.portal {
+            let [r, g, b] = portal_multiplier(p, TemperatureMode::default()).to_array();
+            let domes = match p.domes.is_empty() {
+                true => "no dome".to_string(),
+                false => p.domes.join(", "),
+            };
+            put!(
+                "  portal  {} x {}, multiplier ({r}, {g}, {b}), named by {domes}",
+                p.width,
+                p.height
+            );
+        }
+        if let Some(portals) = &l.portals {
+            match portals.is_empty() {
+                true => put!("  portals  (none)"),
+                false => put!("  portals  {}", portals.join(", ")),
+            }
         }
         for row in &l.world {
             put!(

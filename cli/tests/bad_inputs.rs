@@ -397,6 +397,20 @@ fn zero_sublayer(d: &Path) {
     .unwrap();
 }
 
+/// The mesh-light stages made by usd-core (tools/gen_usd_fixtures.py --only-mesh): the bad
+/// topologies of tests/data/usd/mesh/bad/ and the good scene beside them.
+fn mesh_stages(d: &Path) {
+    let mesh = crate::repo().join("tests/data/usd/mesh");
+    for dir in [mesh.join("bad"), mesh.clone()] {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_file() {
+                std::fs::copy(&p, d.join(p.file_name().unwrap())).unwrap();
+            }
+        }
+    }
+}
+
 const NO_GPU: &[(&str, &str)] = &[
     ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
     ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
@@ -560,6 +574,17 @@ cases! {
     ies_candela_beyond_float32_normalized: Case { args: emission!("{in}/ies_huge_normalized.usda", "{in}/dirs.npy"), exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_huge.ies", "1e39", "float32"], ..Case::default() };
     ies_candela_beyond_float32_on_the_gpu: Case { args: &["emission", "{in}/ies_huge_normalized.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "gpu"], exit: 2, says: &["/L", "inputs:shaping:ies:file", "ies_huge.ies", "1e39", "float32"], gpu: true, ..Case::default() };
     ies_png_is_the_profile: Case { args: &["ies", "{in}/ies_bad_count.ies", "--png", "{in}/ies_bad_count.ies"], exit: 2, says: &["--png", "ies_bad_count.ies"], ..Case::default() };
+
+    // --- Mesh lights (DESIGN.md §7 M1): bad topology refuses the query, naming prim and attribute
+    mesh_face_with_two_vertices: Case { args: emission!("{in}/count_below_3.usda", "{in}/dirs.npy"), exit: 2, says: &["count_below_3.usda", "/Bad", "faceVertexCounts", "at least 3"], setup: Some(mesh_stages), ..Case::default() };
+    mesh_index_out_of_range: Case { args: emission!("{in}/index_out_of_range.usda", "{in}/dirs.npy"), exit: 2, says: &["index_out_of_range.usda", "/Bad", "faceVertexIndices", "7"], setup: Some(mesh_stages), ..Case::default() };
+    mesh_negative_index: Case { args: emission!("{in}/negative_index.usda", "{in}/dirs.npy"), exit: 2, says: &["negative_index.usda", "/Bad", "faceVertexIndices", "-2"], setup: Some(mesh_stages), ..Case::default() };
+    mesh_counts_not_summing_to_the_indices: Case { args: emission!("{in}/counts_not_summing.usda", "{in}/dirs.npy"), exit: 2, says: &["counts_not_summing.usda", "/Bad", "faceVertexIndices", "sums to 4"], setup: Some(mesh_stages), ..Case::default() };
+    mesh_non_finite_point: Case { args: emission!("{in}/non_finite_point.usda", "{in}/dirs.npy"), exit: 2, says: &["non_finite_point.usda", "/Bad", "points", "not finite"], setup: Some(mesh_stages), ..Case::default() };
+    mesh_hole_out_of_range: Case { args: emission!("{in}/hole_out_of_range.usda", "{in}/dirs.npy"), exit: 2, says: &["hole_out_of_range.usda", "/Bad", "holeIndices", "3"], setup: Some(mesh_stages), ..Case::default() };
+    mesh_triangles_over_the_limit: Case { args: emission!("{in}/mesh_lights.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_MESH_TRIANGLES", "3")], says: &["mesh_lights.usda", "/World/Signs/Quads", "4 triangles", "LUXEVAL_MAX_MESH_TRIANGLES"], setup: Some(mesh_stages), ..Case::default() };
+    // Read, not evaluated yet: the dome is evaluated, the mesh lights and portals said skipped.
+    mesh_lights_are_read_and_skipped: Case { args: emission!("{in}/mesh_lights.usda", "{in}/dirs.npy"), exit: 0, lit: true, says: &["/World/Signs/Quads: mesh light", "read, not evaluated yet", "/World/Window: portal read, not evaluated yet"], setup: Some(mesh_stages), ..Case::default() };
 
     // --- Runtime failures: exit 1 ---------------------------------------------------------------
     disk_full_while_writing_npy: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 1, fsize: Some(100), says: &["writing", "out.npy"], ..Case::default() };

@@ -302,6 +302,88 @@ fn lights_json_lists_every_input_and_whether_authored() {
     assert_eq!(diffuse["authored"], false);
 }
 
+/// `lights --json` lists each mesh light (triangle count, world area, tint and its source,
+/// doubleSided, subdivision), each portal (size, multiplier, the domes naming it) and each
+/// dome's portals (DESIGN.md §7, §8), with the numbers usd-core and NumPy computed for the
+/// fixture (tests/data/usd/expected/mesh_lights.json, its earliest-time sample); the text
+/// lists the same, and says the lights are read, not evaluated yet.
+#[test]
+fn lights_lists_mesh_lights_and_portals() {
+    let scene = repo_file("tests/data/usd/mesh/mesh_lights.usda");
+    let exp: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(repo_file("tests/data/usd/expected/mesh_lights.json")).unwrap(),
+    )
+    .unwrap();
+    let earliest = &exp["samples"][0];
+    assert!(earliest["time"].is_null());
+    let o = luxeval(&["lights", &scene, "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let lights = v["lights"].as_array().unwrap();
+    let record = |path: &str| lights.iter().find(|l| l["path"] == path).unwrap();
+    for e in earliest["meshes"].as_array().unwrap() {
+        let l = record(e["path"].as_str().unwrap());
+        assert_eq!(l["evaluable"], false, "{l}");
+        let m = &l["mesh"];
+        assert_eq!(m["triangles"], e["triangles"], "{l}");
+        let (area, want) = (m["area"].as_f64().unwrap(), e["area"].as_f64().unwrap());
+        assert!((area - want).abs() <= 1e-6 * want, "{l}");
+        assert_eq!(m["double_sided"], e["double_sided"], "{l}");
+        assert_eq!(m["subdivision_scheme"], e["subdivision_scheme"], "{l}");
+        for k in 0..3 {
+            let t = m["tint"][k].as_f64().unwrap();
+            assert!((t - e["tint"][k].as_f64().unwrap()).abs() <= 1e-6, "{l}");
+        }
+        assert!(
+            m["tint_source"].as_str().is_some_and(|s| !s.is_empty()),
+            "{l}"
+        );
+    }
+    for e in earliest["portals"].as_array().unwrap() {
+        let l = record(e["path"].as_str().unwrap());
+        assert_eq!(l["portal"]["width"], e["width"], "{l}");
+        assert_eq!(l["portal"]["height"], e["height"], "{l}");
+        assert_eq!(l["portal"]["domes"], e["domes"], "{l}");
+    }
+    // intensity 2 · 2^exposure 1 · color (1, 0.5, 0.25).
+    assert_eq!(
+        record("/World/Window")["portal"]["multiplier"],
+        serde_json::json!([4.0, 2.0, 1.0])
+    );
+    for e in earliest["domes"].as_array().unwrap() {
+        assert_eq!(record(e["path"].as_str().unwrap())["portals"], e["portals"]);
+    }
+    // Other lights' records have no such fields.
+    assert!(record("/World/Sky").get("mesh").is_none());
+
+    let o = luxeval(&["lights", &scene]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for want in [
+        "/World/Signs/Quads (Mesh) [read, not evaluated yet]",
+        "  mesh  4 triangles (0 hole faces removed, 0 degenerate triangles dropped), area 4.000000, doubleSided false",
+        "  tint  (2, 1, 0.5) from emissiveColor of /World/Looks/Glow/Surface (authored)",
+        "/World/Window (PortalLight) [read, not evaluated yet]",
+        "  portal  2 x 1.5, multiplier (4, 2, 1), named by /World/Sky",
+        "  portal  1 x 1, multiplier (1, 1, 1), named by no dome",
+        "  portals  /World/Window, /World/Signs/Quads",
+    ] {
+        assert!(text.contains(want), "{want:?} not in:\n{text}");
+    }
+
+    // Bad topology: listed with the attribute named, refused by the queries.
+    let o = luxeval(&[
+        "lights",
+        &repo_file("tests/data/usd/mesh/bad/count_below_3.usda"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("/Bad: faceVertexCounts") && text.contains("the queries refuse this light"),
+        "{text}"
+    );
+}
+
 /// The fixture of what a renderer applies and luxeval does not (tests/data/usd/unapplied/,
 /// made with usd-core by tools/gen_usd_fixtures.py --only-unapplied).
 fn unapplied_scene() -> String {

@@ -331,7 +331,11 @@ impl Stage {
     /// collections that restrict the light, each with ``name``, ``include_root``,
     /// ``includes``, ``excludes``, ``expansion_rule``, ``membership_expression``) and
     /// ``shaping_without_api`` (``inputs:shaping:*`` authored without ShapingAPI: the light is
-    /// evaluated unshaped)). A new list on each access.
+    /// evaluated unshaped)); a mesh light's ``mesh`` (``triangles``, ``area``, ``holes``,
+    /// ``degenerate_triangles``, ``folded_faces``, ``tint``, ``tint_source``, ``double_sided``,
+    /// ``subdivision_scheme``, ``subdivision``), a portal's ``portal`` (``width``, ``height``,
+    /// its multiplier inputs, ``multiplier``, ``domes``) and a dome's ``portals`` (read, not
+    /// evaluated yet). A new list on each access.
     #[getter]
     fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         py.import(intern!(py, "json"))?

@@ -14,6 +14,9 @@ import luxeval
 from helpers import LUXTEST, REPO, STUDIO, cli_query, floor_points, run_cli, sphere_dirs
 
 LUXTEST_SCENES = sorted(LUXTEST.glob("*.usda"))
+# Mesh lights and portals (read, not evaluated yet): their records carry ``mesh``, ``portal``
+# and a dome's ``portals`` (tools/gen_usd_fixtures.py --only-mesh).
+MESH_SCENE = REPO / "tests" / "data" / "usd" / "mesh" / "mesh_lights.usda"
 
 
 def test_luxtest_scenes_are_there():
@@ -21,7 +24,7 @@ def test_luxtest_scenes_are_there():
     assert len(LUXTEST_SCENES) >= 10, LUXTEST_SCENES
 
 
-@pytest.mark.parametrize("scene", [STUDIO, *LUXTEST_SCENES], ids=lambda p: p.stem)
+@pytest.mark.parametrize("scene", [STUDIO, *LUXTEST_SCENES, MESH_SCENE], ids=lambda p: p.stem)
 @pytest.mark.parametrize("time", [None, 5.0], ids=["default-time", "time-5"])
 def test_lights_are_the_records_of_lights_json(cli, scene, time):
     args = ["lights", scene, "--json"] + ([] if time is None else ["--time", time])

@@ -4,6 +4,8 @@
 
 pub mod asset;
 pub mod light;
+pub mod mesh;
+pub mod portal;
 pub mod schema;
 pub mod value;
 
@@ -12,4 +14,6 @@ pub use light::{
     Ies, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFilter, TextureFormat,
     UpAxis,
 };
+pub use mesh::{MeshGeometry, MeshLight, MeshTopology, MeshTriangle, Tint, TopologyError};
+pub use portal::Portal;
 pub use value::{Input, Value};

@@ -96,6 +96,22 @@ pub mod portal {
     pub const WIDTH: f64 = 1.0;
     pub const HEIGHT: f64 = 1.0;
 }
+/// MeshLightAPI's own fallback (spec/001 "MeshLightAPI"; DESIGN.md §7 M2).
+pub mod mesh_light_api {
+    pub const MATERIAL_SYNC_MODE: &str = "materialGlowTintsLight";
+}
+/// The UsdGeom Mesh attributes a mesh light's geometry reads (DESIGN.md §7 M1): Gprim's
+/// `orientation` and `doubleSided`, Mesh's `subdivisionScheme`.
+pub mod mesh {
+    pub const ORIENTATION: &str = "rightHanded";
+    pub const DOUBLE_SIDED: bool = false;
+    pub const SUBDIVISION_SCHEME: &str = "catmullClark";
+}
+/// UsdPreviewSurface's `inputs:emissiveColor` fallback, the tint of a mesh light whose bound
+/// material authors none (DESIGN.md §7 M2). Not a light attribute, so not a row of [`TABLE`].
+pub mod preview_surface {
+    pub const EMISSIVE_COLOR: [f64; 3] = [0.0, 0.0, 0.0];
+}
 
 use Fallback::{Asset, Bool, Color, Float, Token};
 
@@ -217,6 +233,16 @@ pub const TABLE: &[SchemaAttr] = &[
     attr("DomeLight_1", "poleAxis", Token(dome::POLE_AXIS)),
     attr("PortalLight", "inputs:width", Float(portal::WIDTH)),
     attr("PortalLight", "inputs:height", Float(portal::HEIGHT)),
+    // A MeshLightAPI prim is a Mesh (DESIGN.md §7 M1): the geometry's uniform attributes with
+    // their fallbacks; the arrays (points, counts, indices, holes) have none and are read apart.
+    attr("Mesh", "orientation", Token(mesh::ORIENTATION)),
+    attr("Mesh", "doubleSided", Bool(mesh::DOUBLE_SIDED)),
+    attr("Mesh", "subdivisionScheme", Token(mesh::SUBDIVISION_SCHEME)),
+    attr(
+        "MeshLightAPI",
+        "light:materialSyncMode",
+        Token(mesh_light_api::MATERIAL_SYNC_MODE),
+    ),
 ];
 
 /// The attributes of a prim of USD type `type_name` with the applied API schemas `applied`

@@ -1,19 +1,29 @@
 //! The light records `luxeval lights --json` writes and the Python package's `Stage.lights`
 //! returns: the stage's records with each light's total power (one definition for both).
 
+use glam::DVec3;
+
+use crate::model::Portal;
 use crate::prepare::TemperatureMode;
+use crate::prepare::blackbody::temperature_rgb;
 use crate::usd::Stage;
 
 use super::Reference;
 
 /// `scene.lights` as JSON, each record with `power` ([`Reference::power`]: `rgb`, `lumens`,
 /// `watts`; null for lights at infinity or not evaluated) and, when the light cannot be prepared
-/// (a missing IES file, ...), `power_error` with the reason.
+/// (a missing IES file, ...), `power_error` with the reason. A portal's record adds its
+/// `multiplier` ([`portal_multiplier`]) to its `portal` summary.
 pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
     let mut v = serde_json::to_value(&scene.lights)?;
     if let Some(records) = v.as_array_mut() {
         for (json, l) in records.iter_mut().zip(&scene.lights) {
             json["power"] = serde_json::Value::Null;
+            if let Some(p) = &l.portal {
+                json["portal"]["multiplier"] = serde_json::to_value(
+                    portal_multiplier(p, TemperatureMode::default()).to_array(),
+                )?;
+            }
             let Some(light) = &l.light else { continue };
             match Reference::new(light, TemperatureMode::default()) {
                 Ok(r) => {
@@ -32,4 +42,15 @@ pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
         }
     }
     Ok(v)
+}
+
+/// A portal's multiplier (DESIGN.md §8 P2): its own LightAPI product `intensity · 2^exposure ·
+/// color ⊙ temperature(T)`, as a light's base radiance is formed.
+pub fn portal_multiplier(p: &Portal, mode: TemperatureMode) -> DVec3 {
+    let tint = if p.enable_color_temperature {
+        temperature_rgb(p.color_temperature, mode)
+    } else {
+        DVec3::ONE
+    };
+    p.intensity * 2f64.powf(p.exposure) * p.color * tint
 }

@@ -19,7 +19,7 @@ use crate::prepare::TemperatureMode;
 #[cfg(feature = "usd")]
 mod lights;
 #[cfg(feature = "usd")]
-pub use lights::lights_json;
+pub use lights::{lights_json, portal_multiplier};
 pub use reference::{Power, Reference};
 pub use sample::{SampleOptions, SamplerCheck, Samples, Selection, StrategyVariance};
 pub use scene::PreparedScene;

@@ -5,8 +5,8 @@ use glam::DVec3;
 
 use super::stage as usd;
 use crate::model::{
-    Asset, Ies, Light, LightInputs, LightType, PoleAxis, Shaping, Texture, TextureFormat, UpAxis,
-    Value,
+    Asset, Ies, Light, LightInputs, LightType, MeshLight, PoleAxis, Portal, Shaping, Texture,
+    TextureFormat, UpAxis, Value,
 };
 
 /// Reads typed inputs of one light; a missing input (the schema table lacks it) or a value of the
@@ -100,6 +100,123 @@ impl From<String> for NotEvaluated {
     }
 }
 
+/// What luxeval reads a light prim as.
+#[derive(Debug)]
+pub(super) enum Read {
+    /// A light the queries evaluate.
+    Light(Light),
+    /// A mesh light (DESIGN.md §7): read, not evaluated yet.
+    Mesh(MeshLight),
+    /// A portal (DESIGN.md §8): read, not evaluated yet; its domes are filled in by the scene.
+    Portal(Portal),
+}
+
+/// What `p` is read as, with an optional caveat (naming the prim); or why it is not read.
+/// `max_mesh_triangles` bounds a mesh light's triangles (docs/INPUTS.md "Limits").
+pub(super) fn read(
+    p: &usd::LightPrim,
+    up: UpAxis,
+    max_mesh_triangles: u64,
+) -> std::result::Result<(Read, Option<String>), NotEvaluated> {
+    let r = Reader { p };
+    let caveat = |mut own: Vec<String>| {
+        own.extend(unapplied_caveats(p));
+        (!own.is_empty()).then(|| own.join("; "))
+    };
+    if p.transform_error.is_none()
+        && let Some(arrays) = &p.mesh
+    {
+        let (inputs, shaping) = light_inputs(&r)?;
+        let (mesh, warnings) = super::mesh::convert(
+            p,
+            arrays,
+            inputs,
+            shaping,
+            |name| r.token(name).map(str::to_string),
+            |name| r.bool(name),
+            max_mesh_triangles,
+        )?;
+        return Ok((Read::Mesh(mesh), caveat(warnings)));
+    }
+    if p.transform_error.is_none() && p.usd_type == "PortalLight" {
+        let (portal, warnings) = portal(&r)?;
+        return Ok((Read::Portal(portal), caveat(warnings)));
+    }
+    convert(p, up).map(|(light, caveat)| (Read::Light(light), caveat))
+}
+
+/// A `PortalLight` (DESIGN.md §8 P1): its size and multiplier inputs; normalize and ShapingAPI
+/// do not apply to a portal, so authoring them is said.
+fn portal(r: &Reader) -> std::result::Result<(Portal, Vec<String>), NotEvaluated> {
+    let p = r.p;
+    let mut warnings = Vec::new();
+    if p.inputs
+        .iter()
+        .any(|i| i.name == "inputs:normalize" && i.authored)
+    {
+        warnings.push(format!(
+            "{}: inputs:normalize does not apply to a portal (DESIGN.md §8 P1), ignored",
+            p.path
+        ));
+    }
+    if p.applied_schemas.iter().any(|s| s == "ShapingAPI") {
+        warnings.push(format!(
+            "{}: ShapingAPI does not apply to a portal (DESIGN.md §8 P1), ignored",
+            p.path
+        ));
+    }
+    Ok((
+        Portal {
+            path: p.path.clone(),
+            width: r.float("inputs:width")?,
+            height: r.float("inputs:height")?,
+            intensity: r.float("inputs:intensity")?,
+            exposure: r.float("inputs:exposure")?,
+            color: r.color("inputs:color")?,
+            enable_color_temperature: r.bool("inputs:enableColorTemperature")?,
+            color_temperature: r.float("inputs:colorTemperature")?,
+            world: glam::DMat4::from_cols_array_2d(&p.world),
+            domes: Vec::new(),
+        },
+        warnings,
+    ))
+}
+
+/// LightAPI's inputs and, where ShapingAPI is applied, the shaping (every light type's).
+fn light_inputs(r: &Reader) -> std::result::Result<(LightInputs, Option<Shaping>), NotEvaluated> {
+    let inputs = LightInputs {
+        intensity: r.float("inputs:intensity")?,
+        exposure: r.float("inputs:exposure")?,
+        color: r.color("inputs:color")?,
+        enable_color_temperature: r.bool("inputs:enableColorTemperature")?,
+        color_temperature: r.float("inputs:colorTemperature")?,
+        normalize: r.bool("inputs:normalize")?,
+        diffuse: r.float("inputs:diffuse")?,
+        specular: r.float("inputs:specular")?,
+    };
+    let shaped = r.p.applied_schemas.iter().any(|s| s == "ShapingAPI");
+    let shaping = if shaped {
+        Some(Shaping {
+            focus: r.float("inputs:shaping:focus")?,
+            focus_tint: r.color("inputs:shaping:focusTint")?,
+            cone_angle: r.float("inputs:shaping:cone:angle")?,
+            cone_softness: r.float("inputs:shaping:cone:softness")?,
+            // DESIGN.md §6 I7: IES inputs are read only where ShapingAPI is applied.
+            ies: match r.asset_ref("inputs:shaping:ies:file") {
+                Some(file) => Some(Ies {
+                    file,
+                    angle_scale: r.float("inputs:shaping:ies:angleScale")?,
+                    normalize: r.bool("inputs:shaping:ies:normalize")?,
+                }),
+                None => None,
+            },
+        })
+    } else {
+        None
+    };
+    Ok((inputs, shaping))
+}
+
 /// The light luxeval evaluates for `p`, with an optional caveat; or why it is not evaluated.
 pub(super) fn convert(
     p: &usd::LightPrim,
@@ -129,7 +246,9 @@ pub(super) fn convert(
             "" => "an untyped prim".to_string(),
             ty => format!("a {ty} prim"),
         };
-        return Err(format!("{path}: {api} lights (on {on}) are not supported yet").into());
+        // A Mesh with MeshLightAPI is read by [`read`]; MeshLightAPI on another type and
+        // VolumeLightAPI are listed and skipped (DESIGN.md §7 M1).
+        return Err(format!("{path}: {api} lights (on {on}) are not supported").into());
     }
     let kind = match ty {
         "DistantLight" => LightType::Distant {
@@ -153,10 +272,8 @@ pub(super) fn convert(
         },
         "DomeLight" | "DomeLight_1" => LightType::Dome,
         "PortalLight" => {
-            return Err(format!(
-                "{path}: PortalLight is not supported yet (it shapes a dome light's emission)"
-            )
-            .into());
+            // Read by [`read`] as a portal, never evaluated as a light (DESIGN.md §8 P1).
+            return Err(format!("{path}: a PortalLight is a portal of a dome, not a light").into());
         }
         "GeometryLight" => {
             return Err(format!(
@@ -176,35 +293,7 @@ pub(super) fn convert(
         _ => None,
     };
     let shaped = p.applied_schemas.iter().any(|s| s == "ShapingAPI");
-    let inputs = LightInputs {
-        intensity: r.float("inputs:intensity")?,
-        exposure: r.float("inputs:exposure")?,
-        color: r.color("inputs:color")?,
-        enable_color_temperature: r.bool("inputs:enableColorTemperature")?,
-        color_temperature: r.float("inputs:colorTemperature")?,
-        normalize: r.bool("inputs:normalize")?,
-        diffuse: r.float("inputs:diffuse")?,
-        specular: r.float("inputs:specular")?,
-    };
-    let shaping = if shaped {
-        Some(Shaping {
-            focus: r.float("inputs:shaping:focus")?,
-            focus_tint: r.color("inputs:shaping:focusTint")?,
-            cone_angle: r.float("inputs:shaping:cone:angle")?,
-            cone_softness: r.float("inputs:shaping:cone:softness")?,
-            // DESIGN.md §6 I7: IES inputs are read only where ShapingAPI is applied.
-            ies: match r.asset_ref("inputs:shaping:ies:file") {
-                Some(file) => Some(Ies {
-                    file,
-                    angle_scale: r.float("inputs:shaping:ies:angleScale")?,
-                    normalize: r.bool("inputs:shaping:ies:normalize")?,
-                }),
-                None => None,
-            },
-        })
-    } else {
-        None
-    };
+    let (inputs, shaping) = light_inputs(&r)?;
     let mut caveats: Vec<String> = Vec::new();
     if shaped && !kind.is_shapeable() {
         caveats.push(format!(
@@ -330,6 +419,8 @@ pub(super) mod tests {
             inputs,
             stray_inputs: Vec::new(),
             extras: Default::default(),
+            mesh: None,
+            portals: Vec::new(),
         }
     }
 
@@ -422,14 +513,15 @@ pub(super) mod tests {
         );
         assert!(convert(&empty, UpAxis::Y).is_ok());
 
-        for ty in ["PortalLight", "GeometryLight", "PluginLight"] {
+        for ty in ["GeometryLight", "PluginLight"] {
             let e = convert(&prim(ty, &[]), UpAxis::Y).unwrap_err().to_string();
             assert!(e.contains(ty) && e.contains("/Lights/"), "{e}");
         }
-        let mut mesh = prim("Mesh", &["MeshLightAPI"]);
-        mesh.light_api = Some("MeshLightAPI".into());
-        let e = convert(&mesh, UpAxis::Y).unwrap_err().to_string();
-        assert!(e.contains("MeshLightAPI"), "{e}");
+        // MeshLightAPI on a prim that is not a Mesh has no geometry to read.
+        let mut xform = prim("Xform", &["MeshLightAPI"]);
+        xform.light_api = Some("MeshLightAPI".into());
+        let e = convert(&xform, UpAxis::Y).unwrap_err().to_string();
+        assert!(e.contains("MeshLightAPI") && e.contains("Xform"), "{e}");
     }
 
     #[test]

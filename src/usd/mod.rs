@@ -23,6 +23,7 @@
 mod arcs;
 mod diagnostics;
 mod light;
+mod mesh;
 mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;

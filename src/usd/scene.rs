@@ -10,11 +10,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::light::{NotEvaluated, RefusedInput, convert};
+use super::light::{NotEvaluated, Read, RefusedInput, read};
 use super::stage::{self as usd, UsdStage};
 use super::unapplied::{LightList, LinkCollection};
 use crate::error::{LuxError, Result};
-use crate::model::{Input, Light, UpAxis};
+use crate::model::{Input, Light, MeshLight, Portal, UpAxis};
 
 /// Which time the stage was read at.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -62,6 +62,78 @@ pub struct StageLight {
     /// schema does not have them), so luxeval evaluates it unshaped, as the schema says a
     /// renderer must (DESIGN.md §2). Empty where ShapingAPI is applied.
     pub shaping_without_api: Vec<String>,
+    /// A `Mesh` with MeshLightAPI, read (DESIGN.md §7 M1, M2) and not evaluated yet: the
+    /// queries skip it, as `light` is `None`. Serialized as a summary (triangle count, area,
+    /// tint and its source, doubleSided, subdivision), absent for other lights.
+    #[serde(
+        serialize_with = "mesh_summary",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub mesh: Option<MeshLight>,
+    /// A `PortalLight`, read (DESIGN.md §8 P1) with the domes that name it; not evaluated yet.
+    /// Serialized as a summary, absent for other lights.
+    #[serde(
+        serialize_with = "portal_summary",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub portal: Option<Portal>,
+    /// A dome's `portals` relationship, its targets as composed (also those that are not
+    /// PortalLights, which change nothing and are warned about); `None` for other lights.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub portals: Option<Vec<String>>,
+}
+
+/// Whether a mesh light's `subdivisionScheme` leaves its control cage to be evaluated as
+/// polygons (anything but `none`, DESIGN.md §7 M1).
+pub(crate) fn cage_only(scheme: &str) -> bool {
+    scheme != "none"
+}
+
+fn mesh_summary<S: serde::Serializer>(
+    mesh: &Option<MeshLight>,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    let Some(m) = mesh else {
+        return s.serialize_none();
+    };
+    let g = &m.geometry;
+    serde_json::json!({
+        "triangles": g.triangles.len(),
+        "area": g.area,
+        "holes": g.holes,
+        "degenerate_triangles": g.degenerate,
+        "folded_faces": g.folded_faces.len(),
+        "tint": m.tint.rgb.to_array(),
+        "tint_source": m.tint.source,
+        "double_sided": m.double_sided,
+        "subdivision_scheme": m.subdivision_scheme,
+        "subdivision": if cage_only(&m.subdivision_scheme) {
+            "not applied: the control cage is evaluated as polygons"
+        } else {
+            "none"
+        },
+    })
+    .serialize(s)
+}
+
+fn portal_summary<S: serde::Serializer>(
+    portal: &Option<Portal>,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    let Some(p) = portal else {
+        return s.serialize_none();
+    };
+    serde_json::json!({
+        "width": p.width,
+        "height": p.height,
+        "intensity": p.intensity,
+        "exposure": p.exposure,
+        "color": p.color.to_array(),
+        "enable_color_temperature": p.enable_color_temperature,
+        "color_temperature": p.color_temperature,
+        "domes": p.domes,
+    })
+    .serialize(s)
 }
 
 fn serialize_is_some<S: serde::Serializer>(
@@ -120,6 +192,24 @@ impl Stage {
             let stage = usd.read(time)?;
             Ok((stage, usd))
         })
+    }
+
+    /// The portals the dome at `dome` names that are PortalLights of the stage, in the order of
+    /// its `portals` relationship (DESIGN.md §8 P1); visibility is the caller's to apply.
+    pub fn portals_of(&self, dome: &str) -> Vec<&Portal> {
+        let Some(targets) = self
+            .lights
+            .iter()
+            .find(|l| l.path == dome)
+            .and_then(|l| l.portals.as_ref())
+        else {
+            return Vec::new();
+        };
+        targets
+            .iter()
+            .filter_map(|t| self.lights.iter().find(|l| &l.path == t))
+            .filter_map(|l| l.portal.as_ref())
+            .collect()
     }
 
     /// Visible, evaluable lights in traversal order; `select` (prim paths) filters when
@@ -263,11 +353,13 @@ impl UsdStage {
         } else {
             UpAxis::Y
         };
-        let lights = self
+        let max_mesh_triangles = self.limits().max_mesh_triangles;
+        let mut lights: Vec<StageLight> = self
             .lights_at(at)?
             .into_iter()
-            .map(|p| StageLight::from_prim(p, up))
+            .map(|p| StageLight::from_prim(p, up, max_mesh_triangles))
             .collect();
+        attach_portals(&mut lights);
         Ok(Stage {
             file: self.file().to_path_buf(),
             up_axis: info.up_axis.clone(),
@@ -364,10 +456,86 @@ fn describe_time(rule: TimeRule) -> String {
     }
 }
 
+/// Attaches every PortalLight to the domes whose `portals` relationship names it, and says
+/// what changes nothing (DESIGN.md §8 P1): a target that is not a PortalLight of the stage, and
+/// a PortalLight that no dome names.
+fn attach_portals(lights: &mut [StageLight]) {
+    let named: Vec<(String, Vec<String>)> = lights
+        .iter()
+        .filter_map(|l| Some((l.path.clone(), l.portals.clone()?)))
+        .collect();
+    for (dome, targets) in named {
+        let mut not_portals = Vec::new();
+        for target in targets {
+            match lights
+                .iter_mut()
+                .find(|l| l.path == target)
+                .and_then(|l| l.portal.as_mut())
+            {
+                Some(portal) => portal.domes.push(dome.clone()),
+                None => not_portals.push(target),
+            }
+        }
+        if !not_portals.is_empty()
+            && let Some(l) = lights.iter_mut().find(|l| l.path == dome)
+        {
+            add_warning(
+                &mut l.warning,
+                format!(
+                    "{dome}: portals names {}, not a PortalLight of the stage: changes nothing (DESIGN.md §8 P1)",
+                    not_portals.join(", ")
+                ),
+            );
+        }
+    }
+    for l in lights.iter_mut() {
+        if let Some(p) = &l.portal
+            && p.domes.is_empty()
+        {
+            let w = format!(
+                "{}: no dome's portals relationship names this portal: it changes nothing (DESIGN.md §8 P1)",
+                l.path
+            );
+            add_warning(&mut l.warning, w);
+        }
+    }
+}
+
+fn add_warning(warning: &mut Option<String>, more: String) {
+    *warning = Some(match warning.take() {
+        Some(w) => format!("{w}; {more}"),
+        None => more,
+    });
+}
+
+fn join(first: String, then: Option<String>) -> String {
+    match then {
+        Some(then) => format!("{first}; {then}"),
+        None => first,
+    }
+}
+
 impl StageLight {
-    fn from_prim(p: usd::LightPrim, up: UpAxis) -> StageLight {
-        let (light, warning, refusal) = match convert(&p, up) {
-            Ok((light, caveat)) => (Some(light), caveat, None),
+    fn from_prim(p: usd::LightPrim, up: UpAxis, max_mesh_triangles: u64) -> StageLight {
+        let (mut mesh, mut portal) = (None, None);
+        let (light, warning, refusal) = match read(&p, up, max_mesh_triangles) {
+            Ok((Read::Light(light), caveat)) => (Some(light), caveat, None),
+            // Read, and skipped by every query until they are evaluated: said on every query.
+            Ok((Read::Mesh(m), caveat)) => {
+                let read = format!(
+                    "{}: mesh light ({} triangles, area {}) read, not evaluated yet: skipped",
+                    p.path,
+                    m.geometry.triangles.len(),
+                    m.geometry.area
+                );
+                mesh = Some(m);
+                (None, Some(join(read, caveat)), None)
+            }
+            Ok((Read::Portal(pl), caveat)) => {
+                let read = format!("{}: portal read, not evaluated yet: skipped", p.path);
+                portal = Some(pl);
+                (None, Some(join(read, caveat)), None)
+            }
             Err(NotEvaluated::Skipped(why)) => (None, Some(why), None),
             Err(NotEvaluated::Refused(r)) => (
                 None,
@@ -378,6 +546,7 @@ impl StageLight {
                 Some(r),
             ),
         };
+        let is_dome = matches!(p.usd_type.as_str(), "DomeLight" | "DomeLight_1");
         StageLight {
             path: p.path,
             usd_type: p.usd_type,
@@ -391,6 +560,9 @@ impl StageLight {
             light_filters: p.extras.filters,
             link_collections: p.extras.link_collections,
             shaping_without_api: p.extras.shaping_without_api,
+            mesh,
+            portal,
+            portals: is_dome.then_some(p.portals),
         }
     }
 
@@ -405,9 +577,14 @@ mod tests {
     use super::*;
     use crate::usd::light::tests::prim;
 
+    fn max_triangles() -> u64 {
+        crate::limits::Limits::default().max_mesh_triangles
+    }
+
     #[test]
     fn evaluable_filters_and_rejects_unknown_selection() {
-        let mut hidden = StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
+        let mut hidden =
+            StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y, max_triangles());
         hidden.path = "/Lights/Hidden".into();
         hidden.visible = false;
         let scene = Stage {
@@ -416,8 +593,8 @@ mod tests {
             meters_per_unit: 0.01,
             time: TimeRule::Earliest,
             lights: vec![
-                StageLight::from_prim(prim("DiskLight", &[]), UpAxis::Y),
-                StageLight::from_prim(prim("PortalLight", &[]), UpAxis::Y),
+                StageLight::from_prim(prim("DiskLight", &[]), UpAxis::Y, max_triangles()),
+                StageLight::from_prim(prim("PortalLight", &[]), UpAxis::Y, max_triangles()),
                 hidden,
             ],
             stage_warnings: Vec::new(),
@@ -446,7 +623,7 @@ mod tests {
     #[test]
     fn unapplied_counts_the_evaluated_lights() {
         let with_filter = |ty: &str, visible: bool| {
-            let mut l = StageLight::from_prim(prim(ty, &[]), UpAxis::Y);
+            let mut l = StageLight::from_prim(prim(ty, &[]), UpAxis::Y, max_triangles());
             l.light_filters = vec!["/F".into()];
             l.visible = visible;
             l
@@ -457,7 +634,7 @@ mod tests {
             meters_per_unit: 0.01,
             time: TimeRule::Earliest,
             lights: vec![
-                StageLight::from_prim(prim("DiskLight", &[]), UpAxis::Y),
+                StageLight::from_prim(prim("DiskLight", &[]), UpAxis::Y, max_triangles()),
                 with_filter("PortalLight", true),
                 with_filter("SphereLight", false),
             ],
@@ -487,7 +664,7 @@ mod tests {
 
     #[test]
     fn json_shape() {
-        let l = StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y);
+        let l = StageLight::from_prim(prim("SphereLight", &[]), UpAxis::Y, max_triangles());
         let v = serde_json::to_value(&l).unwrap();
         assert_eq!(v["evaluable"], serde_json::json!(true));
         assert_eq!(v["inputs"][0]["value"], serde_json::json!(1.0));

@@ -10,6 +10,7 @@ use openusd_schemas::geom::{Xformable, XformableExt};
 
 use super::arcs::preflight;
 use super::diagnostics::{check_composition, open_error, stage_error};
+use super::mesh::{MeshArrays, read_arrays};
 use super::resolver::LimitedResolver;
 use super::unapplied::{self, LightExtras, LightList, ListSite};
 use super::values::{convert, reject_spline, value_at, visible_at};
@@ -95,6 +96,11 @@ pub(crate) struct LightPrim {
     pub stray_inputs: Vec<String>,
     /// Filters, link collections, shaping inputs without ShapingAPI: read, not applied, said so.
     pub extras: LightExtras,
+    /// A `Mesh` with MeshLightAPI: its arrays and material glow at the time (DESIGN.md §7 M1).
+    pub mesh: Option<MeshArrays>,
+    /// A dome's `portals` relationship, its targets as composed (DESIGN.md §8 P1); empty for
+    /// other lights.
+    pub portals: Vec<String>,
 }
 
 /// What does not change with time: found once at open.
@@ -114,6 +120,10 @@ struct LightSite {
     stray_inputs: Vec<String>,
     /// See [`LightPrim::extras`].
     extras: LightExtras,
+    /// A `Mesh` with MeshLightAPI: its arrays are read at each time.
+    mesh_light: bool,
+    /// See [`LightPrim::portals`]; relationships do not vary with time.
+    portals: Vec<String>,
     /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
     /// usd-core between samples (see [`super::xform::needs_own_xform`]); its world matrix is
     /// composed here.
@@ -132,6 +142,9 @@ pub struct UsdStage {
     warnings: Vec<String>,
     /// The prims that author a `lightList`, in traversal order.
     light_lists: Vec<ListSite>,
+    /// The limits in force when the stage was opened (a mesh light's triangles are counted at
+    /// each read).
+    limits: Limits,
     // Keeps the composed stage alive for the prim handles above.
     _stage: ousd::Stage,
 }
@@ -298,7 +311,10 @@ impl UsdStage {
                 .iter()
                 .map(|t| t.as_str())
                 .filter(|n| {
-                    schema::TABLE.iter().any(|a| a.name == *n)
+                    // The Mesh rows are geometry any Gprim may author, not light inputs.
+                    schema::TABLE
+                        .iter()
+                        .any(|a| a.name == *n && a.schema != "Mesh")
                         && !attrs.iter().any(|a| a.name == *n)
                 })
                 .map(str::to_string)
@@ -335,7 +351,20 @@ impl UsdStage {
                 own_xform_chain |= own;
                 own_xform_chain_of.insert(path, own_xform_chain);
             }
+            let mesh_light = usd_type == "Mesh" && light_api.as_deref() == Some("MeshLightAPI");
+            let portals = match usd_type.as_str() {
+                "DomeLight" | "DomeLight_1" => prim
+                    .relationship("portals")
+                    .targets()
+                    .map_err(e)?
+                    .iter()
+                    .map(sdf::Path::to_string)
+                    .collect(),
+                _ => Vec::new(),
+            };
             lights.push(LightSite {
+                mesh_light,
+                portals,
                 path: p.to_string(),
                 prim,
                 usd_type,
@@ -366,6 +395,7 @@ impl UsdStage {
             lights,
             warnings,
             light_lists,
+            limits,
             _stage: stage,
         })
     }
@@ -385,6 +415,11 @@ impl UsdStage {
 
     pub fn info(&self) -> &StageInfo {
         &self.info
+    }
+
+    /// The limits in force since the stage was opened.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
     }
 
     /// The file the stage was opened from.
@@ -439,6 +474,11 @@ impl UsdStage {
                 inputs,
                 stray_inputs: site.stray_inputs.clone(),
                 extras: site.extras.clone(),
+                mesh: match site.mesh_light {
+                    true => Some(read_arrays(&site.prim, &site.path, tc)?),
+                    false => None,
+                },
+                portals: site.portals.clone(),
             });
         }
         Ok(out)
