@@ -112,8 +112,9 @@ pub struct Record {
     pub pad: [u32; 2],
     /// The light choice of GPU-resident sampling (`shaders/sample/select.wgsl`): (power weight,
     /// the luminance weight of `base`, the world bounding-sphere radius, 0), each weight divided
-    /// by the scene's largest (`query::scene` fills them; `cpu::sample::select` has the f64
-    /// weights).
+    /// by the scene's largest (`cpu::sample::select` has the f64 weights; `query::scene` fills
+    /// the luminance weight, and the power weight only in the sampling records of a
+    /// `Selection::Power` call, `gpu::sample::SampleLights::with_power`).
     pub select: [f32; 4],
 }
 

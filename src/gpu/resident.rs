@@ -178,13 +178,15 @@ pub(crate) const LLVMPIPE_SAMPLE_LIGHTS: usize = 16_384;
 
 /// What one GPU-resident sampling call draws (`PreparedScene::encode_sample`).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct ResidentDraw {
+pub(crate) struct ResidentDraw<'a> {
     pub points: u32,
     pub per_point: u32,
     pub seed: u32,
     pub first_point: u32,
     /// `SELECT_POWER` or `SELECT_BOUND`.
     pub selection: u32,
+    /// With `SELECT_POWER`: each light's power weight, scaled to the scene's largest.
+    pub power: Option<&'a [f32]>,
 }
 
 impl GpuContext {
@@ -203,7 +205,7 @@ impl GpuContext {
         points: Operand<'_>,
         normals: Option<Operand<'_>>,
         out: Operand<'_>,
-        draw: ResidentDraw,
+        draw: ResidentDraw<'_>,
     ) -> Result<()> {
         if draw.per_point == 0 {
             return Err(LuxError::input(
@@ -266,6 +268,11 @@ impl GpuContext {
         if count == 0 {
             return Ok(());
         }
+        // By power: the records with the power weights filled (uploaded once).
+        let records = match draw.power {
+            Some(weights) => sampling.with_power(self, weights),
+            None => &sampling.buffer,
+        };
         let align = self.params_align();
         let mut block = params_block(&[(0, n_lights)], align, count, false, grid);
         let params = Params {
@@ -291,7 +298,7 @@ impl GpuContext {
             encoder,
             Kernel::SampleResident,
             lights,
-            Some(sampling),
+            Some((records, &sampling.tex_atlas)),
             &block,
             1,
             bound,
@@ -303,8 +310,8 @@ impl GpuContext {
 
 impl GpuContext {
     /// Records `kernel` over the caller's buffers (`bound`: binding 2, 3 and 4 with the bytes
-    /// each call reads or writes; the records and texture atlas of `sampling` where given, in
-    /// place of the scene's), one pass per Params block of `block` (`passes` of them at
+    /// each call reads or writes; `sampling`'s records and texture atlas where given, in place
+    /// of the scene's), one pass per Params block of `block` (`passes` of them at
     /// [`GpuContext::params_align`]). The Params buffer is this call's own, written at
     /// creation (nothing goes through the queue) and kept alive by the command buffer that
     /// uses it. The first call of a kernel builds its pipeline.
@@ -314,7 +321,7 @@ impl GpuContext {
         encoder: &mut wgpu::CommandEncoder,
         kernel: Kernel,
         lights: &GpuLights,
-        sampling: Option<&SampleLights>,
+        sampling: Option<(&wgpu::Buffer, &wgpu::Buffer)>,
         block: &[u8],
         passes: usize,
         bound: [(Operand<'_>, u64); 3],
@@ -330,10 +337,7 @@ impl GpuContext {
                 usage: wgpu::BufferUsages::UNIFORM,
             });
         let [(a, a_bytes), (b, b_bytes), (out, out_bytes)] = bound;
-        let (records, tex_atlas) = match sampling {
-            Some(s) => (&s.buffer, &s.tex_atlas),
-            None => (&lights.buffer, &lights.tex_atlas),
-        };
+        let (records, tex_atlas) = sampling.unwrap_or((&lights.buffer, &lights.tex_atlas));
         let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("luxeval queries (resident)"),
             layout: &self.layout,

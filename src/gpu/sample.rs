@@ -18,6 +18,33 @@ use super::{GpuContext, Kernel};
 pub(crate) struct SampleLights {
     pub(crate) buffer: wgpu::Buffer,
     pub(crate) tex_atlas: wgpu::Buffer,
+    /// The records `buffer` holds, for [`SampleLights::with_power`].
+    records: Vec<super::record::Record>,
+    /// `buffer`'s records with the power weights filled (`Record::select[0]`), uploaded on the
+    /// first `Selection::Power` GPU-resident call.
+    power: std::sync::OnceLock<wgpu::Buffer>,
+}
+
+impl SampleLights {
+    /// The records with each light's power weight (`weights[k]`, scaled to the scene's largest)
+    /// in `select[0]`, for a `Selection::Power` GPU-resident call: built and uploaded once.
+    pub(crate) fn with_power(&self, ctx: &GpuContext, weights: &[f32]) -> &wgpu::Buffer {
+        self.power.get_or_init(|| {
+            let mut records = self.records.clone();
+            for (r, w) in records.iter_mut().zip(weights) {
+                r.select[0] = *w;
+            }
+            let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lights (sampling by power)"),
+                size: std::mem::size_of_val(records.as_slice()).max(4) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            ctx.queue
+                .write_buffer(&buffer, 0, bytemuck::cast_slice(&records));
+            buffer
+        })
+    }
 }
 
 /// One row of the sample kernel's input.
@@ -71,6 +98,8 @@ impl GpuContext {
             return Ok(SampleLights {
                 buffer: lights.buffer.clone(),
                 tex_atlas: lights.tex_atlas.clone(),
+                records: lights.records.clone(),
+                power: Default::default(),
             });
         }
         let mut records = lights.records.clone();
@@ -130,7 +159,12 @@ impl GpuContext {
             self.queue
                 .write_buffer(&tex_atlas, (*base * 4) as u64, bytemuck::cast_slice(words));
         }
-        Ok(SampleLights { buffer, tex_atlas })
+        Ok(SampleLights {
+            buffer,
+            tex_atlas,
+            records,
+            power: Default::default(),
+        })
     }
 
     /// Runs the sample kernel over `rows`, in chunks that fit the device's limits.

@@ -484,7 +484,7 @@ impl PreparedScene {
     }
 
     /// The sampling tables for `selection`, built on the first call and kept.
-    fn sampling_tables(&self, selection: Selection) -> &SceneTables {
+    pub(super) fn sampling_tables(&self, selection: Selection) -> &SceneTables {
         let slot = match selection {
             Selection::Power => 0,
             Selection::Bound => 1,

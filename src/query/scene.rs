@@ -92,7 +92,7 @@ impl PreparedScene {
                     .zip(offsets)
                     .map(|((p, base), offset)| record::pack(p, base, offset))
                     .collect();
-                selection_weights_into(&lights, &mut records);
+                luminance_weights_into(&lights, &mut records);
                 g.upload(&records, &atlas.data, &tex_atlas)?
             }
         };
@@ -335,13 +335,14 @@ fn unit_row(r: [f32; 3]) -> [f32; 3] {
     [u.x as f32, u.y as f32, u.z as f32]
 }
 
-/// The light-choice weights GPU-resident sampling reads from the records (`Record::select`):
-/// each light's power weight and the luminance weight of its base (`cpu::sample::select`, in
-/// f64), each divided by the scene's largest so that f32 holds their ratios whatever the
-/// scene's units; a positive weight stays positive (at least the least normal f32).
-fn selection_weights_into(lights: &[Prepared], records: &mut [record::Record]) {
-    use crate::cpu::sample::select::{power_weight, weight_of};
-    let power: Vec<f64> = lights.iter().map(power_weight).collect();
+/// The luminance weight GPU-resident sampling's `bound` choice reads from the records
+/// (`Record::select[1]`): the luminance of each light's base (`cpu::sample::select`, in f64),
+/// divided by the scene's largest so that f32 holds their ratios whatever the scene's units.
+/// The power weights (`select[0]`) cost an integral over each shaped light's emission and are
+/// filled only in the records of a `Selection::Power` resident call
+/// (`PreparedScene::encode_sample`), from the power tables the host path builds too.
+fn luminance_weights_into(lights: &[Prepared], records: &mut [record::Record]) {
+    use crate::cpu::sample::select::weight_of;
     let luma: Vec<f64> = lights
         .iter()
         .map(|p| {
@@ -352,26 +353,28 @@ fn selection_weights_into(lights: &[Prepared], records: &mut [record::Record]) {
             }
         })
         .collect();
-    let scaled = |w: &[f64]| -> Vec<f32> {
-        let top = w
-            .iter()
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0, f64::max);
-        w.iter()
-            .map(|&v| {
-                if !(v > 0.0 && v.is_finite() && top > 0.0) {
-                    0.0
-                } else {
-                    ((v / top) as f32).max(f32::MIN_POSITIVE)
-                }
-            })
-            .collect()
-    };
-    for ((r, p), y) in records.iter_mut().zip(scaled(&power)).zip(scaled(&luma)) {
-        r.select[0] = p;
+    for (r, y) in records.iter_mut().zip(scaled_weights(&luma)) {
         r.select[1] = y;
     }
+}
+
+/// Weights divided by the largest finite one, as f32; a positive weight stays positive (at
+/// least the least normal f32), a non-finite or non-positive one is 0.
+pub(super) fn scaled_weights(w: &[f64]) -> Vec<f32> {
+    let top = w
+        .iter()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    w.iter()
+        .map(|&v| {
+            if !(v > 0.0 && v.is_finite() && top > 0.0) {
+                0.0
+            } else {
+                ((v / top) as f32).max(f32::MIN_POSITIVE)
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -63,6 +63,11 @@ pub fn env_tables(lights: &[Prepared]) -> Vec<Option<EnvTable>> {
 }
 
 impl SceneTables {
+    /// Each light's power weight (`Selection::Power` tables only; empty for the others).
+    pub fn power_weights(&self) -> &[f64] {
+        &self.power
+    }
+
     /// The tables for `selection`, sharing `env` (built once per scene by [`env_tables`]).
     pub fn new(
         lights: &[Prepared],
