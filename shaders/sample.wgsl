@@ -14,7 +14,8 @@
 //
 // draw is LightAt::new and LightAt::draw in one (WGSL has no enums to carry the strategy).
 // GPU-only drawn, fixed: Drawn's two constructors (a drawn density, or a fixed L).
-// GPU-only sample_main: the kernel's entry point (LightAt::sample's radiance step is inline).
+// GPU-only sample_main: the kernel's entry point.
+// GPU-only drawn_radiance: LightAt::sample's radiance step (both entry points share it).
 // GPU-only sample_resident_main: the GPU-resident kernel's entry point (PreparedScene::
 //   encode_sample): the light chosen on the device (sample/select.wgsl), then drawn as
 //   sample_main draws it.
@@ -174,6 +175,15 @@ fn draw(light: Record, x: vec3<f32>, n: vec3<f32>, u: vec2<f32>, keys: vec3<u32>
     return nothing;
 }
 
+// The radiance along a drawn direction: the strategy's own L where it fixes one (delta lights,
+// nothing), else the light's radiance along it where the density is positive.
+fn drawn_radiance(light: Record, x: vec3<f32>, s: Drawn) -> vec3<f32> {
+    if s.has_l {
+        return s.l;
+    }
+    return select(vec3<f32>(0.0), radiance(light, x, s.dir), s.pdf > 0.0);
+}
+
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn sample_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = sample_index(gid);
@@ -188,10 +198,7 @@ fn sample_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let seed = bitcast<u32>(in_b[4u * i + 3u]);
     let u = vec2<f32>(rng_uniform(seed, point, smp, 0u), rng_uniform(seed, point, smp, 1u));
     let s = draw(light, x, n, u, vec3<u32>(seed, point, smp));
-    var l = s.l;
-    if !s.has_l {
-        l = select(vec3<f32>(0.0), radiance(light, x, s.dir), s.pdf > 0.0);
-    }
+    let l = drawn_radiance(light, x, s);
     let o = 7u * i;
     out_rgb[o] = s.dir.x;
     out_rgb[o + 1u] = s.dir.y;
@@ -321,10 +328,7 @@ fn sample_resident_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let u = vec2<f32>(rng_uniform(seed, key, j, 0u), rng_uniform(seed, key, j, 1u));
         let s = draw(light, x, n, u, vec3<u32>(seed, key, j));
         dir = s.dir;
-        l = s.l;
-        if !s.has_l {
-            l = select(vec3<f32>(0.0), radiance(light, x, s.dir), s.pdf > 0.0);
-        }
+        l = drawn_radiance(light, x, s);
         // −1 stands for a delta light's +∞.
         pdf = select(c.y * s.pdf, bitcast<f32>(0x7f800000u), s.pdf < 0.0);
     }

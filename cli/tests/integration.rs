@@ -15,6 +15,7 @@ mod common;
 
 mod bad_inputs;
 mod cli;
+mod lights;
 mod maps;
 mod pipeline_cache;
 mod robustness;

@@ -23,6 +23,8 @@
 //    total, one more for the pick), not cached per normal as the CPU does.
 // 4. The frame is cone.wgsl's basis, the same formula as dome.rs's (cone::basis).
 // GPU-only Located: the struct standing in for locate's tuple.
+// GPU-only receiver_tiles: the receiver's tile total where the table has tiles and a normal is
+//   given, zero (the plain table) elsewhere (the twin builds EnvTable::receiver_tiles there).
 
 // #import shared/math.wgsl
 // #import shared/texture.wgsl
@@ -35,6 +37,15 @@ struct Located {
     q: vec2<f32>,
 }
 
+// The 48-bit total of the receiver's tile weights (env_table.wgsl receiver_total) where the
+// table has tiles and n is a unit normal; zero, standing for the plain table, elsewhere.
+fn receiver_tiles(t: EnvInfo, nn: vec3<f32>) -> vec2<u32> {
+    if length(nn) > 0.0 && t.tiles > 0u {
+        return receiver_total(t, nn);
+    }
+    return vec2<u32>(0u);
+}
+
 // The direction toward the dome and its density per unit world solid angle: vec4(ω, pdf).
 // `keys` = (seed, point key, sample key) of the generator, for dimensions 3–6.
 fn sample_dome(light: Record, n: vec3<f32>, u: vec2<f32>, keys: vec3<u32>) -> vec4<f32> {
@@ -42,10 +53,7 @@ fn sample_dome(light: Record, n: vec3<f32>, u: vec2<f32>, keys: vec3<u32>) -> ve
     // #if TEXTURE
     if light.tex.z != 0u {
         let t = env_info(light.tex.z);
-        var total = vec2<u32>(0u);
-        if length(nn) > 0.0 && t.tiles > 0u {
-            total = receiver_total(t, nn);
-        }
+        let total = receiver_tiles(t, nn);
         let k = pick_texel(t, nn, total, keys);
         let q = texel_point(t, k, u.x, u.y);
         let d = chart_direction(t, k, q);
@@ -119,10 +127,7 @@ fn pdf_dome(light: Record, n: vec3<f32>, w: vec3<f32>) -> f32 {
     // #if TEXTURE
     if light.tex.z != 0u {
         let t = env_info(light.tex.z);
-        var total = vec2<u32>(0u);
-        if length(nn) > 0.0 && t.tiles > 0u {
-            total = receiver_total(t, nn);
-        }
+        let total = receiver_tiles(t, nn);
         return textured_pdf(light, t, nn, total, w);
     }
     // #endif

@@ -177,7 +177,7 @@ pub(crate) const SAMPLE_ROW_FLOATS: u64 = 8;
 pub(crate) const LLVMPIPE_SAMPLE_LIGHTS: usize = 16_384;
 
 /// What one GPU-resident sampling call draws (`PreparedScene::encode_sample`).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy)]
 pub(crate) struct ResidentDraw<'a> {
     pub points: u32,
     pub per_point: u32,
@@ -185,8 +185,9 @@ pub(crate) struct ResidentDraw<'a> {
     pub first_point: u32,
     /// `SELECT_POWER` or `SELECT_BOUND`.
     pub selection: u32,
-    /// With `SELECT_POWER`: each light's power weight, scaled to the scene's largest.
-    pub power: Option<&'a [f32]>,
+    /// With `SELECT_POWER`: each light's power weight, scaled to the scene's largest (called
+    /// on the first such call of a scene only, [`SampleLights::with_power`]).
+    pub power: Option<&'a dyn Fn() -> Vec<f32>>,
 }
 
 impl GpuContext {

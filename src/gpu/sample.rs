@@ -26,13 +26,18 @@ pub(crate) struct SampleLights {
 }
 
 impl SampleLights {
-    /// The records with each light's power weight (`weights[k]`, scaled to the scene's largest)
-    /// in `select[0]`, for a `Selection::Power` GPU-resident call: built and uploaded once.
-    pub(crate) fn with_power(&self, ctx: &GpuContext, weights: &[f32]) -> &wgpu::Buffer {
+    /// The records with each light's power weight (`weights()[k]`, scaled to the scene's
+    /// largest) in `select[0]`, for a `Selection::Power` GPU-resident call: built and uploaded
+    /// on the first such call (`weights` is called then only).
+    pub(crate) fn with_power(
+        &self,
+        ctx: &GpuContext,
+        weights: &dyn Fn() -> Vec<f32>,
+    ) -> &wgpu::Buffer {
         self.power.get_or_init(|| {
             let mut records = self.records.clone();
-            for (r, w) in records.iter_mut().zip(weights) {
-                r.select[0] = *w;
+            for (r, w) in records.iter_mut().zip(weights()) {
+                r.select[0] = w;
             }
             let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("lights (sampling by power)"),

@@ -308,17 +308,19 @@ impl PreparedScene {
             buffer: out,
         };
         // The power weights integrate each shaped light's emission: computed on the first
-        // call that chooses by power (the host path's tables), not when the scene is prepared.
-        let power = (opts.selection == Selection::Power).then(|| {
-            super::scene::scaled_weights(self.sampling_tables(Selection::Power).power_weights())
-        });
+        // call that chooses by power (the host path's tables), not when the scene is prepared
+        // nor again on later calls.
+        let power_weights =
+            || super::scene::scaled_weights(self.sampling_tables(Selection::Power).power_weights());
+        let power =
+            (opts.selection == Selection::Power).then_some(&power_weights as &dyn Fn() -> Vec<f32>);
         let draw = ResidentDraw {
             points: n_points,
             per_point: count,
             seed: opts.seed,
             first_point: opts.first_point as u32,
             selection,
-            power: power.as_deref(),
+            power,
         };
         g.encode_sample(
             encoder,

@@ -7,6 +7,7 @@
 use glam::DVec3;
 use openusd::sdf;
 use openusd::usd::{self as ousd, TimeCode};
+use serde::Serialize;
 
 use super::light::{NotEvaluated, RefusedInput};
 use super::stage as usd;
@@ -294,7 +295,7 @@ pub(super) fn convert(
     let world = glam::DMat4::from_cols_array_2d(&p.world);
     let geometry = MeshGeometry::triangulate(&topology, world).map_err(from_topology)?;
     let subdivision_scheme = token("subdivisionScheme")?;
-    if subdivision_scheme != "none" {
+    if cage_only(&subdivision_scheme) {
         warnings.push(format!(
             "{path}: subdivisionScheme {subdivision_scheme:?}: its control cage is evaluated as \
              polygons (no subdivision, DESIGN.md §7 M1)"
@@ -391,4 +392,38 @@ pub(super) fn convert(
         },
         warnings,
     ))
+}
+
+/// Whether a mesh light's `subdivisionScheme` leaves its control cage to be evaluated as
+/// polygons (anything but `none`, DESIGN.md §7 M1).
+fn cage_only(scheme: &str) -> bool {
+    scheme != "none"
+}
+
+/// A mesh light's `lights --json` summary (`StageLight::mesh`).
+pub(super) fn summary<S: serde::Serializer>(
+    mesh: &Option<MeshLight>,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    let Some(m) = mesh else {
+        return s.serialize_none();
+    };
+    let g = &m.geometry;
+    serde_json::json!({
+        "triangles": g.triangles.len(),
+        "area": g.area,
+        "holes": g.holes,
+        "degenerate_triangles": g.degenerate,
+        "folded_faces": g.folded_faces.len(),
+        "tint": m.tint.rgb.to_array(),
+        "tint_source": m.tint.source,
+        "double_sided": m.double_sided,
+        "subdivision_scheme": m.subdivision_scheme,
+        "subdivision": if cage_only(&m.subdivision_scheme) {
+            "not applied: the control cage is evaluated as polygons"
+        } else {
+            "none"
+        },
+    })
+    .serialize(s)
 }

@@ -24,6 +24,7 @@ mod arcs;
 mod diagnostics;
 mod light;
 mod mesh;
+mod portals;
 mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;

@@ -66,14 +66,14 @@ pub struct StageLight {
     /// queries skip it, as `light` is `None`. Serialized as a summary (triangle count, area,
     /// tint and its source, doubleSided, subdivision), absent for other lights.
     #[serde(
-        serialize_with = "mesh_summary",
+        serialize_with = "super::mesh::summary",
         skip_serializing_if = "Option::is_none"
     )]
     pub mesh: Option<MeshLight>,
     /// A `PortalLight`, read (DESIGN.md §8 P1) with the domes that name it; not evaluated yet.
     /// Serialized as a summary, absent for other lights.
     #[serde(
-        serialize_with = "portal_summary",
+        serialize_with = "super::portals::summary",
         skip_serializing_if = "Option::is_none"
     )]
     pub portal: Option<Portal>,
@@ -81,59 +81,6 @@ pub struct StageLight {
     /// PortalLights, which change nothing and are warned about); `None` for other lights.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub portals: Option<Vec<String>>,
-}
-
-/// Whether a mesh light's `subdivisionScheme` leaves its control cage to be evaluated as
-/// polygons (anything but `none`, DESIGN.md §7 M1).
-pub(crate) fn cage_only(scheme: &str) -> bool {
-    scheme != "none"
-}
-
-fn mesh_summary<S: serde::Serializer>(
-    mesh: &Option<MeshLight>,
-    s: S,
-) -> std::result::Result<S::Ok, S::Error> {
-    let Some(m) = mesh else {
-        return s.serialize_none();
-    };
-    let g = &m.geometry;
-    serde_json::json!({
-        "triangles": g.triangles.len(),
-        "area": g.area,
-        "holes": g.holes,
-        "degenerate_triangles": g.degenerate,
-        "folded_faces": g.folded_faces.len(),
-        "tint": m.tint.rgb.to_array(),
-        "tint_source": m.tint.source,
-        "double_sided": m.double_sided,
-        "subdivision_scheme": m.subdivision_scheme,
-        "subdivision": if cage_only(&m.subdivision_scheme) {
-            "not applied: the control cage is evaluated as polygons"
-        } else {
-            "none"
-        },
-    })
-    .serialize(s)
-}
-
-fn portal_summary<S: serde::Serializer>(
-    portal: &Option<Portal>,
-    s: S,
-) -> std::result::Result<S::Ok, S::Error> {
-    let Some(p) = portal else {
-        return s.serialize_none();
-    };
-    serde_json::json!({
-        "width": p.width,
-        "height": p.height,
-        "intensity": p.intensity,
-        "exposure": p.exposure,
-        "color": p.color.to_array(),
-        "enable_color_temperature": p.enable_color_temperature,
-        "color_temperature": p.color_temperature,
-        "domes": p.domes,
-    })
-    .serialize(s)
 }
 
 fn serialize_is_some<S: serde::Serializer>(
@@ -359,7 +306,7 @@ impl UsdStage {
             .into_iter()
             .map(|p| StageLight::from_prim(p, up, max_mesh_triangles))
             .collect();
-        attach_portals(&mut lights);
+        super::portals::attach(&mut lights);
         Ok(Stage {
             file: self.file().to_path_buf(),
             up_axis: info.up_axis.clone(),
@@ -454,58 +401,6 @@ fn describe_time(rule: TimeRule) -> String {
         TimeRule::StartTimeCode(t) => format!("time {t} (the stage's startTimeCode)"),
         TimeRule::Earliest => "the earliest time".to_string(),
     }
-}
-
-/// Attaches every PortalLight to the domes whose `portals` relationship names it, and says
-/// what changes nothing (DESIGN.md §8 P1): a target that is not a PortalLight of the stage, and
-/// a PortalLight that no dome names.
-fn attach_portals(lights: &mut [StageLight]) {
-    let named: Vec<(String, Vec<String>)> = lights
-        .iter()
-        .filter_map(|l| Some((l.path.clone(), l.portals.clone()?)))
-        .collect();
-    for (dome, targets) in named {
-        let mut not_portals = Vec::new();
-        for target in targets {
-            match lights
-                .iter_mut()
-                .find(|l| l.path == target)
-                .and_then(|l| l.portal.as_mut())
-            {
-                Some(portal) => portal.domes.push(dome.clone()),
-                None => not_portals.push(target),
-            }
-        }
-        if !not_portals.is_empty()
-            && let Some(l) = lights.iter_mut().find(|l| l.path == dome)
-        {
-            add_warning(
-                &mut l.warning,
-                format!(
-                    "{dome}: portals names {}, not a PortalLight of the stage: changes nothing (DESIGN.md §8 P1)",
-                    not_portals.join(", ")
-                ),
-            );
-        }
-    }
-    for l in lights.iter_mut() {
-        if let Some(p) = &l.portal
-            && p.domes.is_empty()
-        {
-            let w = format!(
-                "{}: no dome's portals relationship names this portal: it changes nothing (DESIGN.md §8 P1)",
-                l.path
-            );
-            add_warning(&mut l.warning, w);
-        }
-    }
-}
-
-fn add_warning(warning: &mut Option<String>, more: String) {
-    *warning = Some(match warning.take() {
-        Some(w) => format!("{w}; {more}"),
-        None => more,
-    });
 }
 
 fn join(first: String, then: Option<String>) -> String {
