@@ -14,6 +14,7 @@ pub mod emission;
 pub mod ies;
 pub mod intensity;
 pub mod irradiance;
+pub mod mesh;
 pub mod power;
 pub mod quadrature;
 pub mod radiance;
