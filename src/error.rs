@@ -36,6 +36,15 @@ pub enum LuxError {
         reason: String,
     },
 
+    /// A query luxeval does not perform for this light yet (sampling a mesh light): refused
+    /// rather than answered without it.
+    #[error("light {light}: {query} is not supported for it yet: {reason}")]
+    NotSupported {
+        light: String,
+        query: String,
+        reason: String,
+    },
+
     /// No wgpu adapter could be found.
     #[error(
         "no GPU adapter found ({reason}); use --device cpu, or install a Vulkan driver (e.g. Mesa's lavapipe: mesa-vulkan-drivers)"
@@ -194,6 +203,7 @@ impl LuxError {
                 | LuxError::InvalidTransform { .. }
                 | LuxError::InvalidInput { .. }
                 | LuxError::NotOnDevice { .. }
+                | LuxError::NotSupported { .. }
                 | LuxError::Io { .. }
                 | LuxError::Asset { .. }
                 | LuxError::Format { .. }

@@ -284,7 +284,10 @@ fn plot_light(eval: &Evaluator, scene: &PreparedScene, args: &SceneArgs, png: &P
     let flux = r
         .flux()
         .map(|f| format!("{:.6} lm", 0.2126 * f.x + 0.7152 * f.y + 0.0722 * f.z))
-        .unwrap_or_else(|| "no finite flux".into());
+        .unwrap_or_else(|| match light.kind {
+            luxeval::LightType::Mesh { .. } => "flux not computed for mesh lights".into(),
+            _ => "no finite flux".into(),
+        });
     polar::render(
         &light.path,
         &format!("{}, peak {peak:.6} cd, {flux}", args.scene.display()),

@@ -61,6 +61,8 @@ pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
             }
         }
         LightType::Sphere { .. } => {}
+        // Evaluated on the host on every backend (GpuPath::Host): nothing to band.
+        LightType::Mesh { .. } => {}
     }
     if let (Some(s), true) = (&p.light.shaping, p.light.kind.is_shapeable()) {
         // The cone edge, hard or soft: scaled so that the band is BAND where
@@ -186,7 +188,7 @@ pub fn radiance_margin(r: &Reference, x: DVec3, w: DVec3) -> f64 {
     let dl = p.to_local * w;
     let u = dl.normalize();
     let m_shape = match p.light.kind {
-        LightType::Distant { .. } | LightType::Dome => f64::INFINITY,
+        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. } => f64::INFINITY,
         LightType::Sphere {
             treat_as_point: true,
             ..
@@ -276,6 +278,8 @@ pub fn irradiance_outline(r: &Reference, x: DVec3) -> Vec<DVec3> {
             .collect()
     };
     match p.light.kind {
+        // Evaluated on the host on every backend (GpuPath::Host): no silhouette to avoid.
+        LightType::Mesh { .. } => vec![],
         LightType::Rect { width, height } => {
             let (hw, hh) = (width / 2.0, height / 2.0);
             let c = [(-hw, -hh), (hw, -hh), (hw, hh), (-hw, hh)];

@@ -43,6 +43,7 @@ pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
         }
         // A sphere (and its point approximation) emits along every direction.
         LightType::Sphere { .. } => base * shaping(p, e),
+        LightType::Mesh { .. } => super::mesh::emission(p, e),
     }
 }
 

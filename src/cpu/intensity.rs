@@ -20,6 +20,10 @@ use crate::prepare::Prepared;
 
 /// `A⊥(e)`: the emitting surface's projected area along unit direction `e` (world units²).
 pub fn projected_area(p: &Prepared, e: DVec3) -> f64 {
+    if matches!(p.light.kind, LightType::Mesh { .. }) {
+        // DESIGN.md §7 M3: the visible emitting surface, self-occlusion included.
+        return super::mesh::projected_area(p, e);
+    }
     let v = p.to_local * e;
     let local = match p.light.kind {
         LightType::Rect { width, height } => width * height * (-v.z).max(0.0),
@@ -28,7 +32,7 @@ pub fn projected_area(p: &Prepared, e: DVec3) -> f64 {
         LightType::Cylinder { length, radius, .. } => {
             2.0 * length * radius * (v.y * v.y + v.z * v.z).sqrt()
         }
-        LightType::Distant { .. } | LightType::Dome => 0.0,
+        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. } => 0.0,
     };
     local * p.det
 }

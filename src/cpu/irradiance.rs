@@ -64,6 +64,7 @@ pub fn irradiance_sh9(p: &Prepared, n: DVec3) -> Option<DVec3> {
 /// [`irradiance`] with the quadrature's [`Rule`] chosen (closed forms are used either way).
 pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> DVec3 {
     let e = match p.light.kind {
+        LightType::Mesh { .. } => super::mesh::irradiance(p, x, n, rule.piece_tolerance()),
         // A textured dome's irradiance is the exact integral of its filtered texture (DESIGN.md
         // §6 "Dome and texture irradiance: what 'exact' means"), see dome.rs.
         LightType::Dome if p.dome_texture().is_some() => match dome::tables(p) {
@@ -178,6 +179,11 @@ pub trait Rule {
     /// Whether the exact per-receiver shortcuts of [`uniform_shaping`] are taken.
     fn shortcuts(&self) -> bool {
         false
+    }
+    /// The relative tolerance a shaped mesh light's visible pieces are integrated to
+    /// (`cpu::mesh::irradiance`): the reference's 1e-9 unless the rule says otherwise.
+    fn piece_tolerance(&self) -> f64 {
+        1e-9
     }
     /// The whole chart integral (the base radiance not applied).
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3
@@ -350,6 +356,10 @@ impl Rule for Adaptive {
 
     fn shortcuts(&self) -> bool {
         self.shortcuts
+    }
+
+    fn piece_tolerance(&self) -> f64 {
+        self.outer.rel
     }
 
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3 {

@@ -18,9 +18,13 @@ use crate::model::LightType;
 use crate::prepare::Prepared;
 use crate::prepare::normalize::world_area;
 
-/// The RGB flux `∫ I(ω) dω` of the light; `None` for distant and dome lights (at infinity).
+/// The RGB flux `∫ I(ω) dω` of the light; `None` for distant and dome lights (at infinity) and
+/// for mesh lights, whose self-occlusion leaves no closed form (not computed yet).
 pub fn flux(p: &Prepared) -> Option<DVec3> {
-    if matches!(p.light.kind, LightType::Distant { .. } | LightType::Dome) {
+    if matches!(
+        p.light.kind,
+        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. }
+    ) {
         return None;
     }
     let Some(s) = &p.shaping else {

@@ -16,7 +16,10 @@ use crate::prepare::Prepared;
 
 /// radiance at `x` from the unit direction `w`.
 pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
-    if matches!(p.light.kind, LightType::Dome) {
+    if matches!(p.light.kind, LightType::Mesh { .. }) {
+        // DESIGN.md §7 M3: the first triangle hit, with the side it is hit on.
+        super::mesh::radiance(p, x, w)
+    } else if matches!(p.light.kind, LightType::Dome) {
         // A dome's emission is indexed by the direction toward the environment (DESIGN.md §3),
         // which is ω itself.
         emission(p, w)
@@ -58,6 +61,7 @@ pub fn hits_emitting_surface(p: &Prepared, x: DVec3, w: DVec3) -> bool {
             ..
         } => false,
         LightType::Cylinder { length, radius, .. } => cylinder_hit(xl, dl, length / 2.0, radius),
+        LightType::Mesh { .. } => super::mesh::radiance(p, x, w) != DVec3::ZERO,
     }
 }
 

@@ -186,6 +186,9 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 /// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture
 /// starts in the scene's texture atlas (`gpu::texture_atlas`).
 pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Record {
+    if p.on_host() {
+        return host_record();
+    }
     let m = p.to_local;
     // Local = M⁻¹·(x − o): row i is (row_i(M⁻¹), −row_i(M⁻¹)·o).
     let row = |i: usize| v4(m.row(i), -m.row(i).dot(p.origin));
@@ -299,8 +302,31 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
             )
         }
         LightType::Dome => (KIND_DOME, [0.0; 4]),
+        LightType::Mesh { .. } => unreachable!("a mesh light is evaluated on the host"),
     };
     r.kind = kind;
     r.size = size;
     r
+}
+
+/// The record of a light every query takes from the CPU reference (`GpuPath::Host`: mesh
+/// lights): a `treatAsPoint` sphere of zero radiance at the origin, with an identity frame, so
+/// that every kernel gives exactly 0 for it and the sampling kernels' light choice never picks
+/// it (its luminance weight is 0); the host adds the reference's values.
+fn host_record() -> Record {
+    let id = |i: usize| {
+        let mut r = [0.0; 4];
+        r[i] = 1.0;
+        r
+    };
+    Record {
+        to_local: [id(0), id(1), id(2)],
+        axis: [0.0, 0.0, -1.0, 0.0],
+        normal: [0.0, 0.0, -1.0, 0.0],
+        world: [id(0), id(1), id(2)],
+        irr: [0.0, 1.0, 0.0, 0.0],
+        kind: KIND_SPHERE,
+        flags: FLAG_TREAT_AS_POINT_OR_LINE | FLAG_HOST_IRRADIANCE | FLAG_SIMILARITY,
+        ..Record::default()
+    }
 }

@@ -7,9 +7,12 @@
 //! (`p_world = p_local * M`); [`Light::with_usd_matrix`] and [`Light::usd_matrix`] convert,
 //! the one being the transpose of the other.
 
+use std::sync::Arc;
+
 use glam::{DMat3, DMat4, DVec3};
 
 use super::asset::Asset;
+use super::mesh::MeshGeometry;
 
 use super::schema;
 use crate::error::{LuxError, Result};
@@ -224,6 +227,15 @@ pub enum LightType {
     },
     /// DomeLight / DomeLight_1: a uniform environment, or the map in [`Light::texture`].
     Dome,
+    /// A `Mesh` with MeshLightAPI (DESIGN.md §7): its world-space triangles (shared, not copied,
+    /// when the light is cloned), whether both sides emit, and the tint of
+    /// `light:materialSyncMode` (M2), which multiplies the emission like `inputs:color`.
+    /// [`Light::world`] is the prim's world transform: shaping's primary axis is its local −Z.
+    Mesh {
+        geometry: Arc<MeshGeometry>,
+        double_sided: bool,
+        tint: DVec3,
+    },
 }
 
 impl LightType {
@@ -236,6 +248,7 @@ impl LightType {
             LightType::Rect { .. } => "RectLight",
             LightType::Cylinder { .. } => "CylinderLight",
             LightType::Dome => "DomeLight",
+            LightType::Mesh { .. } => "Mesh",
         }
     }
 
@@ -332,6 +345,14 @@ impl Light {
     }
     pub fn dome() -> Self {
         Self::new(LightType::Dome)
+    }
+    /// A mesh light (DESIGN.md §7) of `geometry`'s world-space triangles, single-sided, untinted.
+    pub fn mesh(geometry: MeshGeometry) -> Self {
+        Self::new(LightType::Mesh {
+            geometry: Arc::new(geometry),
+            double_sided: false,
+            tint: DVec3::ONE,
+        })
     }
 
     pub fn with_path(mut self, path: impl Into<String>) -> Self {
@@ -444,6 +465,11 @@ impl Light {
                 size("inputs:radius", radius)?;
             }
             LightType::Dome => {}
+            LightType::Mesh { tint, .. } => {
+                for c in tint.to_array() {
+                    finite("emissiveColor (the mesh light's tint)", c)?;
+                }
+            }
         }
         if let Some(s) = &self.shaping {
             finite("inputs:shaping:focus", s.focus)?;
@@ -477,7 +503,13 @@ impl Light {
         // A singular map flattens an area light to zero size, which DESIGN.md §2 "Zero-size
         // lights" evaluates (prepare::zero_size) instead of refusing; the other types need their
         // frame.
-        let sized = !matches!(self.kind, LightType::Distant { .. } | LightType::Dome);
+        // A mesh light's triangles are already in world space, so a singular transform only
+        // loses shaping's primary axis (its local −Z).
+        let sized = match self.kind {
+            LightType::Distant { .. } | LightType::Dome => false,
+            LightType::Mesh { .. } => self.shaping.is_none(),
+            _ => true,
+        };
         if !sized && self.is_singular() {
             let det = self.linear().determinant();
             return Err(LuxError::InvalidTransform {

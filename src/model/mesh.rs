@@ -1,11 +1,12 @@
 //! Mesh lights (MeshLightAPI, DESIGN.md §7) as plain data: the mesh's triangles in world space
-//! with their emitting front, its exact area and its tint. Nothing here evaluates light; the
-//! queries read these once the evaluation exists (until then they list mesh lights and skip
-//! them).
+//! with their emitting front, its exact area and its tint. Nothing here evaluates light: a
+//! [`MeshLight`] becomes a [`Light`] of kind [`LightType::Mesh`], which the queries evaluate.
+
+use std::sync::Arc;
 
 use glam::{DMat4, DVec3};
 
-use super::light::{LightInputs, Shaping};
+use super::light::{Light, LightInputs, LightType, Shaping, UpAxis};
 
 /// One triangle of the fan of one face, in world space. Its front, the side it emits toward,
 /// is `(p[1] − p[0]) × (p[2] − p[0])`: [`MeshGeometry::triangulate`] orders the vertices so
@@ -224,12 +225,32 @@ pub struct MeshLight {
     pub shaping: Option<Shaping>,
     /// Local-to-world, column-vector convention, as [`super::Light::world`].
     pub world: DMat4,
-    pub geometry: MeshGeometry,
+    /// Shared with the [`Light`] of [`MeshLight::light`], not copied.
+    pub geometry: Arc<MeshGeometry>,
     /// `doubleSided`: every triangle emits toward both sides.
     pub double_sided: bool,
     pub tint: Tint,
     /// `subdivisionScheme` as read: anything but `none` is evaluated as its control cage (M1).
     pub subdivision_scheme: String,
+}
+
+impl MeshLight {
+    /// The light the queries evaluate, on a stage whose up axis is `stage_up`.
+    pub fn light(&self, stage_up: UpAxis) -> Light {
+        Light {
+            path: self.path.clone(),
+            kind: LightType::Mesh {
+                geometry: Arc::clone(&self.geometry),
+                double_sided: self.double_sided,
+                tint: self.tint.rgb,
+            },
+            world: self.world,
+            inputs: self.inputs.clone(),
+            shaping: self.shaping.clone(),
+            stage_up,
+            texture: None,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -11,6 +11,7 @@ pub mod blackbody;
 pub mod env_table;
 pub mod ies;
 pub mod ies_kinks;
+pub mod mesh_bvh;
 pub mod normalize;
 pub mod profile;
 pub mod texture;
@@ -101,8 +102,8 @@ pub struct Prepared {
     /// What only this kind of light carries.
     pub kind: KindData,
     /// Where the GPU path takes this light's irradiance from, decided once here (see
-    /// [`IrradiancePath`]).
-    pub irradiance_path: IrradiancePath,
+    /// [`GpuPath`]).
+    pub gpu_path: GpuPath,
     /// The files on disk its assets were read from (IES profile, TILT file, texture, or the
     /// package holding them), so that no output is written over one of them.
     pub files_read: Vec<std::path::PathBuf>,
@@ -130,18 +131,25 @@ pub enum KindData {
     Dome {
         texture: Option<texture::PreparedTexture>,
     },
+    /// A mesh light (DESIGN.md §7): the hierarchy over its triangles (the model's, in world
+    /// space) and the distinct directions its emitting sides face, which decide where it emits
+    /// at all (M3 `emission`).
+    Mesh {
+        bvh: std::sync::Arc<mesh_bvh::MeshBvh>,
+        fronts: std::sync::Arc<Vec<DVec3>>,
+    },
 }
 
-/// Where the GPU path takes a light's irradiance from: the one decision, made per light when it
-/// is prepared, that the record's `FLAG_HOST_IRRADIANCE` (answered with 0 by the irradiance
-/// kernel), the host's sum in `query::PreparedScene::irradiance`, the GPU-resident refusal and
-/// the conformance check all read.
+/// Where the GPU path takes a light's values from: the one decision, made per light when it is
+/// prepared, that the record (`FLAG_HOST_IRRADIANCE`, or a record that emits nothing), the
+/// host's sums in `query::PreparedScene`, the GPU-resident refusals and the conformance check
+/// all read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum IrradiancePath {
-    /// The f32 quadrature on the device.
+pub enum GpuPath {
+    /// Every query on the device.
     Device,
-    /// The CPU reference, until the f32 quadrature can match it; the reason is a phrase ("it is
-    /// IES-shaped"):
+    /// Every query on the device but irradiance, which is the CPU reference's until the f32
+    /// quadrature can match it; the reason is a phrase ("it is IES-shaped"):
     /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as
     ///   the reference's line integrals do, and misses lit features narrower than its nodes
     ///   (measured: up to 100 % on receivers that see a thin lit band of a striped profile).
@@ -152,6 +160,9 @@ pub enum IrradiancePath {
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
+    HostIrradiance(&'static str),
+    /// Every query from the CPU reference: mesh lights (DESIGN.md §7), until kernels traverse
+    /// their triangles on the device. The record the kernels see emits nothing.
     Host(&'static str),
 }
 
@@ -174,6 +185,15 @@ impl Prepared {
             LightType::Sphere { radius, .. } => DVec3::splat(radius),
             LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
             LightType::Dome | LightType::Distant { .. } => DVec3::ZERO,
+            // World-space triangles: the farthest vertex from the origin.
+            LightType::Mesh { ref geometry, .. } => {
+                return geometry
+                    .triangles
+                    .iter()
+                    .flat_map(|t| t.p)
+                    .map(|v| v.distance(self.origin))
+                    .fold(0.0, f64::max);
+            }
         };
         ext.x * self.linear.x_axis.length()
             + ext.y * self.linear.y_axis.length()
@@ -197,9 +217,15 @@ impl Prepared {
     }
 
     /// Whether the GPU path takes this light's irradiance from the CPU reference
-    /// ([`Prepared::irradiance_path`]).
+    /// ([`Prepared::gpu_path`]).
     pub fn irradiance_on_host(&self) -> bool {
-        matches!(self.irradiance_path, IrradiancePath::Host(_))
+        matches!(self.gpu_path, GpuPath::HostIrradiance(_) | GpuPath::Host(_))
+    }
+
+    /// Whether the GPU path takes every query of this light from the CPU reference
+    /// ([`Prepared::gpu_path`]).
+    pub fn on_host(&self) -> bool {
+        matches!(self.gpu_path, GpuPath::Host(_))
     }
 
     /// Validates `light` and computes its constants for `mode`.
@@ -304,6 +330,10 @@ impl Prepared {
                     None => None,
                 },
             },
+            LightType::Mesh { ref geometry, .. } => KindData::Mesh {
+                bvh: std::sync::Arc::new(mesh_bvh::MeshBvh::build(&geometry.triangles)),
+                fronts: std::sync::Arc::new(distinct_fronts(&geometry.triangles)),
+            },
             _ => {
                 // A texture on any other type is refused rather than evaluated as if untextured.
                 if let Some(t) = &light.texture {
@@ -320,17 +350,19 @@ impl Prepared {
                 KindData::Shape
             }
         };
-        let irradiance_path = if ies.is_some() {
-            IrradiancePath::Host("it is IES-shaped")
+        let gpu_path = if matches!(kind, KindData::Mesh { .. }) {
+            GpuPath::Host("it is a mesh light")
+        } else if ies.is_some() {
+            GpuPath::HostIrradiance("it is IES-shaped")
         } else {
             match &kind {
                 KindData::Dome { texture: Some(_) } => {
-                    IrradiancePath::Host("it is a textured dome")
+                    GpuPath::HostIrradiance("it is a textured dome")
                 }
                 KindData::Rect { texture: Some(_) } => {
-                    IrradiancePath::Host("it is a textured rect")
+                    GpuPath::HostIrradiance("it is a textured rect")
                 }
-                _ => IrradiancePath::Device,
+                _ => GpuPath::Device,
             }
         };
         // The files the assets above were loaded from (the profile's, the texture's).
@@ -363,7 +395,7 @@ impl Prepared {
             profile,
             ies,
             kind,
-            irradiance_path,
+            gpu_path,
             light: evaluated,
         })
     }
@@ -494,6 +526,24 @@ fn check_fits_f32(
             &[("inputs:length", length), ("inputs:radius", radius)]
         }
         LightType::Distant { .. } | LightType::Dome => &[],
+        LightType::Mesh { ref geometry, .. } => {
+            let far = geometry.triangles.iter().flat_map(|t| t.p).enumerate().find(|(_, v)| {
+                v.abs().max_element() > MAX_LENGTH
+            });
+            if let Some((i, v)) = far {
+                return Err(LuxError::attr(
+                    &light.path,
+                    "points",
+                    format!("({}, {}, {}) in world space (triangle {})", v.x, v.y, v.z, i / 3),
+                    format!("beyond {MAX_LENGTH:e}, whose square would overflow float32"),
+                ));
+            }
+            // The triangles are in world space: the transform only orients shaping.
+            if light.shaping.is_none() {
+                return Ok(());
+            }
+            &[]
+        }
     };
     for (attr, v) in sizes {
         if v.abs() > MAX_LENGTH {
@@ -541,7 +591,30 @@ pub fn base_radiance(light: &Light, mode: TemperatureMode) -> DVec3 {
     } else {
         DVec3::ONE
     };
-    scalar * i.color * tint
+    // A mesh light's material tint multiplies like color (DESIGN.md §7 M2).
+    let material = match light.kind {
+        LightType::Mesh { tint, .. } => tint,
+        _ => DVec3::ONE,
+    };
+    scalar * i.color * tint * material
+}
+
+/// The distinct unit directions the triangles' fronts face (exact duplicates removed), the
+/// largest-area direction first: emission along ω is non-zero where one of them has `n·ω > 0`
+/// (DESIGN.md §7 M3), and a flat or boxy light answers after one or a few tests.
+fn distinct_fronts(triangles: &[crate::model::MeshTriangle]) -> Vec<DVec3> {
+    let mut by_area: std::collections::HashMap<[u64; 3], f64> = Default::default();
+    for t in triangles {
+        let n = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]);
+        let Some(u) = n.try_normalize() else { continue };
+        *by_area.entry(u.to_array().map(f64::to_bits)).or_default() += n.length();
+    }
+    let mut fronts: Vec<([u64; 3], f64)> = by_area.into_iter().collect();
+    fronts.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    fronts
+        .into_iter()
+        .map(|(k, _)| DVec3::from_array(k.map(f64::from_bits)))
+        .collect()
 }
 
 /// Whether ShapingAPI's factor is exactly 1 along every direction: no focus (or a white tint), a

@@ -64,6 +64,8 @@ pub fn world_area(light: &Light) -> f64 {
             length * radius * ellipse_perimeter_conjugate(a.cross(b), a.cross(c))
         }
         LightType::Distant { .. } | LightType::Dome => 0.0,
+        // DESIGN.md §7 M2: the triangles' world area, one side (also when double-sided).
+        LightType::Mesh { ref geometry, .. } => geometry.area,
     }
 }
 

@@ -28,9 +28,15 @@ pub fn substitute(light: &Light) -> Option<(Light, String)> {
         LightType::Sphere { radius, .. } => Some(radius),
         LightType::Disk { .. } | LightType::Rect { .. } | LightType::Cylinder { .. } => None,
         LightType::Distant { .. } | LightType::Dome => return None,
+        // A mesh's triangles are in world space: only a mesh of no area is dark (its
+        // transform matters to shaping alone, and validation refuses a singular one there).
+        LightType::Mesh { ref geometry, .. } => match geometry.area > 0.0 {
+            true => return None,
+            false => None,
+        },
     };
     let m = light.linear();
-    let singular = light.is_singular();
+    let singular = light.is_singular() && !matches!(light.kind, LightType::Mesh { .. });
     if !singular && world_area(light) > 0.0 {
         return None;
     }

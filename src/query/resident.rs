@@ -10,7 +10,7 @@ use crate::error::{LuxError, Result};
 use crate::gpu::record::{SELECT_BOUND, SELECT_POWER};
 use crate::gpu::resident::{Operand, ResidentDraw};
 use crate::gpu::{GpuContext, GpuLights, Kernel};
-use crate::prepare::IrradiancePath;
+use crate::prepare::GpuPath;
 
 impl Evaluator {
     /// An evaluator on the caller's device (a renderer's own `wgpu::Device` and `wgpu::Queue`,
@@ -167,9 +167,9 @@ impl PreparedScene {
         count: u32,
         acc: Accumulate,
     ) -> Result<()> {
-        if let Some((p, reason)) = self.lights.iter().find_map(|p| match p.irradiance_path {
-            IrradiancePath::Host(reason) => Some((p, reason)),
-            IrradiancePath::Device => None,
+        if let Some((p, reason)) = self.lights.iter().find_map(|p| match p.gpu_path {
+            GpuPath::HostIrradiance(reason) | GpuPath::Host(reason) => Some((p, reason)),
+            GpuPath::Device => None,
         }) {
             return Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),
@@ -257,6 +257,7 @@ impl PreparedScene {
         let Backend::Gpu(g) = &self.backend else {
             return Err(no_device());
         };
+        self.check_sampled()?;
         let selection = match opts.selection {
             Selection::Power => SELECT_POWER,
             Selection::Bound => SELECT_BOUND,
@@ -335,6 +336,26 @@ impl PreparedScene {
     }
 
     #[allow(clippy::too_many_arguments)]
+    /// Refuses a GPU-resident query of a scene holding a light every query of which the host
+    /// computes (`GpuPath::Host`: mesh lights): the kernels give 0 for it, which this path
+    /// would return as if it were the answer.
+    fn check_all_on_device(&self, kernel: Kernel) -> Result<()> {
+        match self.lights.iter().find_map(|p| match p.gpu_path {
+            GpuPath::Host(reason) => Some((p, reason)),
+            _ => None,
+        }) {
+            Some((p, reason)) => Err(LuxError::NotOnDevice {
+                light: p.light.path.clone(),
+                query: format!("{kernel:?}").to_lowercase(),
+                reason: format!(
+                    "{reason}, evaluated on the host (in f64) until kernels traverse its \
+                     triangles; use the PreparedScene query of the same name"
+                ),
+            }),
+            None => Ok(()),
+        }
+    }
+
     fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -348,6 +369,7 @@ impl PreparedScene {
         let Backend::Gpu(g) = &self.backend else {
             return Err(no_device());
         };
+        self.check_all_on_device(kernel)?;
         let out = Operand {
             name: "out",
             buffer: out,

@@ -18,6 +18,7 @@ use crate::cpu::sample::{
     LightAt, SceneTables, choose, env_tables, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
+use crate::model::LightType;
 use crate::gpu::sample::{PdfRow, SampleLights, SampleRow};
 
 pub use crate::cpu::sample::Selection;
@@ -353,6 +354,7 @@ impl PreparedScene {
         normals: &[[f32; 3]],
     ) -> Result<Vec<StrategyVariance>> {
         check_pairs(points, "points", normals, "normals")?;
+        self.check_sampled()?;
         let tables = self.sampling_tables(Selection::Bound);
         let mut out = Vec::with_capacity(self.lights.len() * points.len());
         for (k, p) in self.lights.iter().enumerate() {
@@ -519,7 +521,26 @@ impl PreparedScene {
             }
             None => {}
         }
-        Ok(())
+        self.check_sampled()
+    }
+
+    /// Sampling refuses a scene with a mesh light (DESIGN.md §7): its lights would be drawn
+    /// without it, a density that misses light the scene has.
+    pub(super) fn check_sampled(&self) -> Result<()> {
+        match self
+            .lights
+            .iter()
+            .find(|p| matches!(p.light.kind, LightType::Mesh { .. }))
+        {
+            Some(p) => Err(LuxError::NotSupported {
+                light: p.light.path.clone(),
+                query: "sampling".into(),
+                reason: "mesh lights are evaluated (emission, radiance, irradiance, intensity) \
+                         but not sampled yet; leave it out with --light"
+                    .into(),
+            }),
+            None => Ok(()),
+        }
     }
 }
 

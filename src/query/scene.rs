@@ -168,9 +168,11 @@ impl PreparedScene {
     pub fn emission(&self, dirs: &[[f32; 3]], acc: Accumulate) -> Result<Vec<[f32; 3]>> {
         check_directions("directions", dirs)?;
         let per_light = acc == Accumulate::PerLight;
-        self.run(Kernel::Emission, dirs, None, per_light, || {
+        let mut out = self.run(Kernel::Emission, dirs, None, per_light, || {
             cpu::emission_batch(&self.lights, dirs, per_light)
-        })
+        })?;
+        self.add_host(per_light, &mut out, |l| cpu::emission_batch(l, dirs, true));
+        Ok(out)
     }
 
     /// intensity(light, ω) for every direction (DESIGN.md §3): the far-field RGB intensity
@@ -178,9 +180,11 @@ impl PreparedScene {
     pub fn intensity(&self, dirs: &[[f32; 3]], acc: Accumulate) -> Result<Vec<[f32; 3]>> {
         check_directions("directions", dirs)?;
         let per_light = acc == Accumulate::PerLight;
-        self.run(Kernel::Intensity, dirs, None, per_light, || {
+        let mut out = self.run(Kernel::Intensity, dirs, None, per_light, || {
             cpu::intensity_batch(&self.lights, dirs, per_light)
-        })
+        })?;
+        self.add_host(per_light, &mut out, |l| cpu::intensity_batch(l, dirs, true));
+        Ok(out)
     }
 
     /// Each light's total emitted power (RGB, lm per channel for L in nits): the integral of
@@ -199,9 +203,13 @@ impl PreparedScene {
     ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", dirs, "directions")?;
         let per_light = acc == Accumulate::PerLight;
-        self.run(Kernel::Radiance, points, Some(dirs), per_light, || {
+        let mut out = self.run(Kernel::Radiance, points, Some(dirs), per_light, || {
             cpu::radiance_batch(&self.lights, points, dirs, per_light)
-        })
+        })?;
+        self.add_host(per_light, &mut out, |l| {
+            cpu::radiance_batch(l, points, dirs, true)
+        });
+        Ok(out)
     }
 
     /// irradiance(x, n) for every (point, receiver normal) pair (DESIGN.md §3): the
@@ -248,6 +256,25 @@ impl PreparedScene {
         Ok(out)
     }
 
+    /// On a GPU evaluator, the kernels give 0 for the lights [`Prepared::on_host`] names (mesh
+    /// lights): their values are the CPU reference's (`values` of one light, one row per input
+    /// row), added here. Nothing to do on the CPU backend.
+    fn add_host(
+        &self,
+        per_light: bool,
+        out: &mut [[f32; 3]],
+        values: impl Fn(&[Prepared]) -> Vec<DVec3>,
+    ) {
+        if !matches!(self.backend, Backend::Gpu(_)) {
+            return;
+        }
+        for (k, light) in self.lights.iter().enumerate() {
+            if light.on_host() {
+                add_rows(out, k, per_light, values(std::slice::from_ref(light)));
+            }
+        }
+    }
+
     /// The GPU irradiance kernel gives 0 for the lights [`Prepared::irradiance_on_host`] names (see the
     /// header of shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here.
     fn add_host_irradiance(
@@ -258,18 +285,13 @@ impl PreparedScene {
         rule: &Adaptive,
         out: &mut [[f32; 3]],
     ) {
-        let n = points.len();
         for (k, light) in self.lights.iter().enumerate() {
             if !light.irradiance_on_host() {
                 continue;
             }
             let values =
                 cpu::irradiance_batch(std::slice::from_ref(light), points, normals, true, rule);
-            for (i, v) in values.into_iter().enumerate() {
-                let row = if per_light { k * n + i } else { i };
-                let sum = DVec3::from_array(out[row].map(f64::from)) + v;
-                out[row] = sum.as_vec3().to_array();
-            }
+            add_rows(out, k, per_light, values);
         }
     }
 
@@ -320,6 +342,17 @@ impl PreparedScene {
                 Ok(vec![[0.0; 3]; rows * a.len()])
             }
         }
+    }
+}
+
+/// Adds light `k`'s values (one per input row) to `out`: into its own rows (light-major) with
+/// `per_light`, else into the sums, in f64 before rounding to f32.
+fn add_rows(out: &mut [[f32; 3]], k: usize, per_light: bool, values: Vec<DVec3>) {
+    let n = values.len();
+    for (i, v) in values.into_iter().enumerate() {
+        let row = if per_light { k * n + i } else { i };
+        let sum = DVec3::from_array(out[row].map(f64::from)) + v;
+        out[row] = sum.as_vec3().to_array();
     }
 }
 

@@ -20,6 +20,15 @@ pub(crate) fn local_extent(l: &Light) -> DVec3 {
         LightType::Sphere { radius, .. } => DVec3::splat(radius),
         LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
         LightType::Distant { .. } | LightType::Dome => DVec3::ONE,
+        LightType::Mesh { ref geometry, .. } => {
+            let r = geometry
+                .triangles
+                .iter()
+                .flat_map(|t| t.p)
+                .map(|v| (v - l.origin()).abs())
+                .fold(DVec3::ZERO, DVec3::max);
+            r.max(DVec3::splat(1e-3))
+        }
     }
 }
 

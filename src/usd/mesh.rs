@@ -385,7 +385,7 @@ pub(super) fn convert(
             inputs,
             shaping,
             world,
-            geometry,
+            geometry: std::sync::Arc::new(geometry),
             double_sided: flag("doubleSided")?,
             tint,
             subdivision_scheme,

@@ -417,14 +417,9 @@ impl StageLight {
             Ok((Read::Light(light), caveat)) => (Some(light), caveat, None),
             // Read, and skipped by every query until they are evaluated: said on every query.
             Ok((Read::Mesh(m), caveat)) => {
-                let read = format!(
-                    "{}: mesh light ({} triangles, area {}) read, not evaluated yet: skipped",
-                    p.path,
-                    m.geometry.triangles.len(),
-                    m.geometry.area
-                );
+                let light = m.light(up);
                 mesh = Some(m);
-                (None, Some(join(read, caveat)), None)
+                (Some(light), caveat, None)
             }
             Ok((Read::Portal(pl), caveat)) => {
                 let read = format!("{}: portal read, not evaluated yet: skipped", p.path);

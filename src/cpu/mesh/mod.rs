@@ -1,8 +1,111 @@
-//! Mesh lights (MeshLightAPI, DESIGN.md §7) on the CPU reference, in f64: what the queries need
-//! beyond the model's triangles.
+//! Mesh lights (MeshLightAPI, DESIGN.md §7) on the CPU reference, in f64.
 //!
+//! - [`ray`]: the first triangle a ray meets, through the prepared hierarchy (M3 `radiance`).
 //! - [`visible`]: the parts of a mesh's triangles seen from a point (gnomonic charts) or from a
 //!   direction at infinity (orthographic), with the mesh's self-occlusion, exactly: what M3's
 //!   irradiance and intensity integrate.
+//!
+//! Emission leaves a triangle from its front (`(p1 − p0) × (p2 − p0)`, already oriented for
+//! `orientation` and a mirroring transform by the model), from both sides when `doubleSided`;
+//! every triangle occludes the mesh's own light from either side (M2, M3).
 
+pub(crate) mod ray;
 pub(crate) mod visible;
+
+use glam::DVec3;
+
+use super::shaping::shaping;
+use crate::model::LightType;
+use crate::prepare::{KindData, Prepared};
+
+/// A prepared mesh light's parts: its triangles, hierarchy, distinct front directions and
+/// whether both sides emit. `None` for other lights.
+fn parts(
+    p: &Prepared,
+) -> Option<(
+    &[crate::model::MeshTriangle],
+    &crate::prepare::mesh_bvh::MeshBvh,
+    &[DVec3],
+    bool,
+)> {
+    match (&p.light.kind, &p.kind) {
+        (
+            LightType::Mesh {
+                geometry,
+                double_sided,
+                ..
+            },
+            KindData::Mesh { bvh, fronts },
+        ) => Some((&geometry.triangles, bvh, fronts, *double_sided)),
+        _ => None,
+    }
+}
+
+/// M3 `emission(ω)`: `L(ω)` where some triangle emits along the unit direction `e`
+/// (`n·e > 0`, or `≠ 0` when double-sided), else 0.
+pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
+    let Some((_, _, fronts, double_sided)) = parts(p) else {
+        return DVec3::ZERO;
+    };
+    let emits = fronts.iter().any(|n| {
+        let c = n.dot(e);
+        c > 0.0 || (double_sided && c != 0.0)
+    });
+    if emits {
+        p.base * shaping(p, e)
+    } else {
+        DVec3::ZERO
+    }
+}
+
+/// M3 `radiance(x, ω)`: where the ray `x + tω`, t > 0, first meets the mesh on an emitting side,
+/// the emission back along −ω; 0 where it meets a non-emitting side (the mesh is opaque to its
+/// own light) or nothing.
+pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
+    let Some((triangles, bvh, _, double_sided)) = parts(p) else {
+        return DVec3::ZERO;
+    };
+    match ray::first_hit(triangles, bvh, x, w) {
+        Some(h) if h.front || double_sided => p.base * shaping(p, -w),
+        _ => DVec3::ZERO,
+    }
+}
+
+/// The emitting area visible from the unit direction `e` at infinity, projected on the plane
+/// ⟂ e, self-occlusion included: M3 `intensity(e) = L(e) · projected_area(e)`.
+pub fn projected_area(p: &Prepared, e: DVec3) -> f64 {
+    let Some((triangles, _, _, double_sided)) = parts(p) else {
+        return 0.0;
+    };
+    visible::Surface {
+        triangles,
+        double_sided,
+    }
+    .projected_area(e)
+}
+
+/// M3 `irradiance(x, n)` before `diffuse`, to relative tolerance `rel` where shaped: unshaped, `L`
+/// times the cosine-weighted solid angle of the visible emitting pieces, each by Lambert's
+/// formula clipped at the horizon (exact); shaped, the shaping of the emission direction `−ω`
+/// integrated over the same pieces.
+pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3, rel: f64) -> DVec3 {
+    let Some((triangles, _, _, double_sided)) = parts(p) else {
+        return DVec3::ZERO;
+    };
+    let surface = visible::Surface {
+        triangles,
+        double_sided,
+    };
+    if p.shaping.is_none() {
+        return p.base * surface.cosine_solid_angle(x, n);
+    }
+    let mut sum = DVec3::ZERO;
+    for piece in surface.visible_from(x) {
+        if piece.emitting {
+            sum += visible::integrate_piece(&piece.verts, n, rel, &mut |w: DVec3| {
+                shaping(p, -w)
+            });
+        }
+    }
+    p.base * sum
+}

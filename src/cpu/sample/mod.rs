@@ -124,6 +124,9 @@ impl<'a> LightAt<'a> {
         }
         let xl = p.to_local * (x - p.origin);
         match p.light.kind {
+            // Not sampled yet: the queries refuse a scene with a mesh light before drawing
+            // (`PreparedScene::check_sampled`).
+            LightType::Mesh { .. } => LightAt::Nothing(toward),
             LightType::Dome => LightAt::Dome {
                 env,
                 n,
@@ -350,6 +353,7 @@ pub fn strategy(p: &Prepared) -> &'static str {
             ..
         } => "delta (treatAsLine, uniform by length)",
         LightType::Cylinder { .. } => "uniform over the visible band by area",
+        LightType::Mesh { .. } => "not sampled yet (sampling refuses the scene)",
     }
 }
 

@@ -93,7 +93,7 @@ fn surface_hits(p: &Prepared, x: DVec3, w: DVec3, mut hit: impl FnMut(f64, DVec3
                 }
             }
         }
-        LightType::Distant { .. } | LightType::Dome => {}
+        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. } => {}
     }
 }
 
@@ -122,7 +122,9 @@ pub fn surface_point(p: &Prepared, a: f64, b: f64) -> (DVec3, DVec3, f64) {
             let n = DVec3::new(0.0, b.cos(), b.sin());
             (DVec3::new(a, r * n.y, r * n.z), n, r)
         }
-        LightType::Distant { .. } | LightType::Dome => (DVec3::ZERO, DVec3::Z, 0.0),
+        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. } => {
+            (DVec3::ZERO, DVec3::Z, 0.0)
+        }
     }
 }
 
@@ -136,7 +138,7 @@ pub fn parameter_box(p: &Prepared) -> ((f64, f64), (f64, f64)) {
         LightType::Disk { radius } => ((0.0, radius), tau),
         LightType::Sphere { radius, .. } => ((-radius, radius), tau),
         LightType::Cylinder { length, .. } => ((-length / 2.0, length / 2.0), tau),
-        LightType::Distant { .. } | LightType::Dome => ((0.0, 1.0), tau),
+        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. } => ((0.0, 1.0), tau),
     }
 }
 

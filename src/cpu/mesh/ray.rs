@@ -1,0 +1,151 @@
+//! The first triangle of a mesh light a ray meets (DESIGN.md §7 M3 `radiance`), through the
+//! prepared hierarchy ([`crate::prepare::mesh_bvh`]).
+//!
+//! Ray–triangle intersection by Möller & Trumbore (1997, "Fast, minimum storage ray-triangle
+//! intersection"), in f64, with the edge tests inclusive (a ray through an edge or a vertex shared
+//! by two triangles hits one of them, never neither). Equal distances keep the triangle that
+//! comes first in face and fan order (M1), whatever order the traversal meets them in.
+
+use glam::DVec3;
+
+use crate::model::MeshTriangle;
+use crate::prepare::mesh_bvh::{Aabb, MeshBvh};
+
+/// The hit: the triangle's index, its distance along the ray and whether the ray meets the
+/// triangle's front (the side its cross product points to, against the ray).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub triangle: u32,
+    pub t: f64,
+    pub front: bool,
+}
+
+/// The distance `t > 0` at which the ray `o + t·d` meets triangle `tri` (edges included), and
+/// whether it meets its front; `None` when it misses or runs in the triangle's plane.
+pub fn intersect(tri: &MeshTriangle, o: DVec3, d: DVec3) -> Option<(f64, bool)> {
+    let e1 = tri.p[1] - tri.p[0];
+    let e2 = tri.p[2] - tri.p[0];
+    let pv = d.cross(e2);
+    let det = e1.dot(pv);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - tri.p[0];
+    let u = s.dot(pv) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = d.dot(q) * inv;
+    if !(v >= 0.0 && u + v <= 1.0) {
+        return None;
+    }
+    let t = e2.dot(q) * inv;
+    // det = −d·(e1 × e2): positive when the ray runs against the front normal.
+    (t > 0.0 && t.is_finite()).then_some((t, det > 0.0))
+}
+
+/// The slab test (Kay & Kajiya 1986): whether the ray meets `b` before `t_max`.
+fn meets_box(b: &Aabb, o: DVec3, inv_d: DVec3, t_max: f64) -> bool {
+    let t0 = (b.min - o) * inv_d;
+    let t1 = (b.max - o) * inv_d;
+    // NaN (0 · ∞ for a ray in a slab's plane) is treated as inside: min/max ignore it.
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = t0.max(t1).min_element();
+    near <= far && near <= t_max
+}
+
+/// The first triangle the ray `o + t·d`, t > 0, meets.
+pub fn first_hit(triangles: &[MeshTriangle], bvh: &MeshBvh, o: DVec3, d: DVec3) -> Option<Hit> {
+    if bvh.nodes.is_empty() {
+        return None;
+    }
+    let inv_d = d.recip();
+    let mut best: Option<Hit> = None;
+    let mut stack: Vec<u32> = Vec::with_capacity(64);
+    stack.push(0);
+    while let Some(k) = stack.pop() {
+        let node = &bvh.nodes[k as usize];
+        let t_max = best.map_or(f64::INFINITY, |h| h.t);
+        if !meets_box(&node.bounds, o, inv_d, t_max) {
+            continue;
+        }
+        if node.count == 0 {
+            stack.push(node.first);
+            stack.push(k + 1);
+            continue;
+        }
+        let leaf = &bvh.order[node.first as usize..(node.first + node.count) as usize];
+        for &i in leaf {
+            if let Some((t, front)) = intersect(&triangles[i as usize], o, d) {
+                let better = match best {
+                    None => true,
+                    Some(b) => t < b.t || (t == b.t && i < b.triangle),
+                };
+                if better {
+                    best = Some(Hit {
+                        triangle: i,
+                        t,
+                        front,
+                    });
+                }
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(z: f64, flip: bool) -> MeshTriangle {
+        let (a, b) = (DVec3::new(2.0, -1.0, z), DVec3::new(-1.0, 2.0, z));
+        let p = if flip {
+            [DVec3::new(-1.0, -1.0, z), b, a]
+        } else {
+            [DVec3::new(-1.0, -1.0, z), a, b]
+        };
+        MeshTriangle { p, face: 0 }
+    }
+
+    #[test]
+    fn nearest_of_a_stack_and_its_side() {
+        // Fronts toward +z (cross of (3,0,0) and (0,3,0)); the ray comes from below going up.
+        let tris: Vec<MeshTriangle> = (0..40).map(|k| tri(k as f64, k % 2 == 1)).collect();
+        let bvh = MeshBvh::build(&tris);
+        let o = DVec3::new(0.1, 0.2, 12.5);
+        let up = first_hit(&tris, &bvh, o, DVec3::Z).unwrap();
+        assert_eq!((up.triangle, up.t), (13, 0.5));
+        assert!(up.front); // flipped: its front faces −z, toward the ray's origin.
+        let down = first_hit(&tris, &bvh, o, -DVec3::Z).unwrap();
+        assert_eq!((down.triangle, down.t), (12, 0.5));
+        assert!(down.front);
+        let miss = first_hit(&tris, &bvh, DVec3::new(5.0, 5.0, 0.5), DVec3::Z);
+        assert!(miss.is_none());
+    }
+
+    #[test]
+    fn equal_distances_keep_the_first_triangle_and_shared_edges_are_hit() {
+        // Two coincident triangles, and a ray through the diagonal of a quad's two triangles.
+        let t = tri(1.0, false);
+        let tris = vec![t, t, t];
+        let bvh = MeshBvh::build(&tris);
+        let h = first_hit(&tris, &bvh, DVec3::ZERO, DVec3::Z).unwrap();
+        assert_eq!(h.triangle, 0);
+        let quad = [
+            MeshTriangle {
+                p: [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0)],
+                face: 0,
+            },
+            MeshTriangle {
+                p: [DVec3::ZERO, DVec3::new(1.0, 1.0, 0.0), DVec3::Y],
+                face: 0,
+            },
+        ];
+        let bvh = MeshBvh::build(&quad);
+        let h = first_hit(&quad, &bvh, DVec3::new(0.5, 0.5, -1.0), DVec3::Z).unwrap();
+        assert_eq!((h.triangle, h.t, h.front), (0, 1.0, false));
+    }
+}
