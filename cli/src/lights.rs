@@ -66,7 +66,7 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
                 let _ = writeln!(block, $($arg)*);
             }};
         }
-        let read_only = l.mesh.is_some() || l.portal.is_some();
+        let read_only = l.portal.is_some();
         let status = match (&l.light, l.visible) {
             (Some(_), true) => "evaluated",
             (_, false) => "invisible: skipped",

@@ -26,7 +26,8 @@ fn lights_json_lists_every_input_and_whether_authored() {
 /// doubleSided, subdivision), each portal (size, multiplier, the domes naming it) and each
 /// dome's portals (DESIGN.md §7, §8), with the numbers usd-core and NumPy computed for the
 /// fixture (tests/data/usd/expected/mesh_lights.json, its earliest-time sample); the text
-/// lists the same, and says the lights are read, not evaluated yet.
+/// lists the same, and says the mesh lights are evaluated and the portals read, not evaluated
+/// yet.
 #[test]
 fn lights_lists_mesh_lights_and_portals() {
     let scene = repo_file("tests/data/usd/mesh/mesh_lights.usda");
@@ -43,7 +44,7 @@ fn lights_lists_mesh_lights_and_portals() {
     let record = |path: &str| lights.iter().find(|l| l["path"] == path).unwrap();
     for e in earliest["meshes"].as_array().unwrap() {
         let l = record(e["path"].as_str().unwrap());
-        assert_eq!(l["evaluable"], false, "{l}");
+        assert_eq!(l["evaluable"], true, "{l}");
         let m = &l["mesh"];
         assert_eq!(m["triangles"], e["triangles"], "{l}");
         let (area, want) = (m["area"].as_f64().unwrap(), e["area"].as_f64().unwrap());
@@ -80,7 +81,7 @@ fn lights_lists_mesh_lights_and_portals() {
     assert!(o.status.success(), "{}", stderr(&o));
     let text = String::from_utf8_lossy(&o.stdout);
     for want in [
-        "/World/Signs/Quads (Mesh) [read, not evaluated yet]",
+        "/World/Signs/Quads (Mesh) [evaluated]",
         "  mesh  4 triangles (0 hole faces removed, 0 degenerate triangles dropped), area 4.000000, doubleSided false",
         "  tint  (2, 1, 0.5) from emissiveColor of /World/Looks/Glow/Surface (authored)",
         "/World/Window (PortalLight) [read, not evaluated yet]",

@@ -14,7 +14,7 @@ import luxeval
 from helpers import LUXTEST, REPO, STUDIO, cli_query, floor_points, run_cli, sphere_dirs
 
 LUXTEST_SCENES = sorted(LUXTEST.glob("*.usda"))
-# Mesh lights and portals (read, not evaluated yet): their records carry ``mesh``, ``portal``
+# Mesh lights (evaluated) and portals (read, not evaluated yet): their records carry ``mesh``, ``portal``
 # and a dome's ``portals`` (tools/gen_usd_fixtures.py --only-mesh).
 MESH_SCENE = REPO / "tests" / "data" / "usd" / "mesh" / "mesh_lights.usda"
 

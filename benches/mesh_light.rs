@@ -1,0 +1,88 @@
+//! Criterion benchmarks of a mesh light (DESIGN.md §7) on the CPU reference, at the sizes of
+//! issue "Mesh lights and portals": preparing a 100,000-triangle mesh light (its BVH included),
+//! the radiance of 1,000,000 rays against it, and its exact self-occluded irradiance at one
+//! receiver. `cargo bench --ignore-rust-version --features testkit --bench mesh_light`.
+//!
+//! The mesh is a bumpy torus (250 × 200 quads, fronts outward): non-convex, so rays and
+//! receivers meet self-occlusion.
+
+use std::f64::consts::TAU;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::{DMat4, DVec3};
+use luxeval::testkit::Rng;
+use luxeval::{Accumulate, Evaluator, Light, MeshGeometry, MeshTopology};
+
+/// A torus of `around × across` quads (ring radius 2, tube 0.5, a bump of 5 % along the ring).
+fn torus(around: usize, across: usize) -> MeshGeometry {
+    let mut points = Vec::with_capacity(around * across);
+    for i in 0..around {
+        let a = TAU * i as f64 / around as f64;
+        for j in 0..across {
+            let b = TAU * j as f64 / across as f64;
+            let tube = 0.5 * (1.0 + 0.05 * (7.0 * a).sin());
+            let rho = 2.0 + tube * b.cos();
+            points.push([rho * a.cos(), tube * b.sin(), rho * a.sin()]);
+        }
+    }
+    let v = |i: usize, j: usize| ((i % around) * across + (j % across)) as i32;
+    let mut indices = Vec::with_capacity(4 * around * across);
+    for i in 0..around {
+        for j in 0..across {
+            indices.extend([v(i, j), v(i, j + 1), v(i + 1, j + 1), v(i + 1, j)]);
+        }
+    }
+    let counts = vec![4; around * across];
+    MeshGeometry::triangulate(
+        &MeshTopology {
+            points: &points,
+            face_vertex_counts: &counts,
+            face_vertex_indices: &indices,
+            hole_indices: &[],
+            left_handed: false,
+        },
+        DMat4::IDENTITY,
+    )
+    .expect("a valid torus")
+}
+
+fn mesh_light(c: &mut Criterion) {
+    let geometry = torus(250, 200);
+    assert_eq!(geometry.triangles.len(), 100_000);
+    let light = Light::mesh(geometry);
+    let cpu = Evaluator::cpu();
+    let mut group = c.benchmark_group("mesh_light");
+    group.sample_size(10);
+    group.bench_function("prepare 100k triangles", |b| {
+        b.iter(|| cpu.prepare(std::slice::from_ref(&light)).expect("prepare"))
+    });
+    let scene = cpu.prepare(std::slice::from_ref(&light)).expect("prepare");
+    let mut rng = Rng::new(3);
+    let n = 1_000_000;
+    // Rays from a shell around the torus toward points near it: most hit.
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|_| (rng.unit() * rng.range(3.0, 6.0)).as_vec3().to_array())
+        .collect();
+    let dirs: Vec<[f32; 3]> = points
+        .iter()
+        .map(|p| {
+            let target = rng.unit() * 2.0;
+            (target - DVec3::from_array(p.map(f64::from))).as_vec3().to_array()
+        })
+        .collect();
+    group.throughput(Throughput::Elements(n as u64));
+    group.bench_function("radiance 1M rays", |b| {
+        b.iter(|| scene.radiance(&points, &dirs, Accumulate::Sum).expect("radiance"))
+    });
+    group.throughput(Throughput::Elements(1));
+    // A receiver inside the ring, above the torus' plane, facing down into it.
+    let x = [[0.5f32, 1.0, 0.3]];
+    let nrm = [[0.0f32, -1.0, 0.0]];
+    group.bench_function("irradiance at one receiver", |b| {
+        b.iter(|| scene.irradiance(&x, &nrm, Accumulate::Sum).expect("irradiance"))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, mesh_light);
+criterion_main!(benches);
