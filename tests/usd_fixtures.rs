@@ -966,7 +966,7 @@ fn mesh_lights_and_portals_match_usd_core() {
             }
             // Evaluated (DESIGN.md §7), as the light the queries see.
             if l.light.as_ref().map(|x| x.kind.usd_type()) != Some("Mesh")
-                || w.contains("not evaluated")
+                || w.contains("not evaluated yet")
             {
                 bad(format!("{p}: not evaluated ({w:?})"));
             }

@@ -1,6 +1,8 @@
 //! Mesh lights (MeshLightAPI, DESIGN.md §7) on the CPU reference, in f64.
 //!
 //! - [`ray`]: the first triangle a ray meets, through the prepared hierarchy (M3 `radiance`).
+//! - [`shaped`]: a shaped mesh light's irradiance over one visible piece, in polar coordinates
+//!   about its primary axis.
 //! - [`visible`]: the parts of a mesh's triangles seen from a point (gnomonic charts) or from a
 //!   direction at infinity (orthographic), with the mesh's self-occlusion, exactly: what M3's
 //!   irradiance and intensity integrate.
@@ -10,6 +12,7 @@
 //! every triangle occludes the mesh's own light from either side (M2, M3).
 
 pub(crate) mod ray;
+pub(crate) mod shaped;
 pub(crate) mod visible;
 
 use glam::DVec3;
@@ -102,9 +105,7 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3, rel: f64) -> DVec3 {
     let mut sum = DVec3::ZERO;
     for piece in surface.visible_from(x) {
         if piece.emitting {
-            sum += visible::integrate_piece(&piece.verts, n, rel, &mut |w: DVec3| {
-                shaping(p, -w)
-            });
+            sum += shaped::piece(p, &piece.verts, n, rel);
         }
     }
     p.base * sum
