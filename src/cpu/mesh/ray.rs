@@ -46,34 +46,85 @@ pub fn intersect(tri: &MeshTriangle, o: DVec3, d: DVec3) -> Option<(f64, bool)> 
     (t > 0.0 && t.is_finite()).then_some((t, det > 0.0))
 }
 
-/// The slab test (Kay & Kajiya 1986): whether the ray meets `b` before `t_max`.
-fn meets_box(b: &Aabb, o: DVec3, inv_d: DVec3, t_max: f64) -> bool {
+/// The slab test (Kay & Kajiya 1986): the distance at which the ray enters `b` (0 when it
+/// starts inside), or `None` when it misses `b` or enters it beyond `t_max`.
+fn enter_box(b: &Aabb, o: DVec3, inv_d: DVec3, t_max: f64) -> Option<f64> {
     let t0 = (b.min - o) * inv_d;
     let t1 = (b.max - o) * inv_d;
     // NaN (0 · ∞ for a ray in a slab's plane) is treated as inside: min/max ignore it.
     let near = t0.min(t1).max_element().max(0.0);
     let far = t0.max(t1).min_element();
-    near <= far && near <= t_max
+    (near <= far && near <= t_max).then_some(near)
 }
 
-/// The first triangle the ray `o + t·d`, t > 0, meets.
+/// Deepest traversal stack: a binned-SAH tree over at most 2³² triangles stays far below it,
+/// and a deeper one (a pathological split) falls back to a heap-allocated stack.
+const STACK: usize = 64;
+
+/// The traversal's stack: on the call's own stack up to [`STACK`] entries, then on the heap.
+struct Stack {
+    fixed: [u32; STACK],
+    top: usize,
+    spill: Vec<u32>,
+}
+
+impl Stack {
+    fn push(&mut self, k: u32) {
+        if self.top < STACK {
+            self.fixed[self.top] = k;
+            self.top += 1;
+        } else {
+            self.spill.push(k);
+        }
+    }
+
+    fn pop(&mut self) -> Option<u32> {
+        if let Some(k) = self.spill.pop() {
+            return Some(k);
+        }
+        self.top = self.top.checked_sub(1)?;
+        Some(self.fixed[self.top])
+    }
+}
+
+/// The first triangle the ray `o + t·d`, t > 0, meets. Children are visited nearer first, so
+/// that the nearest hit found early prunes the rest (`t_max`).
 pub fn first_hit(triangles: &[MeshTriangle], bvh: &MeshBvh, o: DVec3, d: DVec3) -> Option<Hit> {
     if bvh.nodes.is_empty() {
         return None;
     }
     let inv_d = d.recip();
     let mut best: Option<Hit> = None;
-    let mut stack: Vec<u32> = Vec::with_capacity(64);
+    let mut stack = Stack {
+        fixed: [0; STACK],
+        top: 0,
+        spill: Vec::new(),
+    };
     stack.push(0);
     while let Some(k) = stack.pop() {
         let node = &bvh.nodes[k as usize];
         let t_max = best.map_or(f64::INFINITY, |h| h.t);
-        if !meets_box(&node.bounds, o, inv_d, t_max) {
+        if enter_box(&node.bounds, o, inv_d, t_max).is_none() {
             continue;
         }
         if node.count == 0 {
-            stack.push(node.first);
-            stack.push(k + 1);
+            let (left, right) = (k + 1, node.first);
+            let tl = enter_box(&bvh.nodes[left as usize].bounds, o, inv_d, t_max);
+            let tr = enter_box(&bvh.nodes[right as usize].bounds, o, inv_d, t_max);
+            // Push the farther first, so the nearer is popped next.
+            match (tl, tr) {
+                (Some(a), Some(b)) if a <= b => {
+                    stack.push(right);
+                    stack.push(left);
+                }
+                (Some(_), Some(_)) => {
+                    stack.push(left);
+                    stack.push(right);
+                }
+                (Some(_), None) => stack.push(left),
+                (None, Some(_)) => stack.push(right),
+                (None, None) => {}
+            }
             continue;
         }
         let leaf = &bvh.order[node.first as usize..(node.first + node.count) as usize];
