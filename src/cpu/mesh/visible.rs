@@ -279,6 +279,14 @@ impl Proj {
     }
 }
 
+/// What of a triangle j may hide a triangle i ([`View::hider`]).
+enum Hider {
+    /// All of proj(j) (its polygon and edge lines are the [`Proj`]'s).
+    Whole,
+    /// The part of proj(j) nearer than i, and its edge lines.
+    Part(Poly, Vec<Line>),
+}
+
 /// The projected triangles of one chart.
 struct View {
     polys: Vec<Proj>,
@@ -338,17 +346,20 @@ impl View {
     }
 
     /// The part of j that may hide i: proj(j) ∩ {j nearer than i}, or None.
-    fn hider(&self, i: &Proj, j: &Proj) -> Option<Poly> {
+    fn hider(&self, i: &Proj, j: &Proj) -> Option<Hider> {
         let d: Vec<f64> = j.poly.iter().map(|&q| j.depth(q) - i.depth(q)).collect();
         let tol = DEPTH_TOL * (i.zmax + j.zmax + self.zfloor);
         if d.iter().all(|v| v.abs() <= tol) {
             // Coplanar: the first in the slice is nearer (DESIGN.md M1).
-            return (j.tri < i.tri).then(|| j.poly.clone());
+            return (j.tri < i.tri).then_some(Hider::Whole);
         }
         match clip::split(&j.poly, &d, tol) {
-            Side::Inside => Some(j.poly.clone()),
+            Side::Inside => Some(Hider::Whole),
             Side::Outside => None,
-            Side::Split(nearer, _) => Some(nearer),
+            Side::Split(nearer, _) => {
+                let lines = clip::edge_lines(&nearer);
+                Some(Hider::Part(nearer, lines))
+            }
         }
     }
 
@@ -386,7 +397,10 @@ impl View {
             for &(_, k) in &cand {
                 let pk = &self.polys[k];
                 let Some(hider) = self.hider(pi, pk) else { continue };
-                let hider_lines = clip::edge_lines(&hider);
+                let (hider, hider_lines) = match &hider {
+                    Hider::Whole => (&pk.poly, &pk.lines),
+                    Hider::Part(p, l) => (p, l),
+                };
                 next.clear();
                 for piece in pieces.drain(..) {
                     let lines = clip::edge_lines(&piece);

@@ -358,19 +358,34 @@ fn occluder_hides_part_of_emitter() {
     println!("occluder: worst relative error {worst:.2e}");
 }
 
+/// Lambert's formula summed over every triangle whose emitting side faces x, ignoring
+/// occlusion: what a version without self-occlusion would return.
+fn without_occlusion(s: &Surface, x: DVec3, n: DVec3) -> f64 {
+    s.triangles
+        .iter()
+        .filter(|t| emits(t, s.double_sided, x - t.p[0]))
+        .map(|t| lambert_of(&t.p, x, n))
+        .sum()
+}
+
 /// Compares cosine_solid_angle with the ray-cast reference at a few receivers; returns the
-/// worst error in units of the reference's standard error.
+/// worst error in units of the reference's standard error. It also checks that the cases
+/// exercise occlusion: at some receiver, ignoring it would be off by more than 20σ.
 fn against_ray_cast(s: &Surface, cases: &[(DVec3, DVec3)], reps: usize, grid: usize) -> f64 {
     let mut worst: f64 = 0.0;
+    let mut occlusion_seen: f64 = 0.0;
     for &(x, n) in cases {
         let got = s.cosine_solid_angle(x, n);
         let (m, se) = ray_cast_irradiance(s, x, n, |_| 1.0, reps, grid);
         let sigmas = (got - m).abs() / se.max(1e-12);
         println!("  x={x:.2} n={n:.2}: exact {got:.6} ray cast {m:.6} ± {se:.1e} ({sigmas:.1}σ)");
         assert!(m > 0.0 && got > 0.0, "the case should see some light");
+        occlusion_seen = occlusion_seen.max((without_occlusion(s, x, n) - m).abs() / se);
         assert!((got - m).abs() <= 4.0 * se + 1e-12, "{x} {n}: {got} vs {m} ± {se}");
         worst = worst.max(sigmas);
     }
+    println!("  ignoring occlusion would be off by up to {occlusion_seen:.0}σ");
+    assert!(occlusion_seen > 20.0, "no case tells occlusion from none ({occlusion_seen:.1}σ)");
     worst
 }
 
@@ -389,13 +404,47 @@ fn interpenetrating_triangles_against_ray_cast() {
 }
 
 #[test]
+fn crossing_quads_exact() {
+    // A horizontal quad (z = 0, front +z) and a vertical one (x = 0, front +x) crossing along
+    // the y axis. From any x with x > 0, z > 0 whose rays through the far halves stay within
+    // |y| ≤ 1 (checked by hand for these receivers: the rays to the hidden halves cross the other
+    // quad at |y| < 1), the vertical quad's upper half hides the horizontal quad's half x < 0
+    // and the horizontal quad's half x > 0 hides the vertical quad's lower half: what is seen is
+    // the two near halves.
+    let mut t = Vec::new();
+    quad(&mut t, v(-1.0, -1.0, 0.0), v(1.0, -1.0, 0.0), v(1.0, 1.0, 0.0), v(-1.0, 1.0, 0.0));
+    quad(&mut t, v(0.0, -1.0, -1.0), v(0.0, 1.0, -1.0), v(0.0, 1.0, 1.0), v(0.0, -1.0, 1.0));
+    let near_h = [v(0.0, -1.0, 0.0), v(1.0, -1.0, 0.0), v(1.0, 1.0, 0.0), v(0.0, 1.0, 0.0)];
+    let near_v = [v(0.0, -1.0, 0.0), v(0.0, 1.0, 0.0), v(0.0, 1.0, 1.0), v(0.0, -1.0, 1.0)];
+    let mut worst: f64 = 0.0;
+    for x in [v(0.5, 0.0, 1.0), v(0.7, 0.3, 0.6)] {
+        for n in directions() {
+            let expect = lambert_of(&near_h, x, n) + lambert_of(&near_v, x, n);
+            for ds in [false, true] {
+                let got = Surface { triangles: &t, double_sided: ds }.cosine_solid_angle(x, n);
+                let err = (got - expect).abs() / expect.max(1e-3);
+                worst = worst.max(err);
+                assert!(err <= 1e-9, "{x} {n} ds={ds}: {got} vs {expect}");
+            }
+        }
+    }
+    println!("crossing quads: worst relative error {worst:.2e}");
+}
+
+#[test]
 fn l_prism_and_ring_against_ray_cast() {
     let l = l_prism(0.8);
     let s = Surface { triangles: &l, double_sided: false };
-    // Receivers in the notch of the L (where the prism hides itself) and beyond.
+    // Receivers in the notch of the L and beyond it, and beside the arm along x, which hides
+    // part of the notch's wall x = 1 from them (the rays to it cross the arm).
     let w = against_ray_cast(
         &s,
-        &[(v(1.6, 1.6, 0.4), v(-1.0, -1.0, 0.0).normalize()), (v(2.5, 2.2, 1.5), v(-1.0, -0.8, -0.9).normalize()), (v(1.3, 1.9, 0.2), v(-0.2, -1.0, 0.3).normalize())],
+        &[
+            (v(1.6, 1.6, 0.4), v(-1.0, -1.0, 0.0).normalize()),
+            (v(2.5, 2.2, 1.5), v(-1.0, -0.8, -0.9).normalize()),
+            (v(2.5, 0.5, 0.4), v(-1.0, 0.3, 0.0).normalize()),
+            (v(2.4, 0.3, 1.2), v(-1.0, 0.4, -0.5).normalize()),
+        ],
         8,
         300,
     );
@@ -409,6 +458,41 @@ fn l_prism_and_ring_against_ray_cast() {
         300,
     );
     println!("ring: worst {w:.1}σ");
+}
+
+/// `m` random triangles in the unit cube (sides up to `size`), the first half single-sided
+/// emitters facing random ways: a soup with interpenetration and cyclic overlap.
+fn soup(m: usize, size: f64, seed: u64) -> Vec<MeshTriangle> {
+    let mut rng = Rng(seed);
+    let r3 = |rng: &mut Rng| v(rng.next(), rng.next(), rng.next());
+    (0..m)
+        .map(|_| {
+            let c = r3(&mut rng);
+            let (a, b, d) = (r3(&mut rng) - 0.5, r3(&mut rng) - 0.5, r3(&mut rng) - 0.5);
+            tri(c + a * size, c + b * size, c + d * size)
+        })
+        .collect()
+}
+
+#[test]
+fn triangle_soup_against_ray_cast() {
+    let t = soup(40, 0.8, 99);
+    for ds in [false, true] {
+        let s = Surface { triangles: &t, double_sided: ds };
+        let w = against_ray_cast(
+            &s,
+            &[(v(0.5, 0.5, 2.0), DVec3::NEG_Z), (v(0.5, 0.45, 0.55), v(0.3, 0.2, 1.0).normalize()), (v(-0.6, 0.2, 0.4), DVec3::X)],
+            8,
+            300,
+        );
+        println!("soup (double-sided {ds}): worst {w:.1}σ");
+        for w in [v(0.2, 0.3, 1.0), v(-1.0, 0.1, 0.2)] {
+            let got = s.projected_area(w);
+            let (m, se) = ray_cast_area(&s, w, 8, 600);
+            println!("  soup along {w:.2}: exact {got:.6} ray cast {m:.6} ± {se:.1e}");
+            assert!((got - m).abs() <= 4.0 * se, "{w}: {got} vs {m} ± {se}");
+        }
+    }
 }
 
 #[test]
@@ -637,4 +721,22 @@ fn timing_ring_of_2000_triangles() {
         pieces / receivers.len()
     );
     assert!(total.is_finite() && area.is_finite());
+    // A soup of 2000 random triangles: heavy overlap, the pathological case for fragmentation.
+    let t = soup(2000, 0.15, 5);
+    let s = Surface { triangles: &t, double_sided: false };
+    let start = Instant::now();
+    let mut pieces = 0;
+    for (x, _) in receivers {
+        pieces += s.visible_from(x).len();
+    }
+    let ms_soup = start.elapsed().as_secs_f64() * 1e3 / receivers.len() as f64;
+    let start = Instant::now();
+    let a = s.projected_area(v(0.2, 0.3, 1.0));
+    let ms_soup_area = start.elapsed().as_secs_f64() * 1e3;
+    println!(
+        "soup of 2000 random triangles: visible_from {ms_soup:.2} ms per receiver ({} pieces on average), projected_area {ms_soup_area:.2} ms",
+        pieces / receivers.len()
+    );
+    assert!(a.is_finite());
 }
+
