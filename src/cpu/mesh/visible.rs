@@ -177,9 +177,10 @@ impl Surface<'_> {
                 if planes.iter().any(|m| s.q.iter().all(|q| m.dot(*q) < 0.0)) {
                     continue;
                 }
-                let mut w3: Vec<DVec3> = s.q.to_vec();
-                for m in planes {
-                    w3 = clip3(&w3, m);
+                // Each vertex carries the set of pyramid planes it was cut on (see clip3).
+                let mut w3: Vec<(DVec3, u8)> = s.q.iter().map(|&q| (q, 0)).collect();
+                for (bit, m) in planes.iter().enumerate() {
+                    w3 = clip3(&w3, *m, 1 << bit);
                     if w3.len() < 3 {
                         break;
                     }
@@ -188,12 +189,26 @@ impl Surface<'_> {
                     continue;
                 }
                 // w·e ≥ |w|/√3 inside the pyramid, and w ≠ 0 because x is off the plane.
-                if w3.iter().any(|w| !(w.dot(e) > 0.0)) {
+                if w3.iter().any(|(w, _)| !(w.dot(e) > 0.0)) {
                     continue;
                 }
+                // A vertex cut on a pyramid plane lies on the chart's border u = ±1 or v = ±1
+                // exactly: say so rather than keep the rounding of its construction. This
+                // matters where x is close to the triangle's plane: a corner of the chart's
+                // square inside the triangle is then reached by cutting segments between far
+                // vertices, whose rounding (relative to their length) is large relative to
+                // the corner's distance; the corner itself is known exactly.
                 let poly: Poly = w3
                     .iter()
-                    .map(|w| DVec2::new(w.dot(a), w.dot(b)) / w.dot(e))
+                    .map(|&(w, cut)| {
+                        let mut uv = DVec2::new(w.dot(a), w.dot(b)) / w.dot(e);
+                        for (bit, (axis, value)) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)].into_iter().enumerate() {
+                            if cut & (1 << bit) != 0 {
+                                uv[axis] = value;
+                            }
+                        }
+                        uv
+                    })
                     .collect();
                 // Inverse depth h = n·(e + u a + v b) / c.
                 let z = DVec3::new(s.n.dot(a), s.n.dot(b), s.n.dot(e)) / s.c;
@@ -404,8 +419,8 @@ impl View {
                 next.clear();
                 for piece in pieces.drain(..) {
                     let lines = clip::edge_lines(&piece);
-                    if clip::overlap(&piece, &lines, &hider, &hider_lines, self.tol) {
-                        clip::subtract(piece, &hider_lines, self.tol, self.tiny, &mut next);
+                    if clip::overlap(&piece, &lines, hider, hider_lines, self.tol) {
+                        clip::subtract(piece, hider_lines, self.tol, self.tiny, &mut next);
                     } else {
                         next.push(piece);
                     }
@@ -423,17 +438,18 @@ impl View {
 }
 
 /// Sutherland–Hodgman against one plane through the origin: the part of the convex polygon
-/// where m·w ≥ 0.
-fn clip3(p: &[DVec3], m: DVec3) -> Vec<DVec3> {
+/// where m·w ≥ 0. Each vertex carries a set of planes (bits): a vertex made on this plane gets
+/// `bit` and the planes its segment's two ends share (the planes the segment lies in).
+fn clip3(p: &[(DVec3, u8)], m: DVec3, bit: u8) -> Vec<(DVec3, u8)> {
     let mut out = Vec::with_capacity(p.len() + 1);
     for k in 0..p.len() {
-        let (a, b) = (p[k], p[(k + 1) % p.len()]);
+        let ((a, ma), (b, mb)) = (p[k], p[(k + 1) % p.len()]);
         let (da, db) = (m.dot(a), m.dot(b));
         if da >= 0.0 {
-            out.push(a);
+            out.push((a, ma));
         }
         if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
-            out.push(a + (b - a) * (da / (da - db)));
+            out.push((a + (b - a) * (da / (da - db)), (ma & mb) | bit));
         }
     }
     out
@@ -532,9 +548,8 @@ pub(crate) fn integrate_piece(
 ) -> DVec3 {
     /// A bound on the work: cells (each 28 evaluations of f when made).
     const MAX_CELLS: usize = 20_000;
-    let mut poly = verts.to_vec();
-    poly = clip3(&poly, n);
-    let units: Vec<DVec3> = poly.iter().filter_map(|q| q.try_normalize()).collect();
+    let poly: Vec<(DVec3, u8)> = verts.iter().map(|&q| (q, 0)).collect();
+    let units: Vec<DVec3> = clip3(&poly, n, 0).iter().filter_map(|(q, _)| q.try_normalize()).collect();
     if units.len() < 3 {
         return DVec3::ZERO;
     }

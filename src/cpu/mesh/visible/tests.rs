@@ -668,6 +668,66 @@ fn integrate_piece_of_constant_is_lambert() {
 }
 
 #[test]
+fn integrate_piece_over_an_enclosure_is_the_hemisphere_moment() {
+    // From inside an inward box every direction sees an emitting inner side, so the pieces
+    // tile the sphere and ∫ f(ω) max(0, n·ω) dω is the hemisphere's: for f = (n·ω)^k it is
+    // 2π/(k + 2); for f = (a·ω)² with a ⟂ n it is π/4 (∫ sin²θ cos²φ cosθ sinθ dθ dφ).
+    let t = box_mesh(v(-0.5, 0.1, 0.2), v(0.7, 1.3, 0.9), false);
+    let s = Surface { triangles: &t, double_sided: false };
+    let mut worst: f64 = 0.0;
+    for (x, n) in [(v(0.1, 0.7, 0.55), DVec3::Z), (v(0.65, 0.2, 0.3), v(0.3, -0.5, 0.8).normalize())] {
+        let a = n.any_orthonormal_vector();
+        let mut sum = DVec3::ZERO;
+        for p in s.visible_from(x).iter().filter(|p| p.emitting) {
+            sum += integrate_piece(&p.verts, n, 1e-11, &mut |w| DVec3::new(n.dot(w).powi(8), a.dot(w).powi(2), 1.0));
+        }
+        let expect = DVec3::new(2.0 * PI / 10.0, PI / 4.0, PI);
+        let err = ((sum - expect) / expect).abs().max_element();
+        worst = worst.max(err);
+        assert!(err <= 1e-9, "{x} {n}: {sum} vs {expect}");
+    }
+    println!("integrate_piece over an enclosure: worst relative error {worst:.2e}");
+}
+
+#[test]
+fn near_and_far_receivers() {
+    // 1e-9 from a face, and far away (the chart shrinks to 1e-4 across): the tolerances are
+    // relative, so the result stays at Lambert's formula's accuracy. (Measured: ~2e-15 at 1e-9
+    // from a face, where the chart's corners inside the face must be exact, see clip3's bits;
+    // 3e-10 at 1e4 away, where Lambert's formula itself, in the reference as in the pieces,
+    // cancels edge terms of 1e-4 to a sum of 1e-8.)
+    let (lo, hi) = (v(0.0, 0.0, 0.0), v(1.0, 1.0, 1.0));
+    let t = box_mesh(lo, hi, true);
+    let faces: Vec<Vec<DVec3>> = box_faces(lo, hi).into_iter().map(|f| f.to_vec()).collect();
+    let mut worst: f64 = 0.0;
+    for x in [v(0.4, 0.3, -1e-9), v(0.4, 1.0 + 1e-9, 0.3), v(3e3, 2e3, 1e3), v(1e4, -3e3, 2e2) + 0.5] {
+        for n in directions() {
+            let expect = convex_reference(&faces, x, n);
+            let got = Surface { triangles: &t, double_sided: false }.cosine_solid_angle(x, n);
+            let err = (got - expect).abs() / expect.max(1e-300);
+            assert!(err <= 1e-9 || (got - expect).abs() <= 1e-15 * PI, "{x} {n}: {got} vs {expect}");
+            if expect > 0.0 {
+                worst = worst.max(err);
+            }
+        }
+    }
+    // Inside a double-sided box, 1e-9 above its floor: enclosed, π.
+    let got = Surface { triangles: &t, double_sided: true }.cosine_solid_angle(v(0.4, 0.3, 1e-9), DVec3::Z);
+    assert!(rel(got, PI) <= 1e-9, "{got}");
+    // A mesh far from the origin.
+    let off = v(1e5, -2e5, 3e5);
+    let t2: Vec<MeshTriangle> = t.iter().map(|tr| tri(tr.p[0] + off, tr.p[1] + off, tr.p[2] + off)).collect();
+    let faces2: Vec<Vec<DVec3>> = faces.iter().map(|f| f.iter().map(|c| *c + off).collect()).collect();
+    let x = off + v(2.5, 1.7, 3.1);
+    for n in directions() {
+        let expect = convex_reference(&faces2, x, n);
+        let got = Surface { triangles: &t2, double_sided: false }.cosine_solid_angle(x, n);
+        assert!((got - expect).abs() <= 1e-9 * expect.max(1e-3), "{n}: {got} vs {expect}");
+    }
+    println!("near and far receivers: worst relative error {worst:.2e}");
+}
+
+#[test]
 fn integrate_piece_of_shaped_radiance_against_ray_cast() {
     // A radiance peaked along −z (a shaping lobe), over a quad with an occluder.
     let mut t = Vec::new();
@@ -739,4 +799,7 @@ fn timing_ring_of_2000_triangles() {
     );
     assert!(a.is_finite());
 }
+
+
+
 
