@@ -34,6 +34,29 @@
 //! piece is a convex planar polygon given as vectors from x, and Lambert's formula
 //! ([`polygon_irradiance`]: Lambert 1760; Arvo 1995, "Applications of irradiance tensors",
 //! with the horizon clip) gives its cosine-weighted solid angle in closed form.
+//!
+//! Sources: the gnomonic projection, Snyder 1987, "Map Projections — A Working Manual", §22;
+//! polygon clipping, Sutherland & Hodgman 1974, "Reentrant polygon clipping"; the separating
+//! axis test for convex polygons, Gottschalk, Lin & Manocha 1996 (OBBTree), in 2-D.
+//!
+//! # Numbers
+//! - A triangle whose plane passes within [`EDGE_ON`] (relative) of x is skipped: it subtends
+//!   no solid angle, hides nothing of positive measure, and its depth 1/c would be rounding.
+//!   This is what makes receivers on the mesh (a floor touching it) finite.
+//! - Lengths in a chart below [`LENGTH_TOL`] of the chart's extent, and depth differences below
+//!   [`DEPTH_TOL`] of the depths, count as zero (ties): see [`clip`]. Each moves a result by
+//!   at most that fraction of a piece's size, far below the 1e-9 target.
+//! - A chart vertex cut on a pyramid plane is put exactly on the chart's border (see
+//!   [`clip3`]); without that, x close to a large triangle lost ~1e-8 (measured).
+//!
+//! # Cost
+//! Per chart, each triangle is compared with the triangles whose boxes meet its box (a grid
+//! over the chart, about one triangle per cell). The pieces of one triangle are disjoint convex
+//! unions of cells of the arrangement of the lines that cut it (its occluders' edges and depth
+//! lines), so with m occluders there are O(m²) of them at most, whatever the overlap: the
+//! memory is bounded by the worst triangle's arrangement, and nothing can fail. Measured (see
+//! the timing test): a 2,000-triangle ring takes a few ms per receiver, a soup of 2,000 random
+//! overlapping triangles some 15–20 ms.
 
 mod clip;
 #[cfg(test)]
@@ -106,8 +129,9 @@ impl Surface<'_> {
         out
     }
 
-    /// Unit-radiance irradiance at x for receiver normal n: the sum over the visible emitting
-    /// pieces of Lambert's formula clipped at the horizon (the unshaped M3 irradiance over L).
+    /// Unit-radiance irradiance at x for the unit receiver normal n: the sum over the visible
+    /// emitting pieces of Lambert's formula clipped at the horizon (the unshaped M3 irradiance
+    /// over L).
     #[allow(dead_code)]
     pub(crate) fn cosine_solid_angle(&self, x: DVec3, n: DVec3) -> f64 {
         let mut sum = 0.0;
@@ -149,7 +173,10 @@ impl Surface<'_> {
                 continue;
             }
             let emitting = if self.double_sided { true } else { nw > 0.0 };
-            let poly: Poly = t.p.iter().map(|&p| DVec2::new((p - o).dot(a), (p - o).dot(b))).collect();
+            let poly: Poly =
+                t.p.iter()
+                    .map(|&p| DVec2::new((p - o).dot(a), (p - o).dot(b)))
+                    .collect();
             // Height over (u, v): s = (n·(p0 − o) − u n·a − v n·b) / (n·w).
             let z = DVec3::new(-nhat.dot(a), -nhat.dot(b), nhat.dot(t.p[0] - o)) / nw;
             if let Some(p) = Proj::new(i as u32, emitting, emitting, poly, z) {
@@ -202,7 +229,10 @@ impl Surface<'_> {
                     .iter()
                     .map(|&(w, cut)| {
                         let mut uv = DVec2::new(w.dot(a), w.dot(b)) / w.dot(e);
-                        for (bit, (axis, value)) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)].into_iter().enumerate() {
+                        for (bit, (axis, value)) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)]
+                            .into_iter()
+                            .enumerate()
+                        {
                             if cut & (1 << bit) != 0 {
                                 uv[axis] = value;
                             }
@@ -229,7 +259,11 @@ impl Surface<'_> {
                             if h > 0.0 { w / h } else { w }
                         })
                         .collect();
-                    sink(Piece { triangle: p.tri, emitting: p.emitting, verts });
+                    sink(Piece {
+                        triangle: p.tri,
+                        emitting: p.emitting,
+                        verts,
+                    });
                 }
             });
         }
@@ -284,7 +318,17 @@ impl Proj {
         }
         let lines = clip::edge_lines(&poly);
         let (lo, hi) = clip::bounds(&poly);
-        let mut p = Proj { tri, emitting, wanted, poly, lines, z, zmax: 0.0, lo, hi };
+        let mut p = Proj {
+            tri,
+            emitting,
+            wanted,
+            poly,
+            lines,
+            z,
+            zmax: 0.0,
+            lo,
+            hi,
+        };
         p.zmax = p.poly.iter().map(|&q| p.depth(q).abs()).fold(0.0, f64::max);
         Some(p)
     }
@@ -324,7 +368,11 @@ impl View {
             (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
             |(lo, hi), p| (lo.min(p.lo), hi.max(p.hi)),
         );
-        let extent = if polys.is_empty() { 0.0 } else { (ghi - glo).max_element() };
+        let extent = if polys.is_empty() {
+            0.0
+        } else {
+            (ghi - glo).max_element()
+        };
         let tol = LENGTH_TOL * extent;
         // About one polygon per cell on average, and a bounded grid.
         let g = ((polys.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
@@ -399,7 +447,9 @@ impl View {
                         }
                         stamp[k] = i;
                         let pk = &self.polys[k];
-                        if pk.lo.cmple(pi.hi + self.tol).all() && pk.hi.cmpge(pi.lo - self.tol).all() {
+                        if pk.lo.cmple(pi.hi + self.tol).all()
+                            && pk.hi.cmpge(pi.lo - self.tol).all()
+                        {
                             cand.push((pk.depth(centre), k));
                         }
                     }
@@ -411,7 +461,9 @@ impl View {
             let mut pieces: Vec<Poly> = vec![pi.poly.clone()];
             for &(_, k) in &cand {
                 let pk = &self.polys[k];
-                let Some(hider) = self.hider(pi, pk) else { continue };
+                let Some(hider) = self.hider(pi, pk) else {
+                    continue;
+                };
                 let (hider, hider_lines) = match &hider {
                     Hider::Whole => (&pk.poly, &pk.lines),
                     Hider::Part(p, l) => (p, l),
@@ -467,7 +519,9 @@ fn lambert(q: &[DVec3], n: DVec3) -> f64 {
         let (a, b, c) = (q[k], q[(k + 1) % m], q[(k + 2) % m]);
         (b - a).cross(c - b).dot(a).abs()
     };
-    let best = (0..m).max_by(|&a, &b| turn(a).total_cmp(&turn(b))).unwrap_or(0);
+    let best = (0..m)
+        .max_by(|&a, &b| turn(a).total_cmp(&turn(b)))
+        .unwrap_or(0);
     if best == 0 {
         return polygon_irradiance(q, n);
     }
@@ -513,8 +567,16 @@ fn split_cell(t: &[DVec3; 3]) -> [[DVec3; 3]; 4] {
 /// and weights (summing to 1).
 fn radon7() -> [([f64; 3], f64); 7] {
     let s = 15f64.sqrt();
-    let (a1, b1, w1) = ((6.0 - s) / 21.0, (9.0 + 2.0 * s) / 21.0, (155.0 - s) / 1200.0);
-    let (a2, b2, w2) = ((6.0 + s) / 21.0, (9.0 - 2.0 * s) / 21.0, (155.0 + s) / 1200.0);
+    let (a1, b1, w1) = (
+        (6.0 - s) / 21.0,
+        (9.0 + 2.0 * s) / 21.0,
+        (155.0 - s) / 1200.0,
+    );
+    let (a2, b2, w2) = (
+        (6.0 + s) / 21.0,
+        (9.0 - 2.0 * s) / 21.0,
+        (155.0 + s) / 1200.0,
+    );
     [
         ([1.0 / 3.0; 3], 9.0 / 40.0),
         ([a1, a1, b1], w1),
@@ -549,7 +611,10 @@ pub(crate) fn integrate_piece(
     /// A bound on the work: cells (each 28 evaluations of f when made).
     const MAX_CELLS: usize = 20_000;
     let poly: Vec<(DVec3, u8)> = verts.iter().map(|&q| (q, 0)).collect();
-    let units: Vec<DVec3> = clip3(&poly, n, 0).iter().filter_map(|(q, _)| q.try_normalize()).collect();
+    let units: Vec<DVec3> = clip3(&poly, n, 0)
+        .iter()
+        .filter_map(|(q, _)| q.try_normalize())
+        .collect();
     if units.len() < 3 {
         return DVec3::ZERO;
     }
@@ -572,7 +637,12 @@ pub(crate) fn integrate_piece(
         let coarse = coarse.unwrap_or_else(|| value(&t));
         let children = split_cell(&t).map(|c| value(&c));
         let fine = children.iter().sum::<DVec3>();
-        Cell { tri: t, children, fine, err: (fine - coarse).abs().max_element() }
+        Cell {
+            tri: t,
+            children,
+            fine,
+            err: (fine - coarse).abs().max_element(),
+        }
     };
     // Start from cells no wider than about 0.5 rad, where the rule is already close.
     let mut start: Vec<[DVec3; 3]> = (1..units.len() - 1)
@@ -598,7 +668,9 @@ pub(crate) fn integrate_piece(
                 return total;
             }
         }
-        let Some(worst) = heap.pop() else { return total };
+        let Some(worst) = heap.pop() else {
+            return total;
+        };
         total -= worst.fine;
         err -= worst.err;
         for (t, coarse) in split_cell(&worst.tri).into_iter().zip(worst.children) {

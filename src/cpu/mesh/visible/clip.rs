@@ -119,7 +119,13 @@ pub(super) fn split(p: &[DVec2], d: &[f64], tol: f64) -> Side {
 /// Whether two convex polygons overlap in more than the tolerance: by the separating axis
 /// theorem (for convex polygons an edge line of one of them separates them whenever anything
 /// does).
-pub(super) fn overlap(p: &[DVec2], p_lines: &[Line], s: &[DVec2], s_lines: &[Line], tol: f64) -> bool {
+pub(super) fn overlap(
+    p: &[DVec2],
+    p_lines: &[Line],
+    s: &[DVec2],
+    s_lines: &[Line],
+    tol: f64,
+) -> bool {
     let separates = |l: &Line, q: &[DVec2]| q.iter().all(|&v| l.eval(v) <= tol);
     !(s_lines.iter().any(|l| separates(l, p)) || p_lines.iter().any(|l| separates(l, s)))
 }
