@@ -613,6 +613,11 @@ fn l_prism_and_ring_against_ray_cast() {
     );
     println!("L prism: worst {w:.1}σ");
     let r = ring(16, 6, 1.0, 0.3);
+    let zmin = r
+        .iter()
+        .flat_map(|t| t.p)
+        .map(|p| p.z)
+        .fold(f64::INFINITY, f64::min);
     let s = Surface {
         triangles: &r,
         double_sided: false,
@@ -623,6 +628,9 @@ fn l_prism_and_ring_against_ray_cast() {
             (v(0.0, 0.0, 0.0), DVec3::X),
             (v(0.2, -0.1, 0.9), v(0.3, 0.1, -1.0).normalize()),
             (v(2.2, 0.3, 0.4), v(-1.0, 0.0, -0.1).normalize()),
+            // A floor touching the ring's flat bottom, beside it and under its hole.
+            (v(1.45, 0.1, zmin), DVec3::Z),
+            (v(0.3, 0.2, zmin), DVec3::Z),
         ],
         8,
         300,
@@ -870,6 +878,29 @@ fn receivers_on_the_mesh_are_finite() {
                     for p in s.visible_from(x) {
                         assert!(p.verts.iter().all(|q| q.is_finite()));
                     }
+                }
+            }
+        }
+    }
+    // On the ring's vertices and edges' midpoints, where several triangles meet at x.
+    let r = ring(16, 6, 1.0, 0.3);
+    for ds in [false, true] {
+        let s = Surface {
+            triangles: &r,
+            double_sided: ds,
+        };
+        for tr in r.iter().step_by(7) {
+            for x in [
+                tr.p[0],
+                0.5 * (tr.p[1] + tr.p[2]),
+                (tr.p[0] + tr.p[1] + tr.p[2]) / 3.0,
+            ] {
+                for n in directions().into_iter().take(5) {
+                    let e = s.cosine_solid_angle(x, n);
+                    assert!(
+                        e.is_finite() && (0.0..=PI * (1.0 + 1e-12)).contains(&e),
+                        "{x} {n}: {e}"
+                    );
                 }
             }
         }
