@@ -468,10 +468,15 @@ impl View {
                     Hider::Whole => (&pk.poly, &pk.lines),
                     Hider::Part(p, l) => (p, l),
                 };
+                let (hlo, hhi) = clip::bounds(hider);
                 next.clear();
                 for piece in pieces.drain(..) {
-                    let lines = clip::edge_lines(&piece);
-                    if clip::overlap(&piece, &lines, hider, hider_lines, self.tol) {
+                    // Cheapest rejections first: boxes, then the hider's edges (no allocation),
+                    // then the piece's own edges.
+                    let (plo, phi) = clip::bounds(&piece);
+                    let boxes_meet =
+                        plo.cmple(hhi + self.tol).all() && phi.cmpge(hlo - self.tol).all();
+                    if boxes_meet && clip::overlap(&piece, hider, hider_lines, self.tol) {
                         clip::subtract(piece, hider_lines, self.tol, self.tiny, &mut next);
                     } else {
                         next.push(piece);
