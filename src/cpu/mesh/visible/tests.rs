@@ -707,6 +707,18 @@ fn projected_area_of_cubes() {
             0.0
         );
     }
+    // Far from the origin (the chart is centred on the mesh, so nothing changes).
+    let far = box_mesh(v(1e6, -2e6, 3e5), v(1e6 + 1.0, -2e6 + 1.0, 3e5 + 1.0), true);
+    for w in directions() {
+        let expect = w.x.abs() + w.y.abs() + w.z.abs();
+        let got = Surface {
+            triangles: &far,
+            double_sided: false,
+        }
+        .projected_area(w);
+        worst = worst.max(rel(got, expect));
+        assert!(rel(got, expect) <= 1e-9, "far {w}: {got} vs {expect}");
+    }
     let s3 = 3f64.sqrt();
     let got = Surface {
         triangles: &t,
