@@ -118,10 +118,14 @@ pub(super) fn split(p: &[DVec2], d: &[f64], tol: f64) -> Side {
 
 /// Whether two convex polygons overlap in more than the tolerance: by the separating axis
 /// theorem (for convex polygons an edge line of one of them separates them whenever anything
-/// does).
-pub(super) fn overlap(p: &[DVec2], p_lines: &[Line], s: &[DVec2], s_lines: &[Line], tol: f64) -> bool {
+/// does). s's edge lines are given; p's are only made when s's do not separate.
+pub(super) fn overlap(p: &[DVec2], s: &[DVec2], s_lines: &[Line], tol: f64) -> bool {
     let separates = |l: &Line, q: &[DVec2]| q.iter().all(|&v| l.eval(v) <= tol);
-    !(s_lines.iter().any(|l| separates(l, p)) || p_lines.iter().any(|l| separates(l, s)))
+    if s_lines.iter().any(|l| separates(l, p)) {
+        return false;
+    }
+    !(0..p.len())
+        .any(|k| Line::through(p[k], p[(k + 1) % p.len()]).is_some_and(|l| separates(&l, s)))
 }
 
 /// Appends to `out` the convex pieces of p outside the convex polygon s (given by its edge
