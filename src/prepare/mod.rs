@@ -137,6 +137,9 @@ pub enum KindData {
     Mesh {
         bvh: std::sync::Arc<mesh_bvh::MeshBvh>,
         fronts: std::sync::Arc<Vec<DVec3>>,
+        /// The running sum of the triangles' areas, in order (the last is the mesh's area):
+        /// the table a point is drawn by area from (DESIGN.md §9 S2 "by their geometry").
+        cumulative_area: std::sync::Arc<Vec<f64>>,
     },
 }
 
@@ -333,6 +336,16 @@ impl Prepared {
             LightType::Mesh { ref geometry, .. } => KindData::Mesh {
                 bvh: std::sync::Arc::new(mesh_bvh::MeshBvh::build(&geometry.triangles)),
                 fronts: std::sync::Arc::new(distinct_fronts(&geometry.triangles)),
+                cumulative_area: std::sync::Arc::new(
+                    geometry
+                        .triangles
+                        .iter()
+                        .scan(0.0, |sum, t| {
+                            *sum += t.area();
+                            Some(*sum)
+                        })
+                        .collect(),
+                ),
             },
             _ => {
                 // A texture on any other type is refused rather than evaluated as if untextured.

@@ -257,7 +257,7 @@ impl PreparedScene {
         let Backend::Gpu(g) = &self.backend else {
             return Err(no_device());
         };
-        self.check_sampled()?;
+        self.check_sampled_on_device()?;
         let selection = match opts.selection {
             Selection::Power => SELECT_POWER,
             Selection::Bound => SELECT_BOUND,

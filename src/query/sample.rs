@@ -18,7 +18,6 @@ use crate::cpu::sample::{
     LightAt, SceneTables, choose, env_tables, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
-use crate::model::LightType;
 use crate::gpu::sample::{PdfRow, SampleLights, SampleRow};
 
 pub use crate::cpu::sample::Selection;
@@ -147,6 +146,11 @@ impl PreparedScene {
         let (Backend::Gpu(g), Some(lights)) = (&self.backend, &self.gpu) else {
             return None;
         };
+        // A mesh light's rows are the CPU reference's (GpuPath::Host): the whole scene is
+        // sampled there, so that one light choice and one set of rows serve every light.
+        if self.lights.iter().any(|p| p.on_host()) {
+            return None;
+        }
         let built = self.sampling_gpu.get_or_init(|| {
             let env = self
                 .sampling_env
@@ -354,7 +358,6 @@ impl PreparedScene {
         normals: &[[f32; 3]],
     ) -> Result<Vec<StrategyVariance>> {
         check_pairs(points, "points", normals, "normals")?;
-        self.check_sampled()?;
         let tables = self.sampling_tables(Selection::Bound);
         let mut out = Vec::with_capacity(self.lights.len() * points.len());
         for (k, p) in self.lights.iter().enumerate() {
@@ -521,22 +524,20 @@ impl PreparedScene {
             }
             None => {}
         }
-        self.check_sampled()
+        Ok(())
     }
 
-    /// Sampling refuses a scene with a mesh light (DESIGN.md §7): its lights would be drawn
-    /// without it, a density that misses light the scene has.
-    pub(super) fn check_sampled(&self) -> Result<()> {
-        match self
-            .lights
-            .iter()
-            .find(|p| matches!(p.light.kind, LightType::Mesh { .. }))
-        {
-            Some(p) => Err(LuxError::NotSupported {
+    /// GPU-resident sampling refuses a scene holding a light every query of which the host
+    /// computes (`GpuPath::Host`: mesh lights, drawn by the CPU reference): the device cannot
+    /// draw its rows. `PreparedScene::sample` samples such a scene on the CPU reference.
+    pub(super) fn check_sampled_on_device(&self) -> Result<()> {
+        match self.lights.iter().find(|p| p.on_host()) {
+            Some(p) => Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),
                 query: "sampling".into(),
-                reason: "mesh lights are evaluated (emission, radiance, irradiance, intensity) \
-                         but not sampled yet; leave it out with --light"
+                reason: "it is a mesh light, whose directions the CPU reference draws (through \
+                         its BVH); use PreparedScene::sample, which samples such a scene on the \
+                         CPU reference"
                     .into(),
             }),
             None => Ok(()),

@@ -1,6 +1,7 @@
 //! Mesh lights (MeshLightAPI, DESIGN.md §7) on the CPU reference, in f64.
 //!
 //! - [`ray`]: the first triangle a ray meets, through the prepared hierarchy (M3 `radiance`).
+//! - [`sample`]: directions drawn by area, with the density summed over every triangle crossed.
 //! - [`shaped`]: a shaped mesh light's irradiance over one visible piece, in polar coordinates
 //!   about its primary axis.
 //! - [`visible`]: the parts of a mesh's triangles seen from a point (gnomonic charts) or from a
@@ -12,6 +13,7 @@
 //! every triangle occludes the mesh's own light from either side (M2, M3).
 
 pub(crate) mod ray;
+pub mod sample;
 pub(crate) mod shaped;
 pub(crate) mod visible;
 
@@ -38,7 +40,7 @@ fn parts(
                 double_sided,
                 ..
             },
-            KindData::Mesh { bvh, fronts },
+            KindData::Mesh { bvh, fronts, .. },
         ) => Some((&geometry.triangles, bvh, fronts, *double_sided)),
         _ => None,
     }

@@ -147,6 +147,43 @@ pub fn first_hit(triangles: &[MeshTriangle], bvh: &MeshBvh, o: DVec3, d: DVec3) 
     best
 }
 
+/// Every triangle the ray `o + t·d`, t > 0, meets, in no particular order: `hit(triangle, t)`.
+/// The density of a direction drawn by area sums over all of them (`cpu::mesh::sample`).
+pub fn all_hits(
+    triangles: &[MeshTriangle],
+    bvh: &MeshBvh,
+    o: DVec3,
+    d: DVec3,
+    mut hit: impl FnMut(u32, f64),
+) {
+    if bvh.nodes.is_empty() {
+        return;
+    }
+    let inv_d = d.recip();
+    let mut stack = Stack {
+        fixed: [0; STACK],
+        top: 0,
+        spill: Vec::new(),
+    };
+    stack.push(0);
+    while let Some(k) = stack.pop() {
+        let node = &bvh.nodes[k as usize];
+        if enter_box(&node.bounds, o, inv_d, f64::INFINITY).is_none() {
+            continue;
+        }
+        if node.count == 0 {
+            stack.push(node.first);
+            stack.push(k + 1);
+            continue;
+        }
+        for &i in &bvh.order[node.first as usize..(node.first + node.count) as usize] {
+            if let Some((t, _)) = intersect(&triangles[i as usize], o, d) {
+                hit(i, t);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -128,7 +128,7 @@ pub fn piece(p: &Prepared, verts: &[DVec3], n: DVec3, rel: f64) -> DVec3 {
         max_intervals: 100,
     };
     let radial = p.ies.is_none();
-    let mut ring = |th: f64| -> DVec3 {
+    let ring = |th: f64| -> DVec3 {
         let (st, ct) = th.sin_cos();
         let arcs = arcs_at(&edges, c, u, v, st, ct);
         if radial {

@@ -19,6 +19,9 @@
 //!   +∞, and `L` such that `L · max(0, n·ω)` is (on average over u, for a line) the
 //!   irradiance without `diffuse` (S1).
 //!
+//! - mesh light: a triangle by area, a point uniform on it; the density sums every triangle the
+//!   direction crosses ([`crate::cpu::mesh::sample`]).
+//!
 //! IES-shaped, shaped rects, disks and cylinders, and textured rects are sampled by their
 //! geometry (S2 "other shapes by their geometry"); their radiance carries the shaping.
 
@@ -91,6 +94,8 @@ pub enum LightAt<'a> {
         hl: f64,
         r: f64,
     },
+    /// A mesh light: a point drawn by area ([`crate::cpu::mesh::sample`]).
+    Mesh,
     /// A dome: its texture's table and, with a normal, the table's product with the
     /// receiver's cosine by tiles (`EnvTable::receiver_tiles`).
     Dome {
@@ -124,8 +129,7 @@ impl<'a> LightAt<'a> {
         }
         let xl = p.to_local * (x - p.origin);
         match p.light.kind {
-            // Not sampled yet: the queries refuse a scene with a mesh light before drawing
-            // (`PreparedScene::check_sampled`).
+            LightType::Mesh { .. } if super::mesh::sample::parts(p).is_some() => LightAt::Mesh,
             LightType::Mesh { .. } => LightAt::Nothing(toward),
             LightType::Dome => LightAt::Dome {
                 env,
@@ -275,6 +279,10 @@ impl<'a> LightAt<'a> {
                 let (w, pdf) = dome::sample_dome(p, env, n, tiles.as_deref(), u);
                 (w, pdf, None)
             }
+            LightAt::Mesh => match super::mesh::sample::sample(p, x, [u[0], u[1], u[2]]) {
+                Some((w, pdf)) => (w, pdf, None),
+                None => (DVec3::Y, 0.0, Some(DVec3::ZERO)),
+            },
         }
     }
 
@@ -310,6 +318,7 @@ impl<'a> LightAt<'a> {
             LightAt::Disk { xl, r } => disk_pdf(p, xl, r, w),
             LightAt::Cylinder { xl, hl, r } => cylinder_pdf(p, xl, hl, r, w),
             LightAt::Dome { env, n, ref tiles } => dome::pdf_dome(p, env, n, tiles.as_deref(), w),
+            LightAt::Mesh => super::mesh::sample::pdf(p, x, w),
         }
     }
 }
@@ -353,7 +362,9 @@ pub fn strategy(p: &Prepared) -> &'static str {
             ..
         } => "delta (treatAsLine, uniform by length)",
         LightType::Cylinder { .. } => "uniform over the visible band by area",
-        LightType::Mesh { .. } => "not sampled yet (sampling refuses the scene)",
+        LightType::Mesh { .. } => {
+            "uniform by area over the triangles (the density summed over every triangle crossed)"
+        }
     }
 }
 

@@ -242,6 +242,32 @@ pub fn strategy_variance(
                 i,
             );
         }
+        (LightType::Mesh { .. }, _) => {
+            // Over the receiver's hemisphere, as for a dome: luxeval's strategy is the uniform
+            // area density (cpu::mesh::sample), so the area baseline is the same figure.
+            let dir = |t: f64, phi: f64| cone_dir(&n, t, phi);
+            let g = |pdf: &dyn Fn(DVec3) -> f64, t: f64, phi: f64| {
+                let w = dir(t, phi);
+                let fv = f(w);
+                if !(fv > 0.0) {
+                    return 0.0;
+                }
+                let d = pdf(w);
+                if d > 0.0 { fv * fv / d } else { f64::INFINITY }
+            };
+            let lux = |w: DVec3| at.pdf(p, x, w);
+            let cos = |w: DVec3| n.dot(w) / PI;
+            let range = ((0.0, 1.0), (0.0, 2.0 * PI));
+            out.luxeval = rel(
+                integrate(&|t, ph| g(&lux, t, ph), range.0, range.1, depth, 3, tol).0,
+                i,
+            );
+            out.area = out.luxeval;
+            out.cosine = rel(
+                integrate(&|t, ph| g(&cos, t, ph), range.0, range.1, depth, 3, tol).0,
+                i,
+            );
+        }
         (LightType::Distant { .. }, _) => {}
         _ => {
             // A finite shape: over its visible surface (cos_l > 0 faces x: planar shapes from

@@ -136,6 +136,17 @@ pub(crate) fn power_weight(p: &Prepared) -> f64 {
                 std::f64::consts::PI * t.sin().powi(2)
             })
         }
+        // The unoccluded flux `π L A` per emitting side, shaping left out: an upper bound of
+        // a mesh light's flux (its self-occlusion has no closed form, cpu::power), and any
+        // positive weight keeps the choice unbiased.
+        LightType::Mesh {
+            ref geometry,
+            double_sided,
+            ..
+        } => {
+            let sides = if double_sided { 2.0 } else { 1.0 };
+            Some(std::f64::consts::PI * geometry.area * sides)
+        }
         _ => None,
     };
     match facing {
@@ -257,7 +268,8 @@ fn spot_bound(p: &Prepared, e: DVec3, alpha: f64) -> f64 {
             LightType::Sphere { .. }
             | LightType::Rect { .. }
             | LightType::Disk { .. }
-            | LightType::Cylinder { .. },
+            | LightType::Cylinder { .. }
+            | LightType::Mesh { .. },
         ) => {
             let theta = (crate::cpu::shaping::off_axis_angle(p.axis, e) - alpha).max(0.0);
             crate::cpu::shaping::cone_factor(theta, s.cone, s.start)
