@@ -79,6 +79,9 @@ pub struct MeshBvh {
     pub nodes: Vec<Node>,
     /// Triangle indices, each leaf's range sorted ascending.
     pub order: Vec<u32>,
+    /// `(p0, p1 − p0, p2 − p0)` of triangle `order[k]` at k: what a ray test reads, laid out
+    /// leaf by leaf so that a leaf's triangles are contiguous in memory.
+    pub edges: Vec<[DVec3; 3]>,
 }
 
 impl MeshBvh {
@@ -86,6 +89,7 @@ impl MeshBvh {
         let mut bvh = MeshBvh {
             nodes: Vec::with_capacity(2 * triangles.len().div_ceil(LEAF)),
             order: (0..triangles.len() as u32).collect(),
+            edges: Vec::new(),
         };
         if triangles.is_empty() {
             return bvh;
@@ -135,6 +139,14 @@ impl MeshBvh {
             stack.push((Some(slot), first + left, count - left));
             stack.push((None, first, left));
         }
+        bvh.edges = bvh
+            .order
+            .iter()
+            .map(|&i| {
+                let p = triangles[i as usize].p;
+                [p[0], p[1] - p[0], p[2] - p[0]]
+            })
+            .collect();
         bvh
     }
 }

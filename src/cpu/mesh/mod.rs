@@ -67,10 +67,10 @@ pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
 /// the emission back along −ω; 0 where it meets a non-emitting side (the mesh is opaque to its
 /// own light) or nothing.
 pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
-    let Some((triangles, bvh, _, double_sided)) = parts(p) else {
+    let Some((_, bvh, _, double_sided)) = parts(p) else {
         return DVec3::ZERO;
     };
-    match ray::first_hit(triangles, bvh, x, w) {
+    match ray::first_hit(bvh, x, w) {
         Some(h) if h.front || double_sided => p.base * shaping(p, -w),
         _ => DVec3::ZERO,
     }

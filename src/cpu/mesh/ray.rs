@@ -8,7 +8,6 @@
 
 use glam::DVec3;
 
-use crate::model::MeshTriangle;
 use crate::prepare::mesh_bvh::{Aabb, MeshBvh};
 
 /// The hit: the triangle's index, its distance along the ray and whether the ray meets the
@@ -20,18 +19,17 @@ pub struct Hit {
     pub front: bool,
 }
 
-/// The distance `t > 0` at which the ray `o + t·d` meets triangle `tri` (edges included), and
-/// whether it meets its front; `None` when it misses or runs in the triangle's plane.
-pub fn intersect(tri: &MeshTriangle, o: DVec3, d: DVec3) -> Option<(f64, bool)> {
-    let e1 = tri.p[1] - tri.p[0];
-    let e2 = tri.p[2] - tri.p[0];
+/// The distance `t > 0` at which the ray `o + t·d` meets the triangle `(p0, p1 − p0, p2 − p0)`
+/// ([`MeshBvh::edges`]; edges included), and whether it meets its front; `None` when it misses
+/// or runs in the triangle's plane.
+fn intersect_edges(&[p0, e1, e2]: &[DVec3; 3], o: DVec3, d: DVec3) -> Option<(f64, bool)> {
     let pv = d.cross(e2);
     let det = e1.dot(pv);
     if det == 0.0 || !det.is_finite() {
         return None;
     }
     let inv = 1.0 / det;
-    let s = o - tri.p[0];
+    let s = o - p0;
     let u = s.dot(pv) * inv;
     if !(0.0..=1.0).contains(&u) {
         return None;
@@ -61,24 +59,33 @@ fn enter_box(b: &Aabb, o: DVec3, inv_d: DVec3, t_max: f64) -> Option<f64> {
 /// and a deeper one (a pathological split) falls back to a heap-allocated stack.
 const STACK: usize = 64;
 
-/// The traversal's stack: on the call's own stack up to [`STACK`] entries, then on the heap.
+/// The traversal's stack of (node, distance at which the ray enters its box): on the call's
+/// own stack up to [`STACK`] entries, then on the heap.
 struct Stack {
-    fixed: [u32; STACK],
+    fixed: [(u32, f64); STACK],
     top: usize,
-    spill: Vec<u32>,
+    spill: Vec<(u32, f64)>,
 }
 
 impl Stack {
-    fn push(&mut self, k: u32) {
-        if self.top < STACK {
-            self.fixed[self.top] = k;
-            self.top += 1;
-        } else {
-            self.spill.push(k);
+    fn new() -> Stack {
+        Stack {
+            fixed: [(0, 0.0); STACK],
+            top: 0,
+            spill: Vec::new(),
         }
     }
 
-    fn pop(&mut self) -> Option<u32> {
+    fn push(&mut self, k: u32, t: f64) {
+        if self.top < STACK {
+            self.fixed[self.top] = (k, t);
+            self.top += 1;
+        } else {
+            self.spill.push((k, t));
+        }
+    }
+
+    fn pop(&mut self) -> Option<(u32, f64)> {
         if let Some(k) = self.spill.pop() {
             return Some(k);
         }
@@ -88,25 +95,25 @@ impl Stack {
 }
 
 /// The first triangle the ray `o + t·d`, t > 0, meets. Children are visited nearer first, so
-/// that the nearest hit found early prunes the rest (`t_max`).
-pub fn first_hit(triangles: &[MeshTriangle], bvh: &MeshBvh, o: DVec3, d: DVec3) -> Option<Hit> {
+/// that the nearest hit found early prunes the rest; a node's box is tested once, when its
+/// parent is, and skipped when popped if a hit nearer than its entry was found since.
+pub fn first_hit(bvh: &MeshBvh, o: DVec3, d: DVec3) -> Option<Hit> {
     if bvh.nodes.is_empty() {
         return None;
     }
     let inv_d = d.recip();
     let mut best: Option<Hit> = None;
-    let mut stack = Stack {
-        fixed: [0; STACK],
-        top: 0,
-        spill: Vec::new(),
-    };
-    stack.push(0);
-    while let Some(k) = stack.pop() {
-        let node = &bvh.nodes[k as usize];
+    let mut stack = Stack::new();
+    match enter_box(&bvh.nodes[0].bounds, o, inv_d, f64::INFINITY) {
+        Some(t) => stack.push(0, t),
+        None => return None,
+    }
+    while let Some((k, t_enter)) = stack.pop() {
         let t_max = best.map_or(f64::INFINITY, |h| h.t);
-        if enter_box(&node.bounds, o, inv_d, t_max).is_none() {
+        if t_enter > t_max {
             continue;
         }
+        let node = &bvh.nodes[k as usize];
         if node.count == 0 {
             let (left, right) = (k + 1, node.first);
             let tl = enter_box(&bvh.nodes[left as usize].bounds, o, inv_d, t_max);
@@ -114,22 +121,22 @@ pub fn first_hit(triangles: &[MeshTriangle], bvh: &MeshBvh, o: DVec3, d: DVec3) 
             // Push the farther first, so the nearer is popped next.
             match (tl, tr) {
                 (Some(a), Some(b)) if a <= b => {
-                    stack.push(right);
-                    stack.push(left);
+                    stack.push(right, b);
+                    stack.push(left, a);
                 }
-                (Some(_), Some(_)) => {
-                    stack.push(left);
-                    stack.push(right);
+                (Some(a), Some(b)) => {
+                    stack.push(left, a);
+                    stack.push(right, b);
                 }
-                (Some(_), None) => stack.push(left),
-                (None, Some(_)) => stack.push(right),
+                (Some(a), None) => stack.push(left, a),
+                (None, Some(b)) => stack.push(right, b),
                 (None, None) => {}
             }
             continue;
         }
-        let leaf = &bvh.order[node.first as usize..(node.first + node.count) as usize];
-        for &i in leaf {
-            if let Some((t, front)) = intersect(&triangles[i as usize], o, d) {
+        let range = node.first as usize..(node.first + node.count) as usize;
+        for (&i, edges) in bvh.order[range.clone()].iter().zip(&bvh.edges[range]) {
+            if let Some((t, front)) = intersect_edges(edges, o, d) {
                 let better = match best {
                     None => true,
                     Some(b) => t < b.t || (t == b.t && i < b.triangle),
@@ -150,7 +157,6 @@ pub fn first_hit(triangles: &[MeshTriangle], bvh: &MeshBvh, o: DVec3, d: DVec3) 
 /// Every triangle the ray `o + t·d`, t > 0, meets, in no particular order: `hit(triangle, t)`.
 /// The density of a direction drawn by area sums over all of them (`cpu::mesh::sample`).
 pub fn all_hits(
-    triangles: &[MeshTriangle],
     bvh: &MeshBvh,
     o: DVec3,
     d: DVec3,
@@ -160,24 +166,21 @@ pub fn all_hits(
         return;
     }
     let inv_d = d.recip();
-    let mut stack = Stack {
-        fixed: [0; STACK],
-        top: 0,
-        spill: Vec::new(),
-    };
-    stack.push(0);
-    while let Some(k) = stack.pop() {
+    let mut stack = Stack::new();
+    stack.push(0, 0.0);
+    while let Some((k, _)) = stack.pop() {
         let node = &bvh.nodes[k as usize];
         if enter_box(&node.bounds, o, inv_d, f64::INFINITY).is_none() {
             continue;
         }
         if node.count == 0 {
-            stack.push(node.first);
-            stack.push(k + 1);
+            stack.push(node.first, 0.0);
+            stack.push(k + 1, 0.0);
             continue;
         }
-        for &i in &bvh.order[node.first as usize..(node.first + node.count) as usize] {
-            if let Some((t, _)) = intersect(&triangles[i as usize], o, d) {
+        let range = node.first as usize..(node.first + node.count) as usize;
+        for (&i, edges) in bvh.order[range.clone()].iter().zip(&bvh.edges[range]) {
+            if let Some((t, _)) = intersect_edges(edges, o, d) {
                 hit(i, t);
             }
         }
@@ -187,6 +190,7 @@ pub fn all_hits(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::MeshTriangle;
 
     fn tri(z: f64, flip: bool) -> MeshTriangle {
         let (a, b) = (DVec3::new(2.0, -1.0, z), DVec3::new(-1.0, 2.0, z));
@@ -204,13 +208,13 @@ mod tests {
         let tris: Vec<MeshTriangle> = (0..40).map(|k| tri(k as f64, k % 2 == 1)).collect();
         let bvh = MeshBvh::build(&tris);
         let o = DVec3::new(0.1, 0.2, 12.5);
-        let up = first_hit(&tris, &bvh, o, DVec3::Z).unwrap();
+        let up = first_hit(&bvh, o, DVec3::Z).unwrap();
         assert_eq!((up.triangle, up.t), (13, 0.5));
         assert!(up.front); // flipped: its front faces −z, toward the ray's origin.
-        let down = first_hit(&tris, &bvh, o, -DVec3::Z).unwrap();
+        let down = first_hit(&bvh, o, -DVec3::Z).unwrap();
         assert_eq!((down.triangle, down.t), (12, 0.5));
         assert!(down.front);
-        let miss = first_hit(&tris, &bvh, DVec3::new(5.0, 5.0, 0.5), DVec3::Z);
+        let miss = first_hit(&bvh, DVec3::new(5.0, 5.0, 0.5), DVec3::Z);
         assert!(miss.is_none());
     }
 
@@ -220,7 +224,7 @@ mod tests {
         let t = tri(1.0, false);
         let tris = vec![t, t, t];
         let bvh = MeshBvh::build(&tris);
-        let h = first_hit(&tris, &bvh, DVec3::ZERO, DVec3::Z).unwrap();
+        let h = first_hit(&bvh, DVec3::ZERO, DVec3::Z).unwrap();
         assert_eq!(h.triangle, 0);
         let quad = [
             MeshTriangle {
@@ -233,7 +237,7 @@ mod tests {
             },
         ];
         let bvh = MeshBvh::build(&quad);
-        let h = first_hit(&quad, &bvh, DVec3::new(0.5, 0.5, -1.0), DVec3::Z).unwrap();
+        let h = first_hit(&bvh, DVec3::new(0.5, 0.5, -1.0), DVec3::Z).unwrap();
         assert_eq!((h.triangle, h.t, h.front), (0, 1.0, false));
     }
 }

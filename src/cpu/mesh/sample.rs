@@ -56,7 +56,7 @@ pub fn sample(p: &Prepared, x: DVec3, u: [f64; 3]) -> Option<(DVec3, f64)> {
     // The drawn triangle's own term, also where rounding puts the ray just outside it.
     let mut own = false;
     let mut sum = 0.0;
-    ray::all_hits(triangles, bvh, x, dir, |j, tj| {
+    ray::all_hits(bvh, x, dir, |j, tj| {
         sum += term(&triangles[j as usize], dir, tj, total);
         own |= j as usize == k;
     });
@@ -73,7 +73,7 @@ pub fn pdf(p: &Prepared, x: DVec3, w: DVec3) -> f64 {
     };
     let total = cum[cum.len() - 1];
     let mut sum = 0.0;
-    ray::all_hits(triangles, bvh, x, w, |j, t| {
+    ray::all_hits(bvh, x, w, |j, t| {
         sum += term(&triangles[j as usize], w, t, total);
     });
     sum
