@@ -105,10 +105,8 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3, rel: f64) -> DVec3 {
         return p.base * surface.cosine_solid_angle(x, n);
     }
     let mut sum = DVec3::ZERO;
-    for piece in surface.visible_from(x) {
-        if piece.emitting {
-            sum += shaped::piece(p, &piece.verts, n, rel);
-        }
+    for piece in surface.emitting_above(x, n) {
+        sum += shaped::piece(p, &piece.verts, n, rel);
     }
     p.base * sum
 }

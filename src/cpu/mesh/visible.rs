@@ -125,7 +125,21 @@ impl Surface<'_> {
     #[allow(dead_code)]
     pub(crate) fn visible_from(&self, x: DVec3) -> Vec<Piece> {
         let mut out = Vec::new();
-        self.pieces_from(x, |_| true, |piece| out.push(piece));
+        self.pieces_from(x, |_| true, |_| true, |piece| out.push(piece));
+        out
+    }
+
+    /// The visible pieces seen from x of the emitting triangles with a point above the
+    /// horizon of the unit normal n: what irradiance integrates. A triangle wholly below the
+    /// horizon is left out as an occluder too: it can hide only directions below the horizon.
+    pub(crate) fn emitting_above(&self, x: DVec3, n: DVec3) -> Vec<Piece> {
+        let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
+        let mut out = Vec::new();
+        self.pieces_from(x, |s| s.emitting && above(s), above, |piece| {
+            if piece.emitting {
+                out.push(piece)
+            }
+        });
         out
     }
 
@@ -137,8 +151,10 @@ impl Surface<'_> {
         let mut sum = 0.0;
         // Only emitting triangles with a vertex above the horizon can add anything; the others
         // are computed only as occluders.
-        let wanted = |s: &Seen| s.emitting && s.q.iter().any(|q| n.dot(*q) > 0.0);
-        self.pieces_from(x, wanted, |piece| {
+        let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
+        let wanted = |s: &Seen| s.emitting && above(s);
+        // A triangle wholly below the horizon hides only directions below it: left out.
+        self.pieces_from(x, wanted, above, |piece| {
             if piece.emitting {
                 sum += lambert(&piece.verts, n);
             }
@@ -191,10 +207,20 @@ impl Surface<'_> {
         area
     }
 
-    /// Calls `sink` with every visible piece seen from x of the triangles `wanted` accepts (all
-    /// triangles occlude).
-    fn pieces_from(&self, x: DVec3, wanted: impl Fn(&Seen) -> bool, mut sink: impl FnMut(Piece)) {
-        let seen: Vec<Option<Seen>> = self.triangles.iter().map(|t| self.seen(t, x)).collect();
+    /// Calls `sink` with every visible piece seen from x of the triangles `wanted` accepts;
+    /// the triangles `occludes` accepts hide them (a wanted triangle must be one).
+    fn pieces_from(
+        &self,
+        x: DVec3,
+        wanted: impl Fn(&Seen) -> bool,
+        occludes: impl Fn(&Seen) -> bool,
+        mut sink: impl FnMut(Piece),
+    ) {
+        let seen: Vec<Option<Seen>> = self
+            .triangles
+            .iter()
+            .map(|t| self.seen(t, x).filter(&occludes))
+            .collect();
         for [e, a, b] in FACES {
             // The pyramid's four planes through x, inside where m·w ≥ 0.
             let planes = [e - a, e + a, e - b, e + b];
