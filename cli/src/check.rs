@@ -87,6 +87,12 @@ pub fn run(a: &CheckArgs) -> CliResult {
                 if r.pass { "ok" } else { "OVER TOLERANCE" }
             );
         }
+        for (light, why) in &report.host_only {
+            outln!(
+                "{light}: not compared: {why}, whose every query the CPU reference answers on \
+                 every device"
+            );
+        }
         outln!(
             "{} samples, {} excluded, largest relative error {:.3e}: {}",
             report.samples,

@@ -17,6 +17,7 @@ mod bad_inputs;
 mod cli;
 mod lights;
 mod maps;
+mod mesh;
 mod pipeline_cache;
 mod robustness;
 mod sample;

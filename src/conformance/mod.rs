@@ -91,6 +91,10 @@ pub struct CheckReport {
     pub samples: usize,
     pub excluded: usize,
     pub rows: Vec<QueryReport>,
+    /// The lights every query of which the CPU reference answers on every device
+    /// (`GpuPath::Host`: mesh lights), with why: nothing of theirs runs on the device, so
+    /// nothing is compared.
+    pub host_only: Vec<(String, String)>,
 }
 
 impl CheckReport {
@@ -177,8 +181,13 @@ pub fn check_with(
 ) -> Result<CheckReport> {
     let mut rng = Rng::new(seed);
     let mut rows = Vec::new();
+    let mut host_only = Vec::new();
     for r in lights {
         let p = &r.p;
+        if let crate::prepare::GpuPath::Host(why) = p.gpu_path {
+            host_only.push((p.light.path.clone(), why.to_string()));
+            continue;
+        }
         let scene = PreparedScene::from_prepared(eval.backend().clone(), vec![p.clone()])?;
         // A texture the GPU holds reduced (over the device's binding limit) differs from the
         // reference by design: there is nothing to check on this device.
@@ -269,6 +278,7 @@ pub fn check_with(
         samples: rows.iter().map(|r| r.samples).sum(),
         excluded: rows.iter().map(|r| r.excluded).sum(),
         rows,
+        host_only,
     })
 }
 
