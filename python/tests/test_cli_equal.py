@@ -208,3 +208,23 @@ def test_what_luxeval_does_not_apply_is_the_cli_s(cli, tmp_path):
     assert stage.unapplied is not None
     assert f"warning: {UNAPPLIED}: {stage.unapplied}" in p.stderr.splitlines()
     assert luxeval.Stage(STUDIO).unapplied is None and luxeval.Stage(STUDIO).light_lists == []
+
+
+NEON = REPO / "assets" / "neon_ring.usda"
+
+
+def test_mesh_light_queries_equal_cli(cli, tmp_path):
+    # A mesh light (DESIGN.md §7): Python and the CLI evaluate it alike, bit for bit.
+    points = floor_points(200)
+    normals = np.tile(np.array([[0.0, 1.0, 0.0]], dtype=np.float32), (len(points), 1))
+    dirs = sphere_dirs(200)
+    stage = luxeval.Stage(NEON)
+    got = stage.irradiance(points, normals, device="cpu")
+    want = cli_query(cli, tmp_path, "irradiance", NEON, {"points": points, "normals": normals},
+                     "--device", "cpu")
+    np.testing.assert_array_equal(got, want)
+    assert np.count_nonzero(got[:, 0]) > 150
+    got = stage.emission(dirs, device="cpu")
+    want = cli_query(cli, tmp_path, "emission", NEON, {"dirs": dirs}, "--device", "cpu")
+    np.testing.assert_array_equal(got, want)
+    assert np.count_nonzero(got) > 0
