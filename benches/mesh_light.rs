@@ -67,19 +67,29 @@ fn mesh_light(c: &mut Criterion) {
         .iter()
         .map(|p| {
             let target = rng.unit() * 2.0;
-            (target - DVec3::from_array(p.map(f64::from))).as_vec3().to_array()
+            (target - DVec3::from_array(p.map(f64::from)))
+                .as_vec3()
+                .to_array()
         })
         .collect();
     group.throughput(Throughput::Elements(n as u64));
     group.bench_function("radiance 1M rays", |b| {
-        b.iter(|| scene.radiance(&points, &dirs, Accumulate::Sum).expect("radiance"))
+        b.iter(|| {
+            scene
+                .radiance(&points, &dirs, Accumulate::Sum)
+                .expect("radiance")
+        })
     });
     group.throughput(Throughput::Elements(1));
     // A receiver inside the ring, above the torus' plane, facing down into it.
     let x = [[0.5f32, 1.0, 0.3]];
     let nrm = [[0.0f32, -1.0, 0.0]];
     group.bench_function("irradiance at one receiver", |b| {
-        b.iter(|| scene.irradiance(&x, &nrm, Accumulate::Sum).expect("irradiance"))
+        b.iter(|| {
+            scene
+                .irradiance(&x, &nrm, Accumulate::Sum)
+                .expect("irradiance")
+        })
     });
     group.finish();
 }

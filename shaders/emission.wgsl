@@ -27,6 +27,11 @@ fn emission(light: Record, e: vec3<f32>) -> vec3<f32> {
         case KIND_RECT, KIND_DISK: {
             return surface_emission(light, e) * rect_mean(light);
         }
+        case KIND_MESH: {
+            // GpuPath::RadianceOnDevice: a mesh light's emission (and so its intensity) is the
+            // CPU reference's, added on the host.
+            return vec3<f32>(0.0);
+        }
         case KIND_CYLINDER: {
             // Some point of the side faces e unless e is parallel to the axis.
             let el = to_local_dir(light, e);

@@ -7,6 +7,7 @@
 
 // #import shared/record.wgsl
 // #import shared/shapes.wgsl
+// #import mesh/ray.wgsl
 // #import emission.wgsl
 
 fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
@@ -19,6 +20,15 @@ fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
         case KIND_DISTANT: {
             // The distant light's cone in direction w.
             return emission(light, -w);
+        }
+        case KIND_MESH: {
+            // DESIGN.md §7 M3: the first triangle hit, L(−ω) on an emitting side, else 0 (the
+            // mesh is opaque to its own light).
+            let hit = first_hit(light, x, w);
+            if hit.z > 0.0 && (hit.y > 0.0 || has_flag(light, FLAG_DOUBLE_SIDED)) {
+                return light.base.xyz * shaping(light, -w);
+            }
+            return vec3<f32>(0.0);
         }
         default: {}
     }

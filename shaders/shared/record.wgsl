@@ -91,6 +91,8 @@ struct Params {
 @group(0) @binding(5) var<storage, read> ies_atlas: array<f32>;
 // Every dome and rect texture of the scene (shared/texture.wgsl reads it; layout in src/gpu/texture_atlas.rs).
 @group(0) @binding(6) var<storage, read> tex_atlas: array<f32>;
+// Every mesh light's BVH and triangles (mesh/ray.wgsl reads it; layout in src/gpu/mesh_atlas.rs).
+@group(0) @binding(7) var<storage, read> mesh_atlas: array<f32>;
 
 fn sample_index(gid: vec3<u32>) -> u32 {
     return gid.x + gid.y * params.row_stride;

@@ -37,6 +37,37 @@ pub fn intensity_margin(r: &Reference, e: DVec3) -> f64 {
     emission_margin(r, e).min(t / band * BAND)
 }
 
+/// How far the ray `x + tω`, t > 0, passes from the nearest edge of any mesh triangle whose
+/// plane it crosses, as a fraction of that triangle's longest edge: where it is small the f32
+/// ray test of shaders/mesh/ray.wgsl may hit where the f64 one misses, or the other triangle of
+/// an edge. Every triangle is tested (a diagnostic, not a query).
+pub fn mesh_edge_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, w: DVec3) -> f64 {
+    let mut m = f64::INFINITY;
+    for t in triangles {
+        let (e1, e2) = (t.p[1] - t.p[0], t.p[2] - t.p[0]);
+        let n = e1.cross(e2);
+        let denom = n.dot(w);
+        let s = n.dot(t.p[0] - x) / denom;
+        if !(s > 0.0) || !s.is_finite() {
+            continue;
+        }
+        let h = x + s * w - t.p[0];
+        // Barycentrics (Cramer's rule) times each vertex's height over its opposite edge: the
+        // hit point's distance to that edge's line.
+        let (d11, d12, d22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
+        let (h1, h2) = (h.dot(e1), h.dot(e2));
+        let det = d11 * d22 - d12 * d12;
+        let (v, u) = ((d22 * h1 - d12 * h2) / det, (d11 * h2 - d12 * h1) / det);
+        let area2 = n.length();
+        let sides = [(e2 - e1).length(), e2.length(), e1.length()];
+        let size = sides[0].max(sides[1]).max(sides[2]);
+        for (b, side) in [1.0 - u - v, v, u].into_iter().zip(sides) {
+            m = m.min((b * area2 / side).abs() / size);
+        }
+    }
+    m
+}
+
 /// Distance of an emission direction from the light's discontinuities, in radians.
 pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
     let p = &r.p;
@@ -188,7 +219,8 @@ pub fn radiance_margin(r: &Reference, x: DVec3, w: DVec3) -> f64 {
     let dl = p.to_local * w;
     let u = dl.normalize();
     let m_shape = match p.light.kind {
-        LightType::Distant { .. } | LightType::Dome | LightType::Mesh { .. } => f64::INFINITY,
+        LightType::Distant { .. } | LightType::Dome => f64::INFINITY,
+        LightType::Mesh { ref geometry, .. } => mesh_edge_margin(&geometry.triangles, x, w),
         LightType::Sphere {
             treat_as_point: true,
             ..

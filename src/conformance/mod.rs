@@ -91,9 +91,9 @@ pub struct CheckReport {
     pub samples: usize,
     pub excluded: usize,
     pub rows: Vec<QueryReport>,
-    /// The lights every query of which the CPU reference answers on every device
-    /// (`GpuPath::Host`: mesh lights), with why: nothing of theirs runs on the device, so
-    /// nothing is compared.
+    /// The lights some or all of whose queries the CPU reference answers on every device
+    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`: mesh lights), with what is not compared
+    /// and why.
     pub host_only: Vec<(String, String)>,
 }
 
@@ -184,9 +184,22 @@ pub fn check_with(
     let mut host_only = Vec::new();
     for r in lights {
         let p = &r.p;
-        if let crate::prepare::GpuPath::Host(why) = p.gpu_path {
-            host_only.push((p.light.path.clone(), why.to_string()));
-            continue;
+        match p.gpu_path {
+            crate::prepare::GpuPath::Host(why) => {
+                host_only.push((
+                    p.light.path.clone(),
+                    format!("{why}, whose every query the CPU reference answers on every device"),
+                ));
+                continue;
+            }
+            crate::prepare::GpuPath::RadianceOnDevice(why) => host_only.push((
+                p.light.path.clone(),
+                format!(
+                    "{why}, whose emission, intensity and irradiance the CPU reference answers \
+                     on every device (its radiance is compared)"
+                ),
+            )),
+            _ => {}
         }
         let scene = PreparedScene::from_prepared(eval.backend().clone(), vec![p.clone()])?;
         // A texture the GPU holds reduced (over the device's binding limit) differs from the
@@ -197,8 +210,8 @@ pub fn check_with(
                 format!("cannot check on this device: {w}"),
             ));
         }
-        // Emission.
-        let samples = counts.emission;
+        // Emission (not for a light whose emission and intensity the host computes).
+        let samples = if p.on_host() { 0 } else { counts.emission };
         let dirs = emission_samples(r, samples, &mut rng);
         let got = scene.emission(&dirs, Accumulate::Sum)?;
         rows.push(compare(r, CheckedQuery::Emission, samples, |i| {

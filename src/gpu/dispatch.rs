@@ -13,11 +13,13 @@ use super::record::{Params, Record, WORKGROUP_SIZE};
 use super::shaders::Features;
 use super::{GpuContext, Kernel};
 
-/// A prepared scene's light records, IES atlas and texture atlas on the device.
+/// A prepared scene's light records, IES atlas, texture atlas and mesh atlas on the device.
 pub(crate) struct GpuLights {
     pub(super) buffer: wgpu::Buffer,
     pub(super) ies_atlas: wgpu::Buffer,
     pub(super) tex_atlas: wgpu::Buffer,
+    /// Mesh lights' BVHs and triangles (`super::mesh_atlas`).
+    pub(super) mesh_atlas: wgpu::Buffer,
     /// The records as uploaded and the texture atlas's length in f32 words: the sample and pdf
     /// kernels' copy with textured domes' sampling tables appended starts from them
     /// (`GpuContext::sample_lights`).
@@ -83,13 +85,14 @@ pub(crate) struct Scratch {
 }
 
 impl GpuContext {
-    /// Uploads the records, the IES atlas and the texture atlas of a prepared scene (None
-    /// when there are no lights).
+    /// Uploads the records, the IES atlas, the texture atlas and the mesh atlas of a prepared
+    /// scene (None when there are no lights).
     pub fn upload(
         &self,
         records: &[Record],
         ies_atlas: &[f32],
         tex_atlas: &super::texture_atlas::Atlas,
+        mesh_atlas: &[f32],
     ) -> Result<Option<GpuLights>> {
         if records.is_empty() {
             return Ok(None);
@@ -177,10 +180,33 @@ impl GpuContext {
                 );
             }
         }
+        let mesh_bytes = std::mem::size_of_val(mesh_atlas) as u64;
+        if mesh_bytes > self.limits.max_storage_buffer_binding_size {
+            return Err(LuxError::input(
+                "mesh lights",
+                format!(
+                    "the scene's mesh lights need {mesh_bytes} bytes of BVH and triangles, over \
+                     this device's storage binding limit of {} bytes; split the stage with \
+                     --light or use --device cpu",
+                    self.limits.max_storage_buffer_binding_size
+                ),
+            ));
+        }
+        let mesh_atlas_buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("mesh atlas"),
+            size: mesh_bytes.max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        if !mesh_atlas.is_empty() {
+            self.queue
+                .write_buffer(&mesh_atlas_buffer, 0, bytemuck::cast_slice(mesh_atlas));
+        }
         Ok(Some(GpuLights {
             buffer,
             ies_atlas: ies_atlas_buffer,
             tex_atlas: tex_atlas_buffer,
+            mesh_atlas: mesh_atlas_buffer,
             records: records.to_vec(),
             tex_words: tex_atlas.len(),
             count: records.len(),
@@ -297,6 +323,7 @@ impl GpuContext {
                 entry(4, &buf_out),
                 entry(5, &lights.ies_atlas),
                 entry(6, &lights.tex_atlas),
+                entry(7, &lights.mesh_atlas),
             ],
         });
         Scratch {

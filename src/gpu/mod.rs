@@ -6,6 +6,7 @@
 pub(crate) mod cache;
 pub(crate) mod dispatch;
 pub(crate) mod ies_atlas;
+pub(crate) mod mesh_atlas;
 pub(crate) mod record;
 pub(crate) mod resident;
 pub(crate) mod sample;
@@ -306,6 +307,7 @@ impl GpuContext {
                 layout_entry(4, wgpu::BufferBindingType::Storage { read_only: false }),
                 layout_entry(5, wgpu::BufferBindingType::Storage { read_only: true }),
                 layout_entry(6, wgpu::BufferBindingType::Storage { read_only: true }),
+                layout_entry(7, wgpu::BufferBindingType::Storage { read_only: true }),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -16,6 +16,9 @@ pub const KIND_DISK: u32 = 2;
 pub const KIND_RECT: u32 = 3;
 pub const KIND_CYLINDER: u32 = 4;
 pub const KIND_DOME: u32 = 5;
+/// A mesh light (DESIGN.md §7): its BVH and triangles in the scene's mesh atlas
+/// (`super::mesh_atlas`), located by `tex`.
+pub const KIND_MESH: u32 = 6;
 
 /// ShapingAPI is applied.
 pub const FLAG_SHAPING: u32 = 1;
@@ -50,6 +53,8 @@ pub const FLAG_HOST_IRRADIANCE: u32 = 4096;
 /// spherical triangles (`prepare::is_sheared`, the test
 /// `cpu::sample::rect::RectSampler::new` takes, in f64).
 pub const FLAG_SHEARED_RECT: u32 = 8192;
+/// A mesh light whose triangles emit from both sides (`doubleSided`, DESIGN.md §7 M2).
+pub const FLAG_DOUBLE_SIDED: u32 = 16384;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -62,6 +67,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("KIND_RECT", KIND_RECT),
     ("KIND_CYLINDER", KIND_CYLINDER),
     ("KIND_DOME", KIND_DOME),
+    ("KIND_MESH", KIND_MESH),
     ("FLAG_SHAPING", FLAG_SHAPING),
     ("FLAG_TREAT_AS_POINT_OR_LINE", FLAG_TREAT_AS_POINT_OR_LINE),
     ("FLAG_SIMILARITY", FLAG_SIMILARITY),
@@ -76,6 +82,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_RECT_TEXTURE", FLAG_RECT_TEXTURE),
     ("FLAG_HOST_IRRADIANCE", FLAG_HOST_IRRADIANCE),
     ("FLAG_SHEARED_RECT", FLAG_SHEARED_RECT),
+    ("FLAG_DOUBLE_SIDED", FLAG_DOUBLE_SIDED),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
     ("SELECT_POWER", SELECT_POWER),
     ("SELECT_BOUND", SELECT_BOUND),
@@ -185,8 +192,13 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 /// Rounds a prepared light's f64 constants to its GPU record; `ies_base` is where its IES
 /// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture
 /// starts in the scene's texture atlas (`gpu::texture_atlas`).
-pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Record {
-    if p.on_host() {
+pub fn pack(
+    p: &Prepared,
+    ies_base: Option<u32>,
+    tex_offset: Option<u32>,
+    mesh: Option<[u32; 4]>,
+) -> Record {
+    if p.radiance_on_host() {
         return host_record();
     }
     let m = p.to_local;
@@ -302,7 +314,15 @@ pub fn pack(p: &Prepared, ies_base: Option<u32>, tex_offset: Option<u32>) -> Rec
             )
         }
         LightType::Dome => (KIND_DOME, [0.0; 4]),
-        LightType::Mesh { .. } => unreachable!("a mesh light is evaluated on the host"),
+        LightType::Mesh { double_sided, .. } => {
+            if double_sided {
+                r.flags |= FLAG_DOUBLE_SIDED;
+            }
+            // GpuPath::RadianceOnDevice: the kernels traverse its BVH for radiance; emission,
+            // intensity and irradiance are the host's (they give 0 for KIND_MESH).
+            r.tex = mesh.unwrap_or([0; 4]);
+            (KIND_MESH, [0.0; 4])
+        }
     };
     r.kind = kind;
     r.size = size;

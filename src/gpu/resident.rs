@@ -71,7 +71,7 @@ impl GpuContext {
     pub(crate) fn no_lights(&self) -> Result<GpuLights> {
         let atlas = super::texture_atlas::Atlas::new();
         Ok(self
-            .upload(&[Record::default()], &[], &atlas)?
+            .upload(&[Record::default()], &[], &atlas, &[])?
             .expect("one record uploaded"))
     }
 
@@ -359,6 +359,7 @@ impl GpuContext {
                 },
                 entry(5, &lights.ies_atlas),
                 entry(6, tex_atlas),
+                entry(7, &lights.mesh_atlas),
             ],
         });
         // Buffers of another device, for one, fail here.

@@ -293,6 +293,7 @@ impl GpuContext {
                 entry(4, &buf_out),
                 entry(5, &lights.ies_atlas),
                 entry(6, &sampling.tex_atlas),
+                entry(7, &lights.mesh_atlas),
             ],
         });
         let mut result = Ok(());

@@ -16,7 +16,7 @@ use std::collections::HashSet;
 use std::sync::OnceLock;
 
 use super::record::WGSL_CONSTANTS;
-use super::{ies_atlas, texture_atlas};
+use super::{ies_atlas, mesh_atlas, texture_atlas};
 use crate::rules;
 
 /// Every WGSL source file, by its path under `shaders/`.
@@ -49,6 +49,7 @@ pub const SOURCES: &[(&str, &str)] = &[
         "shared/texture.wgsl",
         include_str!("../../shaders/shared/texture.wgsl"),
     ),
+    ("mesh/ray.wgsl", include_str!("../../shaders/mesh/ray.wgsl")),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),
     (
@@ -293,6 +294,7 @@ pub fn prelude() -> String {
         .chain(rules::wgsl_u32_constants())
         .chain(ies_atlas::wgsl_constants())
         .chain(texture_atlas::wgsl_constants())
+        .chain(mesh_atlas::wgsl_constants())
     {
         s.push_str(&format!("const {name}: u32 = {value}u;\n"));
     }

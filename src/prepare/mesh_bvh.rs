@@ -85,6 +85,25 @@ pub struct MeshBvh {
 }
 
 impl MeshBvh {
+    /// The most nodes on a path from the root to a leaf (0 for an empty mesh): what a
+    /// traversal's stack must hold.
+    pub fn depth(&self) -> usize {
+        let mut deepest = 0;
+        let mut stack = Vec::new();
+        if !self.nodes.is_empty() {
+            stack.push((0usize, 1usize));
+        }
+        while let Some((k, d)) = stack.pop() {
+            deepest = deepest.max(d);
+            let node = self.nodes[k];
+            if node.count == 0 {
+                stack.push((k + 1, d + 1));
+                stack.push((node.first as usize, d + 1));
+            }
+        }
+        deepest
+    }
+
     pub fn build(triangles: &[MeshTriangle]) -> MeshBvh {
         let mut bvh = MeshBvh {
             nodes: Vec::with_capacity(2 * triangles.len().div_ceil(LEAF)),

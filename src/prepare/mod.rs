@@ -164,10 +164,25 @@ pub enum GpuPath {
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
     HostIrradiance(&'static str),
-    /// Every query from the CPU reference: mesh lights (DESIGN.md §7), until kernels traverse
-    /// their triangles on the device. The record the kernels see emits nothing.
+    /// Radiance on the device (the first hit through the mesh's BVH, shaders/mesh/ray.wgsl);
+    /// emission, intensity and irradiance from the CPU reference: mesh lights (DESIGN.md §7).
+    /// Their emission tests every distinct front direction, their intensity and irradiance
+    /// need the exact visible pieces (cpu::mesh::visible): none has a kernel yet.
+    RadianceOnDevice(&'static str),
+    /// Every query from the CPU reference: mesh lights the device cannot hold or traverse (a
+    /// hierarchy deeper than the kernel's stack, more data than [`MESH_DEVICE_BYTES`], a
+    /// singular transform), and masked domes. The record the kernels see emits nothing.
     Host(&'static str),
 }
+
+/// The most bytes of BVH nodes and triangles one mesh light may take on the device (32 bytes a
+/// node, 40 a triangle: about 800,000 triangles); a larger mesh is evaluated on the host
+/// ([`GpuPath::Host`]), so that a scene's meshes fit WebGPU's default storage binding limit
+/// (128 MiB) with room for others.
+pub const MESH_DEVICE_BYTES: u64 = 48 << 20;
+
+/// The deepest BVH the radiance kernel traverses: its stack holds this many nodes.
+pub const MESH_STACK: usize = 64;
 
 impl Prepared {
     /// A distant light's θmax (half its angular diameter, radians); 0 for other types.
@@ -222,12 +237,20 @@ impl Prepared {
     /// Whether the GPU path takes this light's irradiance from the CPU reference
     /// ([`Prepared::gpu_path`]).
     pub fn irradiance_on_host(&self) -> bool {
-        matches!(self.gpu_path, GpuPath::HostIrradiance(_) | GpuPath::Host(_))
+        !matches!(self.gpu_path, GpuPath::Device)
     }
 
-    /// Whether the GPU path takes every query of this light from the CPU reference
-    /// ([`Prepared::gpu_path`]).
+    /// Whether the GPU path takes this light's emission and intensity from the CPU reference
+    /// ([`Prepared::gpu_path`]): some query besides irradiance is the host's.
     pub fn on_host(&self) -> bool {
+        matches!(
+            self.gpu_path,
+            GpuPath::RadianceOnDevice(_) | GpuPath::Host(_)
+        )
+    }
+
+    /// Whether the GPU path takes this light's radiance from the CPU reference.
+    pub fn radiance_on_host(&self) -> bool {
         matches!(self.gpu_path, GpuPath::Host(_))
     }
 
@@ -363,8 +386,17 @@ impl Prepared {
                 KindData::Shape
             }
         };
-        let gpu_path = if matches!(kind, KindData::Mesh { .. }) {
-            GpuPath::Host("it is a mesh light")
+        let gpu_path = if let KindData::Mesh { bvh, .. } = &kind {
+            let bytes = 32 * bvh.nodes.len() as u64 + 40 * bvh.order.len() as u64;
+            if bvh.depth() > MESH_STACK {
+                GpuPath::Host("it is a mesh light whose BVH is deeper than the kernel's stack")
+            } else if bytes > MESH_DEVICE_BYTES {
+                GpuPath::Host("it is a mesh light too large for the device")
+            } else if !to_local.is_finite() {
+                GpuPath::Host("it is a mesh light with a singular transform")
+            } else {
+                GpuPath::RadianceOnDevice("it is a mesh light")
+            }
         } else if ies.is_some() {
             GpuPath::HostIrradiance("it is IES-shaped")
         } else {
@@ -540,14 +572,23 @@ fn check_fits_f32(
         }
         LightType::Distant { .. } | LightType::Dome => &[],
         LightType::Mesh { ref geometry, .. } => {
-            let far = geometry.triangles.iter().flat_map(|t| t.p).enumerate().find(|(_, v)| {
-                v.abs().max_element() > MAX_LENGTH
-            });
+            let far = geometry
+                .triangles
+                .iter()
+                .flat_map(|t| t.p)
+                .enumerate()
+                .find(|(_, v)| v.abs().max_element() > MAX_LENGTH);
             if let Some((i, v)) = far {
                 return Err(LuxError::attr(
                     &light.path,
                     "points",
-                    format!("({}, {}, {}) in world space (triangle {})", v.x, v.y, v.z, i / 3),
+                    format!(
+                        "({}, {}, {}) in world space (triangle {})",
+                        v.x,
+                        v.y,
+                        v.z,
+                        i / 3
+                    ),
                     format!("beyond {MAX_LENGTH:e}, whose square would overflow float32"),
                 ));
             }

@@ -10,7 +10,7 @@ use crate::error::{LuxError, Result};
 use crate::gpu::record::{SELECT_BOUND, SELECT_POWER};
 use crate::gpu::resident::{Operand, ResidentDraw};
 use crate::gpu::{GpuContext, GpuLights, Kernel};
-use crate::prepare::GpuPath;
+use crate::prepare::{GpuPath, Prepared};
 
 impl Evaluator {
     /// An evaluator on the caller's device (a renderer's own `wgpu::Device` and `wgpu::Queue`,
@@ -168,7 +168,9 @@ impl PreparedScene {
         acc: Accumulate,
     ) -> Result<()> {
         if let Some((p, reason)) = self.lights.iter().find_map(|p| match p.gpu_path {
-            GpuPath::HostIrradiance(reason) | GpuPath::Host(reason) => Some((p, reason)),
+            GpuPath::HostIrradiance(reason)
+            | GpuPath::RadianceOnDevice(reason)
+            | GpuPath::Host(reason) => Some((p, reason)),
             GpuPath::Device => None,
         }) {
             return Err(LuxError::NotOnDevice {
@@ -340,16 +342,23 @@ impl PreparedScene {
     /// computes (`GpuPath::Host`: mesh lights): the kernels give 0 for it, which this path
     /// would return as if it were the answer.
     fn check_all_on_device(&self, kernel: Kernel) -> Result<()> {
+        let refused = |p: &Prepared| match kernel {
+            Kernel::Radiance => p.radiance_on_host(),
+            _ => p.on_host(),
+        };
         match self.lights.iter().find_map(|p| match p.gpu_path {
-            GpuPath::Host(reason) => Some((p, reason)),
+            GpuPath::Host(reason) | GpuPath::RadianceOnDevice(reason) if refused(p) => {
+                Some((p, reason))
+            }
             _ => None,
         }) {
             Some((p, reason)) => Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),
                 query: format!("{kernel:?}").to_lowercase(),
                 reason: format!(
-                    "{reason}, evaluated on the host (in f64) until kernels traverse its \
-                     triangles; use the PreparedScene query of the same name"
+                    "{reason}, whose {} the host evaluates (in f64); use the PreparedScene \
+                     query of the same name",
+                    format!("{kernel:?}").to_lowercase()
                 ),
             }),
             None => Ok(()),

@@ -8,7 +8,7 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
-use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, record, texture_atlas};
+use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, mesh_atlas, record, texture_atlas};
 use crate::model::Light;
 use crate::prepare::{self, Prepared, TemperatureMode};
 
@@ -86,14 +86,16 @@ impl PreparedScene {
                         r.path, r.from.0, r.from.1, r.to.0, r.to.1
                     ));
                 }
+                let (mesh_atlas, meshes) = mesh_atlas::scene_atlas(&lights);
                 let mut records: Vec<record::Record> = lights
                     .iter()
                     .zip(bases)
                     .zip(offsets)
-                    .map(|((p, base), offset)| record::pack(p, base, offset))
+                    .zip(meshes)
+                    .map(|(((p, base), offset), mesh)| record::pack(p, base, offset, mesh))
                     .collect();
                 luminance_weights_into(&lights, &mut records);
-                g.upload(&records, &atlas.data, &tex_atlas)?
+                g.upload(&records, &atlas.data, &tex_atlas, &mesh_atlas)?
             }
         };
         // How lights are evaluated other than as authored (zero-size lights), on every device.
@@ -171,7 +173,9 @@ impl PreparedScene {
         let mut out = self.run(Kernel::Emission, dirs, None, per_light, || {
             cpu::emission_batch(&self.lights, dirs, per_light)
         })?;
-        self.add_host(per_light, &mut out, |l| cpu::emission_batch(l, dirs, true));
+        self.add_host(per_light, &mut out, Prepared::on_host, |l| {
+            cpu::emission_batch(l, dirs, true)
+        });
         Ok(out)
     }
 
@@ -183,7 +187,9 @@ impl PreparedScene {
         let mut out = self.run(Kernel::Intensity, dirs, None, per_light, || {
             cpu::intensity_batch(&self.lights, dirs, per_light)
         })?;
-        self.add_host(per_light, &mut out, |l| cpu::intensity_batch(l, dirs, true));
+        self.add_host(per_light, &mut out, Prepared::on_host, |l| {
+            cpu::intensity_batch(l, dirs, true)
+        });
         Ok(out)
     }
 
@@ -206,7 +212,7 @@ impl PreparedScene {
         let mut out = self.run(Kernel::Radiance, points, Some(dirs), per_light, || {
             cpu::radiance_batch(&self.lights, points, dirs, per_light)
         })?;
-        self.add_host(per_light, &mut out, |l| {
+        self.add_host(per_light, &mut out, Prepared::radiance_on_host, |l| {
             cpu::radiance_batch(l, points, dirs, true)
         });
         Ok(out)
@@ -256,20 +262,21 @@ impl PreparedScene {
         Ok(out)
     }
 
-    /// On a GPU evaluator, the kernels give 0 for the lights [`Prepared::on_host`] names (mesh
-    /// lights): their values are the CPU reference's (`values` of one light, one row per input
-    /// row), added here. Nothing to do on the CPU backend.
+    /// On a GPU evaluator, the kernels give 0 for the lights `on_host` names for the query
+    /// ([`Prepared::gpu_path`]: mesh lights): their values are the CPU reference's (`values`
+    /// of one light, one row per input row), added here. Nothing to do on the CPU backend.
     fn add_host(
         &self,
         per_light: bool,
         out: &mut [[f32; 3]],
+        on_host: impl Fn(&Prepared) -> bool,
         values: impl Fn(&[Prepared]) -> Vec<DVec3>,
     ) {
         if !matches!(self.backend, Backend::Gpu(_)) {
             return;
         }
         for (k, light) in self.lights.iter().enumerate() {
-            if light.on_host() {
+            if on_host(light) {
                 add_rows(out, k, per_light, values(std::slice::from_ref(light)));
             }
         }

@@ -156,12 +156,7 @@ pub fn first_hit(bvh: &MeshBvh, o: DVec3, d: DVec3) -> Option<Hit> {
 
 /// Every triangle the ray `o + t·d`, t > 0, meets, in no particular order: `hit(triangle, t)`.
 /// The density of a direction drawn by area sums over all of them (`cpu::mesh::sample`).
-pub fn all_hits(
-    bvh: &MeshBvh,
-    o: DVec3,
-    d: DVec3,
-    mut hit: impl FnMut(u32, f64),
-) {
+pub fn all_hits(bvh: &MeshBvh, o: DVec3, d: DVec3, mut hit: impl FnMut(u32, f64)) {
     if bvh.nodes.is_empty() {
         return;
     }

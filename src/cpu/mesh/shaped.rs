@@ -282,7 +282,10 @@ mod tests {
             for n in normals() {
                 let got = piece(&p, &q, n, 1e-10).x;
                 let want = crate::cpu::irradiance::closed::polygon_irradiance(&q, n);
-                assert!((got - want).abs() <= 1e-12 * want.max(1e-300), "{got} vs {want}");
+                assert!(
+                    (got - want).abs() <= 1e-12 * want.max(1e-300),
+                    "{got} vs {want}"
+                );
                 let rev: Vec<DVec3> = q.iter().rev().copied().collect();
                 assert!((piece(&p, &rev, n, 1e-10).x - got).abs() <= 1e-13 * got.max(1e-300));
             }
@@ -291,15 +294,34 @@ mod tests {
 
     fn polys() -> Vec<Vec<DVec3>> {
         vec![
-            vec![DVec3::new(-1.0, -1.0, -2.0), DVec3::new(1.0, -1.0, -2.0), DVec3::new(0.0, 1.0, -2.0)],
-            vec![DVec3::new(0.5, -1.0, -1.0), DVec3::new(2.0, -1.0, -1.0), DVec3::new(2.0, 1.0, -1.5), DVec3::new(0.5, 1.0, -1.0)],
+            vec![
+                DVec3::new(-1.0, -1.0, -2.0),
+                DVec3::new(1.0, -1.0, -2.0),
+                DVec3::new(0.0, 1.0, -2.0),
+            ],
+            vec![
+                DVec3::new(0.5, -1.0, -1.0),
+                DVec3::new(2.0, -1.0, -1.0),
+                DVec3::new(2.0, 1.0, -1.5),
+                DVec3::new(0.5, 1.0, -1.0),
+            ],
             // Around the pole c = +Z (the sphere light's −axis) and crossing the horizon of n = X.
-            vec![DVec3::new(-1.0, -1.0, 1.0), DVec3::new(1.0, -1.0, 1.0), DVec3::new(1.0, 1.0, 1.0), DVec3::new(-1.0, 1.0, 1.0)],
+            vec![
+                DVec3::new(-1.0, -1.0, 1.0),
+                DVec3::new(1.0, -1.0, 1.0),
+                DVec3::new(1.0, 1.0, 1.0),
+                DVec3::new(-1.0, 1.0, 1.0),
+            ],
         ]
     }
 
     fn normals() -> Vec<DVec3> {
-        vec![DVec3::NEG_Z, DVec3::new(0.5, 0.2, -1.0).normalize(), DVec3::X, DVec3::Z]
+        vec![
+            DVec3::NEG_Z,
+            DVec3::new(0.5, 0.2, -1.0).normalize(),
+            DVec3::X,
+            DVec3::Z,
+        ]
     }
 
     /// Against the visible module's adaptive cubature over the sphere (independent code).
@@ -315,15 +337,19 @@ mod tests {
             Prepared::new(&l, TemperatureMode::Spec).unwrap()
         };
         let mut lit = 0;
-        for p in [shaped(40.0, 0.3, 2.0), shaped(70.0, 0.0, 0.0), shaped(180.0, 0.0, 3.0)] {
+        for p in [
+            shaped(40.0, 0.3, 2.0),
+            shaped(70.0, 0.0, 0.0),
+            shaped(180.0, 0.0, 3.0),
+        ] {
             for q in &polys() {
                 for n in normals() {
                     let got = piece(&p, q, n, 1e-10);
                     let want = crate::cpu::mesh::visible::integrate_piece(q, n, 1e-9, &mut |w| {
                         shaping(&p, -w)
                     });
-                    let err = (got - want).abs().max_element()
-                        / want.abs().max_element().max(1e-300);
+                    let err =
+                        (got - want).abs().max_element() / want.abs().max_element().max(1e-300);
                     assert!(err < 1e-7, "{got} vs {want}");
                     lit += usize::from(got.x > 0.0);
                 }
