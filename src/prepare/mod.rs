@@ -13,6 +13,7 @@ pub mod ies;
 pub mod ies_kinks;
 pub mod mesh_bvh;
 pub mod normalize;
+pub mod portal;
 pub mod profile;
 pub mod texture;
 pub mod zero_size;
@@ -26,6 +27,7 @@ use crate::model::{Light, LightType, Shaping, Texture, UpAxis};
 use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
+pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
 
 /// A light's IES profile as both backends evaluate it (DESIGN.md §6 I7): the factor along a
@@ -110,6 +112,10 @@ pub struct Prepared {
     /// How the light is evaluated other than as authored, naming the prim (a zero-size light,
     /// [`zero_size`]).
     pub warning: Option<String>,
+    /// A dome masked by its portals (DESIGN.md §8 P2, [`PortalMode::Mask`]): the portals light
+    /// reaches a point through (possibly none that pass light: then the dome lights nothing).
+    /// `None`: not masked (hint mode, another type, a dome naming no visible portal).
+    pub portals: Option<Vec<PreparedPortal>>,
 }
 
 /// What one kind of light carries beyond the shared frame, base radiance and shaping of
@@ -162,7 +168,8 @@ pub enum GpuPath {
     ///   (src/cpu/irradiance/rect_texture.rs).
     HostIrradiance(&'static str),
     /// Every query from the CPU reference: mesh lights (DESIGN.md §7), until kernels traverse
-    /// their triangles on the device. The record the kernels see emits nothing.
+    /// their triangles on the device, and domes masked by portals (§8 P2 mask mode), until a
+    /// kernel tests portal crossings. The record the kernels see emits nothing.
     Host(&'static str),
 }
 
@@ -226,6 +233,21 @@ impl Prepared {
     /// ([`Prepared::gpu_path`]).
     pub fn on_host(&self) -> bool {
         matches!(self.gpu_path, GpuPath::Host(_))
+    }
+
+    /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
+    /// portals is masked, and every query of it on a GPU evaluator is the CPU reference's
+    /// (there is no portal kernel). Hint mode changes nothing.
+    pub fn apply_portal_mode(
+        &mut self,
+        mode: PortalMode,
+        temperature: TemperatureMode,
+    ) -> Result<()> {
+        self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
+        if self.portals.is_some() {
+            self.gpu_path = GpuPath::Host("it is masked by portals");
+        }
+        Ok(())
     }
 
     /// Validates `light` and computes its constants for `mode`.
@@ -380,6 +402,7 @@ impl Prepared {
         .flat_map(|a| cache.files(a))
         .collect();
         Ok(Prepared {
+            portals: None,
             warning,
             files_read,
             base,
@@ -527,14 +550,23 @@ fn check_fits_f32(
         }
         LightType::Distant { .. } | LightType::Dome => &[],
         LightType::Mesh { ref geometry, .. } => {
-            let far = geometry.triangles.iter().flat_map(|t| t.p).enumerate().find(|(_, v)| {
-                v.abs().max_element() > MAX_LENGTH
-            });
+            let far = geometry
+                .triangles
+                .iter()
+                .flat_map(|t| t.p)
+                .enumerate()
+                .find(|(_, v)| v.abs().max_element() > MAX_LENGTH);
             if let Some((i, v)) = far {
                 return Err(LuxError::attr(
                     &light.path,
                     "points",
-                    format!("({}, {}, {}) in world space (triangle {})", v.x, v.y, v.z, i / 3),
+                    format!(
+                        "({}, {}, {}) in world space (triangle {})",
+                        v.x,
+                        v.y,
+                        v.z,
+                        i / 3
+                    ),
                     format!("beyond {MAX_LENGTH:e}, whose square would overflow float32"),
                 ));
             }
@@ -639,11 +671,19 @@ pub fn tilt_angle(axis: DVec3, up: UpAxis) -> f64 {
 
 /// Prepares every light, failing on the first invalid one; a file referenced by several lights
 /// is loaded once.
-pub fn prepare(lights: &[Light], mode: TemperatureMode) -> Result<Vec<Prepared>> {
+pub fn prepare(
+    lights: &[Light],
+    mode: TemperatureMode,
+    portal_mode: PortalMode,
+) -> Result<Vec<Prepared>> {
     let mut cache = AssetCache::default();
     lights
         .iter()
-        .map(|l| Prepared::with_assets(l, mode, &mut cache))
+        .map(|l| {
+            let mut p = Prepared::with_assets(l, mode, &mut cache)?;
+            p.apply_portal_mode(portal_mode, mode)?;
+            Ok(p)
+        })
         .collect()
 }
 

@@ -18,8 +18,8 @@ use crate::cpu::sample::{
     LightAt, SceneTables, choose, env_tables, rng, scene_pdf, selection_weights, strategy,
 };
 use crate::error::{LuxError, Result};
-use crate::model::LightType;
 use crate::gpu::sample::{PdfRow, SampleLights, SampleRow};
+use crate::model::LightType;
 
 pub use crate::cpu::sample::Selection;
 pub use crate::cpu::sample::report::StrategyVariance;
@@ -524,20 +524,32 @@ impl PreparedScene {
         self.check_sampled()
     }
 
-    /// Sampling refuses a scene with a mesh light (DESIGN.md §7): its lights would be drawn
-    /// without it, a density that misses light the scene has.
+    /// Sampling refuses a scene with a mesh light (DESIGN.md §7) or a dome masked by portals
+    /// (§8 P2 mask mode; hint mode samples as without portals): its lights would be drawn
+    /// without it, or with a density that misses where its light comes from.
     pub(super) fn check_sampled(&self) -> Result<()> {
-        match self
-            .lights
-            .iter()
-            .find(|p| matches!(p.light.kind, LightType::Mesh { .. }))
-        {
-            Some(p) => Err(LuxError::NotSupported {
+        let refused = self.lights.iter().find_map(|p| {
+            if matches!(p.light.kind, LightType::Mesh { .. }) {
+                Some((
+                    p,
+                    "mesh lights are evaluated (emission, radiance, irradiance, intensity) \
+                     but not sampled yet; leave it out with --light",
+                ))
+            } else if p.portals.is_some() {
+                Some((
+                    p,
+                    "a dome masked by its portals (--portal-mode mask) is evaluated but not \
+                     sampled yet; sample with --portal-mode hint or leave it out with --light",
+                ))
+            } else {
+                None
+            }
+        });
+        match refused {
+            Some((p, reason)) => Err(LuxError::NotSupported {
                 light: p.light.path.clone(),
                 query: "sampling".into(),
-                reason: "mesh lights are evaluated (emission, radiance, irradiance, intensity) \
-                         but not sampled yet; leave it out with --light"
-                    .into(),
+                reason: reason.into(),
             }),
             None => Ok(()),
         }
