@@ -269,7 +269,7 @@ impl Stage {
         let scene = py.detach(|| {
             no_panic(|| ReadStage::load(&path, time).map_err(|e| errors::lux(e, None)))
         })?;
-        let lights_json = luxeval::lights_json(&scene)
+        let lights_json = luxeval::lights_json(&scene, luxeval::PortalMode::Hint)
             .map(|v| v.to_string())
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
         Ok(Stage {
