@@ -18,6 +18,7 @@ mod cli;
 mod lights;
 mod maps;
 mod pipeline_cache;
+mod portals;
 mod robustness;
 mod sample;
 mod stream;
