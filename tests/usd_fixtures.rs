@@ -1037,6 +1037,18 @@ fn mesh_lights_and_portals_match_usd_core() {
                 .filter(|t| light(t).portal.is_some())
                 .collect();
             assert_eq!(portals, named, "{ctx} {p}");
+            // DESIGN.md §8 P1: the dome's light carries the visible ones, in that order.
+            let carried: Vec<&str> = l
+                .light
+                .as_ref()
+                .map(|d| d.portals.iter().map(|q| q.path.as_str()).collect())
+                .unwrap_or_default();
+            let visible: Vec<&str> = named
+                .iter()
+                .copied()
+                .filter(|t| light(t).visible)
+                .collect();
+            assert_eq!(carried, visible, "{ctx} {p}");
         }
         // Every query evaluates the dome and the visible mesh lights, in traversal order; the
         // portals are skipped and said to be.

@@ -70,7 +70,9 @@ fn irradiance(dir: &Path, extra: &[&str], per_light: bool) -> (Vec<u64>, Vec<f32
 /// `--portal-mode mask` changes the irradiance of a stage with a window portal: the dome's 2
 /// nits times the window's multiplier 0.5 times Lambert's formula of the 2 × 1 window at
 /// z = 3 (centre (0, 1)), 0 facing away and from the window's +Z side; hint mode (the default)
-/// is the unmasked dome, π · 2. Portals are never rows of `--per-light`.
+/// is the unmasked dome, π · 2. The dome also names an invisible 10 × 10 portal in front of the
+/// window with multiplier 100: ignored, as if not named (P1). Portals are never rows of
+/// `--per-light`.
 #[test]
 fn portal_mode_mask_changes_irradiance_through_a_window() {
     let dir = tempfile::tempdir().unwrap();
