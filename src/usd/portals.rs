@@ -69,9 +69,9 @@ pub(super) fn attach(lights: &mut [StageLight]) {
             && p.domes.is_empty()
         {
             let read = format!("{}: portal read, not evaluated yet: skipped", l.path);
-            let w = format!(
-                "no dome's portals relationship names this portal: it changes nothing (DESIGN.md §8 P1)"
-            );
+            let w = "no dome's portals relationship names this portal: it changes nothing \
+                     (DESIGN.md §8 P1)"
+                .to_string();
             let caveat = l.warning.take();
             l.warning = Some(read);
             if let Some(c) = caveat {
