@@ -1043,11 +1043,7 @@ fn mesh_lights_and_portals_match_usd_core() {
                 .as_ref()
                 .map(|d| d.portals.iter().map(|q| q.path.as_str()).collect())
                 .unwrap_or_default();
-            let visible: Vec<&str> = named
-                .iter()
-                .copied()
-                .filter(|t| light(t).visible)
-                .collect();
+            let visible: Vec<&str> = named.iter().copied().filter(|t| light(t).visible).collect();
             assert_eq!(carried, visible, "{ctx} {p}");
         }
         // Every query evaluates the dome and the visible mesh lights, in traversal order; the

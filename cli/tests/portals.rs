@@ -86,7 +86,12 @@ fn portal_mode_mask_changes_irradiance_through_a_window() {
 
     let (shape, mask) = irradiance(dir.path(), &["--portal-mode", "mask"], false);
     assert_eq!(shape, vec![3, 3]);
-    let window = [[-1.0, 0.5, 3.0], [1.0, 0.5, 3.0], [1.0, 1.5, 3.0], [-1.0, 1.5, 3.0]];
+    let window = [
+        [-1.0, 0.5, 3.0],
+        [1.0, 0.5, 3.0],
+        [1.0, 1.5, 3.0],
+        [-1.0, 1.5, 3.0],
+    ];
     let want = 2.0 * 0.5 * lambert(&window, [0.0, 0.0, 1.0]);
     for c in 0..3 {
         let got = mask[c] as f64;
@@ -139,6 +144,9 @@ fn every_scene_command_takes_portal_mode() {
     ]);
     assert!(!o.status.success());
     let err = stderr(&o);
-    assert!(err.contains("/World/Sky") && err.contains("portal"), "{err}");
+    assert!(
+        err.contains("/World/Sky") && err.contains("portal"),
+        "{err}"
+    );
     assert!(!out.exists());
 }

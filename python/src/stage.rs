@@ -465,7 +465,13 @@ impl Stage {
         texture_filter: &str,
         portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter, portal_mode)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         self.query(py, Query::Emission, dirs, None, per_light, o)
     }
 
@@ -488,7 +494,13 @@ impl Stage {
         texture_filter: &str,
         portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter, portal_mode)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         self.query(py, Query::Radiance, points, Some(dirs), per_light, o)
     }
 
@@ -515,8 +527,14 @@ impl Stage {
         portal_mode: &str,
         tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter, portal_mode)?
-            .with_tolerance(tolerance)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?
+        .with_tolerance(tolerance)?;
         self.query(py, Query::Irradiance, points, Some(normals), per_light, o)
     }
 
@@ -543,8 +561,14 @@ impl Stage {
         portal_mode: &str,
         tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter, portal_mode)?
-            .with_tolerance(tolerance)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?
+        .with_tolerance(tolerance)?;
         let origin = vec3(py, origin, "origin")?;
         let u = vec3(py, u, "u")?;
         let v = vec3(py, v, "v")?;
@@ -648,7 +672,14 @@ impl Stage {
         portal_mode: &str,
         first_point: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = self.sampling_options(py, lights, device, temperature_mode, texture_filter, portal_mode)?;
+        let o = self.sampling_options(
+            py,
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         let k = match count {
             Some(c) => args::count(c)?,
             None => 1,
@@ -758,7 +789,14 @@ impl Stage {
         texture_filter: &str,
         portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = self.sampling_options(py, lights, device, temperature_mode, texture_filter, portal_mode)?;
+        let o = self.sampling_options(
+            py,
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         let selection = args::parse_selection(selection)?;
         let (p_arr, n_arr) = self.sampling_rows(py, points, normals, selection)?;
         let d_arr = arrays::rows(py, dirs, "dirs", RowKind::Directions)?;

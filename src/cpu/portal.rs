@@ -117,7 +117,10 @@ mod tests {
     /// the vectors `v` from x to its vertices: `½ |Σ θ_i n·û_i|`, θ_i the angle between v_i and
     /// v_{i+1}, û_i the unit normal of the plane through x and that edge (Lambert 1760).
     fn lambert(v: &[DVec3], n: DVec3) -> f64 {
-        assert!(v.iter().all(|q| n.dot(*q) > 0.0), "the test keeps polygons above the horizon");
+        assert!(
+            v.iter().all(|q| n.dot(*q) > 0.0),
+            "the test keeps polygons above the horizon"
+        );
         let mut s = 0.0;
         for i in 0..v.len() {
             let (a, b) = (v[i].normalize(), v[(i + 1) % v.len()].normalize());
@@ -178,8 +181,14 @@ mod tests {
         let mut worst: f64 = 0.0;
         for (x, n) in [
             (DVec3::ZERO, DVec3::Z),
-            (DVec3::new(0.5, 0.3, -1.0), DVec3::new(0.1, -0.2, 1.0).normalize()),
-            (DVec3::new(-2.0, 1.0, 0.5), DVec3::new(0.3, 0.0, 1.0).normalize()),
+            (
+                DVec3::new(0.5, 0.3, -1.0),
+                DVec3::new(0.1, -0.2, 1.0).normalize(),
+            ),
+            (
+                DVec3::new(-2.0, 1.0, 0.5),
+                DVec3::new(0.3, 0.0, 1.0).normalize(),
+            ),
         ] {
             let v = corners.map(|c| c - x);
             let want = l * lambert(&v, n);
@@ -241,7 +250,9 @@ mod tests {
             .with_path("/Window")
             .with_transform(at(DVec3::new(0.0, 0.0, 4.0)))
             .with_intensity(0.5);
-        let dome = Light::dome().with_intensity(4.0).with_portal(window.clone());
+        let dome = Light::dome()
+            .with_intensity(4.0)
+            .with_portal(window.clone());
         let p = mask(&dome);
         let ports = p.portals.clone().unwrap();
         let x = DVec3::ZERO;
@@ -296,7 +307,10 @@ mod tests {
     fn monte_carlo_agrees(dome: Light, n_samples: usize) {
         let p = mask(&dome);
         let ports = p.portals.clone().unwrap();
-        let (x, n) = (DVec3::new(0.3, -0.2, 0.1), DVec3::new(0.2, 0.1, 1.0).normalize());
+        let (x, n) = (
+            DVec3::new(0.3, -0.2, 0.1),
+            DVec3::new(0.2, 0.1, 1.0).normalize(),
+        );
         let (t, b) = n.any_orthonormal_pair();
         let mut rng = Rng::new(7);
         let (mut sum, mut sum2) = (DVec3::ZERO, DVec3::ZERO);
@@ -334,7 +348,9 @@ mod tests {
             .with_path("/Skylight")
             .with_transform(at(DVec3::new(0.0, 0.5, 4.0)))
             .with_intensity(2.0);
-        dome.with_diffuse(0.8).with_portal(window).with_portal(skylight)
+        dome.with_diffuse(0.8)
+            .with_portal(window)
+            .with_portal(skylight)
     }
 
     #[test]
@@ -345,7 +361,10 @@ mod tests {
     #[test]
     fn monte_carlo_of_masked_radiance_textured() {
         // The orientation chart: the studio map's sun would leave σ at ~15 % of the mean.
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/textures/testImage.png");
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/textures/testImage.png"
+        );
         let tex = Texture::new(Asset::file(file)).with_format(TextureFormat::LatLong);
         monte_carlo_agrees(room(Light::dome().with_texture(tex)), 400_000);
     }
@@ -354,7 +373,10 @@ mod tests {
     /// dome without portals, on every query, summed and per light.
     #[test]
     fn hint_mode_is_bitwise_no_portal() {
-        let file = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/textures/studio_dwab.exr");
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/textures/studio_dwab.exr"
+        );
         let tex = Texture::new(Asset::file(file)).with_format(TextureFormat::LatLong);
         let mut rng = Rng::new(3);
         let mut unit = || {
@@ -366,15 +388,18 @@ mod tests {
         let dirs: Vec<[f32; 3]> = (0..64).map(|_| unit()).collect();
         let normals: Vec<[f32; 3]> = (0..64).map(|_| unit()).collect();
         let points: Vec<[f32; 3]> = (0..64).map(|i| [i as f32 * 0.1, 0.0, 0.5]).collect();
-        for plain in [Light::dome().with_intensity(2.0), Light::dome().with_texture(tex)] {
+        for plain in [
+            Light::dome().with_intensity(2.0),
+            Light::dome().with_texture(tex),
+        ] {
             let named = room(plain.clone());
             let plain = plain.with_diffuse(0.8);
-            let cases = [
-                (PortalMode::Hint, &named),
-                (PortalMode::Mask, &plain),
-            ];
+            let cases = [(PortalMode::Hint, &named), (PortalMode::Mask, &plain)];
             for (mode, lights) in cases {
-                let lights = [lights.clone(), Light::sphere(0.5).with_transform(at(DVec3::Y))];
+                let lights = [
+                    lights.clone(),
+                    Light::sphere(0.5).with_transform(at(DVec3::Y)),
+                ];
                 let without = [plain.clone(), lights[1].clone()];
                 let eval = Evaluator::cpu().with_portal_mode(mode);
                 let base = Evaluator::cpu();
@@ -424,10 +449,20 @@ mod tests {
         let l = [dome];
         let acc = Accumulate::Sum;
         assert!(hint.emission(&l, &dirs, acc).unwrap() == maskev.emission(&l, &dirs, acc).unwrap());
-        assert!(hint.radiance(&l, &points, &dirs, acc).unwrap() != maskev.radiance(&l, &points, &dirs, acc).unwrap());
-        assert!(hint.irradiance(&l, &points, &dirs, acc).unwrap() != maskev.irradiance(&l, &points, &dirs, acc).unwrap());
+        assert!(
+            hint.radiance(&l, &points, &dirs, acc).unwrap()
+                != maskev.radiance(&l, &points, &dirs, acc).unwrap()
+        );
+        assert!(
+            hint.irradiance(&l, &points, &dirs, acc).unwrap()
+                != maskev.irradiance(&l, &points, &dirs, acc).unwrap()
+        );
         let scene = maskev.prepare(&l).unwrap();
-        let opts = SampleOptions { seed: 1, selection: Selection::Bound, first_point: 0 };
+        let opts = SampleOptions {
+            seed: 1,
+            selection: Selection::Bound,
+            first_point: 0,
+        };
         let e = scene.sample(&points, None, 1, &opts).unwrap_err();
         assert!(matches!(e, crate::LuxError::NotSupported { .. }), "{e}");
         assert!(e.to_string().contains("/World/Sky"), "{e}");
@@ -445,10 +480,22 @@ mod tests {
         let cpu = Evaluator::cpu().with_portal_mode(PortalMode::Mask);
         let gpu = gpu.with_portal_mode(PortalMode::Mask);
         for acc in [Accumulate::Sum, Accumulate::PerLight] {
-            assert_eq!(gpu.radiance(&l, &points, &dirs, acc).unwrap(), cpu.radiance(&l, &points, &dirs, acc).unwrap());
-            assert_eq!(gpu.irradiance(&l, &points, &dirs, acc).unwrap(), cpu.irradiance(&l, &points, &dirs, acc).unwrap());
-            assert_eq!(gpu.emission(&l, &dirs, acc).unwrap(), cpu.emission(&l, &dirs, acc).unwrap());
-            assert_eq!(gpu.intensity(&l, &dirs, acc).unwrap(), cpu.intensity(&l, &dirs, acc).unwrap());
+            assert_eq!(
+                gpu.radiance(&l, &points, &dirs, acc).unwrap(),
+                cpu.radiance(&l, &points, &dirs, acc).unwrap()
+            );
+            assert_eq!(
+                gpu.irradiance(&l, &points, &dirs, acc).unwrap(),
+                cpu.irradiance(&l, &points, &dirs, acc).unwrap()
+            );
+            assert_eq!(
+                gpu.emission(&l, &dirs, acc).unwrap(),
+                cpu.emission(&l, &dirs, acc).unwrap()
+            );
+            assert_eq!(
+                gpu.intensity(&l, &dirs, acc).unwrap(),
+                cpu.intensity(&l, &dirs, acc).unwrap()
+            );
         }
     }
 }
