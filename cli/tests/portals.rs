@@ -93,8 +93,8 @@ fn portal_mode_mask_changes_irradiance_through_a_window() {
         [-1.0, 1.5, 3.0],
     ];
     let want = 2.0 * 0.5 * lambert(&window, [0.0, 0.0, 1.0]);
-    for c in 0..3 {
-        let got = mask[c] as f64;
+    for &c in &mask[0..3] {
+        let got = c as f64;
         assert!((got - want).abs() <= 1e-6 * want, "{got} vs {want}");
     }
     assert_eq!(&mask[3..9], &[0.0; 6]);

@@ -108,7 +108,9 @@ pub fn prepare_portals(
                 format!("intensity · 2^exposure · color overflows ({multiplier})"),
             ));
         }
-        if !(det.abs() > 0.0) || !(half.x > 0.0 && half.y > 0.0) {
+        // Written so that a NaN also leaves the portal out.
+        let passes = det.abs() > 0.0 && half.x > 0.0 && half.y > 0.0;
+        if !passes {
             continue;
         }
         let to_local = linear.inverse();
