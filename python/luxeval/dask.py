@@ -17,7 +17,7 @@ chunk is evaluated by whichever scheduler computes it: the local threaded schedu
 
 A worker process opens the stage once, on its first chunk, and keeps it (a per-process cache
 keyed by the stage's absolute path and requested time); the stage keeps its prepared lights per
-(``lights``, device, ``temperature_mode``, ``texture_filter``), so the GPU pipelines and buffers are built once per
+(``lights``, device, ``temperature_mode``, ``texture_filter``, ``portal_mode``), so the GPU pipelines and buffers are built once per
 worker, not per chunk. The path must name the same file on every worker (a shared file system).
 
 Devices: each worker picks its own. With ``device="auto"`` (the default) a worker without a hardware GPU
