@@ -498,6 +498,32 @@ mod tests {
         assert!(e.to_string().contains("/World/Sky"), "{e}");
     }
 
+    /// A masked textured dome depends on the receiver's position, not its normal alone: the
+    /// batch path (which shares one integral per normal for unmasked textured domes) gives each
+    /// receiver its own value.
+    #[test]
+    fn batch_of_a_masked_textured_dome_is_per_receiver() {
+        let file = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/textures/testImage.png"
+        );
+        let tex = Texture::new(Asset::file(file)).with_format(TextureFormat::LatLong);
+        let dome = room(Light::dome().with_texture(tex));
+        let p = mask(&dome);
+        let points = [[0.0f32, 0.0, 0.0], [0.5, 0.3, 1.0], [-0.4, 0.2, 3.0]];
+        let normals = [[0.0f32, 0.0, 1.0]; 3];
+        let got = Evaluator::cpu()
+            .with_portal_mode(PortalMode::Mask)
+            .irradiance(&[dome], &points, &normals, Accumulate::Sum)
+            .unwrap();
+        for (x, row) in points.iter().zip(&got) {
+            let x = DVec3::from_array(x.map(f64::from));
+            let want = super::super::irradiance::irradiance(&p, x, DVec3::Z);
+            assert_eq!(*row, want.as_vec3().to_array(), "{x}");
+        }
+        assert!(got[0] != got[1] && got[1] != got[2], "{got:?}");
+    }
+
     /// A bad portal input is refused in mask mode, naming the portal and the attribute; hint
     /// mode does not read portals (bitwise no portal), so it does not refuse them. A zero-size
     /// portal passes no light: the dome is masked to 0.
