@@ -7,6 +7,45 @@ use glam::{DMat4, DVec3};
 
 use crate::error::{LuxError, Result};
 
+/// How a dome's portals are read (DESIGN.md §8 P2; `--portal-mode`, Python `portal_mode=`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum PortalMode {
+    /// The schema's words, "guide light sampling" (Cycles, Karma, Mitsuba): portals change no
+    /// emission, radiance, irradiance or intensity.
+    #[default]
+    Hint,
+    /// hdPrman, Arnold `interior_only`, pbrt-v4: the dome reaches a point only through its
+    /// portals, each scaling what passes by its multiplier.
+    Mask,
+}
+
+impl PortalMode {
+    pub const ALL: [PortalMode; 2] = [Self::Hint, Self::Mask];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hint => "hint",
+            Self::Mask => "mask",
+        }
+    }
+}
+
+impl std::str::FromStr for PortalMode {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        Self::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown portal mode {s:?} (expected hint or mask)"))
+    }
+}
+
+impl std::fmt::Display for PortalMode {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
 /// One `PortalLight`: a `width × height` rectangle in its local XY plane, centred on its
 /// origin; light passes through it toward its local −Z (P1).
 #[derive(Clone, Debug, PartialEq)]

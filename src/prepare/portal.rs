@@ -8,46 +8,10 @@ use glam::{DMat3, DVec2, DVec3};
 use super::TemperatureMode;
 use super::blackbody::temperature_rgb;
 use crate::error::{LuxError, Result};
+// The mode is plain data of the model, so that `usd` (above `prepare`, DESIGN.md §1) can say
+// how a stage's portals are evaluated.
+pub use crate::model::PortalMode;
 use crate::model::{Light, LightType, Portal};
-
-/// How a dome's portals are read (DESIGN.md §8 P2; `--portal-mode`, Python `portal_mode=`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum PortalMode {
-    /// The schema's words, "guide light sampling" (Cycles, Karma, Mitsuba): portals change no
-    /// emission, radiance, irradiance or intensity.
-    #[default]
-    Hint,
-    /// hdPrman, Arnold `interior_only`, pbrt-v4: the dome reaches a point only through its
-    /// portals, each scaling what passes by its multiplier.
-    Mask,
-}
-
-impl PortalMode {
-    pub const ALL: [PortalMode; 2] = [Self::Hint, Self::Mask];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Hint => "hint",
-            Self::Mask => "mask",
-        }
-    }
-}
-
-impl std::str::FromStr for PortalMode {
-    type Err = String;
-    fn from_str(s: &str) -> std::result::Result<Self, String> {
-        Self::ALL
-            .into_iter()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown portal mode {s:?} (expected hint or mask)"))
-    }
-}
-
-impl std::fmt::Display for PortalMode {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// A portal's multiplier (DESIGN.md §8 P2): its own LightAPI product `intensity · 2^exposure ·
 /// color ⊙ temperature(T)`, formed as a light's base radiance is (normalize does not apply, P1).

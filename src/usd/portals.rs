@@ -1,7 +1,7 @@
 //! Portal lights on a stage (DESIGN.md §8 P1): each PortalLight attached to the domes whose
 //! `portals` relationship names it, what changes nothing said, and the `lights --json` summary.
 //! Each dome's model light carries the visible portals it names (P1); what they change is the
-//! portal mode's to say (P2, `prepare::PortalMode`).
+//! portal mode's to say (P2, `model::PortalMode`).
 
 use serde::Serialize;
 
@@ -106,7 +106,7 @@ pub(super) fn attach(lights: &mut [StageLight]) {
 /// not such portals.
 pub(super) fn named_portal_warning(
     l: &StageLight,
-    mode: crate::prepare::PortalMode,
+    mode: crate::model::PortalMode,
     when: &str,
 ) -> Option<String> {
     let p = l.portal.as_ref().filter(|p| !p.domes.is_empty())?;
@@ -114,12 +114,12 @@ pub(super) fn named_portal_warning(
         format!("{}: invisible at {when}: ignored, as if not named", l.path)
     } else {
         match mode {
-            crate::prepare::PortalMode::Hint => format!(
+            crate::model::PortalMode::Hint => format!(
                 "{}: portal of {}: guides sampling only (hint mode), changes no value",
                 l.path,
                 p.domes.join(", ")
             ),
-            crate::prepare::PortalMode::Mask => {
+            crate::model::PortalMode::Mask => {
                 format!("{}: masks {} (mask mode)", l.path, p.domes.join(", "))
             }
         }

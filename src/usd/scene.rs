@@ -208,13 +208,13 @@ impl Stage {
     /// listed but skipped by the queries (unsupported type or feature, invisible), naming the
     /// prim.
     pub fn warnings(&self) -> Vec<String> {
-        self.warnings_in(crate::prepare::PortalMode::default())
+        self.warnings_in(crate::model::PortalMode::default())
     }
 
     /// [`Stage::warnings`] for the queries of `mode`: a portal a dome names says how it is
     /// evaluated ("guides sampling only (hint mode)", "masks /World/Sky (mask mode)"), DESIGN.md
     /// §8 P2.
-    pub fn warnings_in(&self, mode: crate::prepare::PortalMode) -> Vec<String> {
+    pub fn warnings_in(&self, mode: crate::model::PortalMode) -> Vec<String> {
         let when = describe_time(self.time);
         let lights = self.lights.iter().filter_map(|l| {
             super::portals::named_portal_warning(l, mode, &when)
