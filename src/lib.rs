@@ -83,11 +83,11 @@ pub use model::{
     MeshTriangle, PoleAxis, Portal, Shaping, Texture, TextureFilter, TextureFormat, Tint,
     TopologyError, UpAxis, Value, schema,
 };
-pub use prepare::TemperatureMode;
 pub use prepare::ies::{
     FluxCheck, HFold as IesHFold, Peak as IesPeak, Plane as IesPlane, Profile as IesProfile,
     Spread as IesSpread, VFold as IesVFold,
 };
+pub use prepare::{PortalMode, TemperatureMode};
 pub use query::{
     Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, SamplerCheck, Samples,
     Selection, StrategyVariance,

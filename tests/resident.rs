@@ -514,3 +514,42 @@ fn counts_over_the_binding_limit_are_refused_with_the_most_one_call_takes() {
         .unwrap();
     assert_eq!(got, host);
 }
+
+/// A dome masked by its portals (DESIGN.md §8 P2 mask mode) is every query's CPU reference on a
+/// GPU evaluator (`GpuPath::Host`), so the GPU-resident queries refuse it by name; in hint mode
+/// the same dome runs on the device.
+#[test]
+fn masked_domes_are_refused_by_name_and_hint_mode_runs_on_the_device() {
+    let Some(r) = renderer() else { return };
+    let dome = Light::dome().with_path("/World/Sky").with_portal(
+        luxeval::Portal::new(2.0, 1.0)
+            .with_path("/World/Window")
+            .with_transform(glam::DMat4::from_translation(glam::DVec3::new(
+                0.0, 0.0, 3.0,
+            ))),
+    );
+    let n = 16;
+    let dirs = r.buffer(&vec![[0.0, 0.0, 1.0]; n], wgpu::BufferUsages::STORAGE);
+    let out = r.output(n);
+    for mode in [luxeval::PortalMode::Hint, luxeval::PortalMode::Mask] {
+        let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone())
+            .unwrap()
+            .with_portal_mode(mode);
+        let scene = eval.prepare(std::slice::from_ref(&dome)).unwrap();
+        let mut enc = r.encoder();
+        let got = scene.encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum);
+        match (mode, got) {
+            (luxeval::PortalMode::Hint, Ok(_)) => {
+                assert_eq!(r.finish(enc, &out, n), vec![[1.0; 3]; n]);
+            }
+            (luxeval::PortalMode::Mask, Err(e @ LuxError::NotOnDevice { .. })) => {
+                let text = e.to_string();
+                assert!(
+                    text.contains("/World/Sky") && text.contains("masked by portals"),
+                    "{text}"
+                );
+            }
+            (mode, other) => panic!("{mode:?}: {other:?}"),
+        }
+    }
+}

@@ -1037,6 +1037,14 @@ fn mesh_lights_and_portals_match_usd_core() {
                 .filter(|t| light(t).portal.is_some())
                 .collect();
             assert_eq!(portals, named, "{ctx} {p}");
+            // DESIGN.md §8 P1: the dome's light carries the visible ones, in that order.
+            let carried: Vec<&str> = l
+                .light
+                .as_ref()
+                .map(|d| d.portals.iter().map(|q| q.path.as_str()).collect())
+                .unwrap_or_default();
+            let visible: Vec<&str> = named.iter().copied().filter(|t| light(t).visible).collect();
+            assert_eq!(carried, visible, "{ctx} {p}");
         }
         // Every query evaluates the dome and the visible mesh lights, in traversal order; the
         // portals are skipped and said to be.
@@ -1054,16 +1062,30 @@ fn mesh_lights_and_portals_match_usd_core() {
             .collect();
         assert!(want.len() > 1, "{ctx}");
         assert_eq!(evaluated, want, "{ctx}");
+        // Every portal is said once: a portal no dome names is read, not evaluated; one a dome
+        // names says how it is evaluated (DESIGN.md §8 P2; hint mode by default).
         let warnings = scene.warnings();
         let skipped = warnings
             .iter()
             .filter(|w| w.contains("read, not evaluated yet"))
             .count();
-        assert_eq!(
-            skipped,
-            sample["portals"].as_array().unwrap().len(),
-            "{ctx}: {warnings:#?}"
-        );
+        let hints = warnings
+            .iter()
+            .filter(|w| w.contains("guides sampling only (hint mode)"))
+            .count();
+        let portals = sample["portals"].as_array().unwrap();
+        let unnamed = portals
+            .iter()
+            .filter(|e| e["domes"].as_array().is_none_or(|d| d.is_empty()))
+            .count();
+        assert_eq!(skipped, unnamed, "{ctx}: {warnings:#?}");
+        assert_eq!(skipped + hints, portals.len(), "{ctx}: {warnings:#?}");
+        let masks = scene
+            .warnings_in(luxeval::PortalMode::Mask)
+            .iter()
+            .filter(|w| w.contains("masks /World/Sky (mask mode)"))
+            .count();
+        assert_eq!(masks, hints, "{ctx}");
         // A dome's target that is not a PortalLight is said on the dome.
         let sky = light("/World/Sky").warning.clone().unwrap_or_default();
         assert!(

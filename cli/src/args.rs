@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 
-use luxeval::{Accumulate, TemperatureMode, TextureFilter};
+use luxeval::{Accumulate, PortalMode, TemperatureMode, TextureFilter};
 
 /// The stage, light selection, time, colour-temperature mode and texture filter every scene
 /// command takes.
@@ -26,6 +26,33 @@ pub struct SceneArgs {
     /// nearest texel. Irradiance integrates the reconstruction chosen.
     #[arg(long, value_enum, default_value_t = FilterArg::Bilinear)]
     pub texture_filter: FilterArg,
+    #[command(flatten)]
+    pub portal: PortalArg,
+}
+
+/// `--portal-mode` (DESIGN.md §8 P2), shared by the scene commands and `lights`.
+#[derive(Args, Clone, Copy)]
+pub struct PortalArg {
+    /// How a dome's PortalLights are read: hint (they guide sampling only and change no value),
+    /// or mask (the dome reaches a point only through its portals, times each portal's
+    /// multiplier).
+    #[arg(long = "portal-mode", value_enum, default_value_t = PortalArgMode::Hint)]
+    pub portal_mode: PortalArgMode,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum PortalArgMode {
+    Hint,
+    Mask,
+}
+
+impl From<PortalArgMode> for PortalMode {
+    fn from(m: PortalArgMode) -> Self {
+        match m {
+            PortalArgMode::Hint => PortalMode::Hint,
+            PortalArgMode::Mask => PortalMode::Mask,
+        }
+    }
 }
 
 /// Options shared by the array queries.

@@ -41,12 +41,13 @@ pub fn run(a: &CheckArgs) -> CliResult {
     let mode: TemperatureMode = a.scene.temperature_mode.into();
     let refs = lights
         .iter()
-        .map(|l| Reference::new(l, mode))
+        .map(|l| Reference::with_portal_mode(l, mode, a.scene.portal.portal_mode.into()))
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| in_scene(path, e))?;
     let gpu = Evaluator::gpu()
         .map_err(|e| Failure::runtime(format!("check compares against a GPU: {e}")))?
-        .with_temperature_mode(mode);
+        .with_temperature_mode(mode)
+        .with_portal_mode(a.scene.portal.portal_mode.into());
     let device = gpu.device_name();
     let report = check_against_reference(&gpu, &refs, a.samples, a.seed)?;
     if a.json {

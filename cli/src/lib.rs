@@ -37,7 +37,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use args::{QueryArgs, TimeArg};
+use args::{PortalArg, QueryArgs, TimeArg};
 use exit::CliResult;
 
 #[derive(Parser)]
@@ -75,6 +75,8 @@ enum Command {
         json: bool,
         #[command(flatten)]
         time: TimeArg,
+        #[command(flatten)]
+        portal: PortalArg,
     },
     /// emission(light, ω): RGB radiance leaving each light along each direction ω (pointing away
     /// from the light; for a dome, toward the environment).
@@ -202,7 +204,12 @@ pub fn main() -> ExitCode {
 fn run(cli: Cli) -> CliResult {
     match cli.command {
         Command::Info { json } => info::run(json),
-        Command::Lights { scene, json, time } => lights::run(&scene, json, time.time),
+        Command::Lights {
+            scene,
+            json,
+            time,
+            portal,
+        } => lights::run(&scene, json, time.time, portal.portal_mode.into()),
         Command::Emission {
             common,
             dirs,

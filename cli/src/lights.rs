@@ -6,7 +6,7 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use luxeval::{Power, Reference, StageLight, TemperatureMode, portal_multiplier};
+use luxeval::{PortalMode, Power, Reference, StageLight, TemperatureMode, portal_multiplier};
 
 use crate::exit::{CliResult, Failure};
 
@@ -22,21 +22,24 @@ fn power(l: &StageLight) -> Result<(Option<Power>, Option<String>), String> {
     Ok((r.power(), r.warning().map(str::to_string)))
 }
 
-pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
+pub fn run(path: &Path, json: bool, time: Option<f64>, portal_mode: PortalMode) -> CliResult {
     let scene = crate::open::load(path, time)?;
     if json {
         let runtime = |e: serde_json::Error| Failure::runtime(e.to_string());
         let mut v = serde_json::to_value(&scene).map_err(runtime)?;
-        v["lights"] = luxeval::lights_json(&scene).map_err(runtime)?;
+        v["lights"] = luxeval::lights_json(&scene, portal_mode).map_err(runtime)?;
+        // DESIGN.md §8 P2: the reading is reported with the lights it changes.
+        v["portal_mode"] = portal_mode.name().into();
         outln!("{}", serde_json::to_string_pretty(&v).map_err(runtime)?);
         return Ok(());
     }
     outln!("{}", scene.file.display());
     outln!(
-        "  upAxis {}, metersPerUnit {}, time {}",
+        "  upAxis {}, metersPerUnit {}, time {}, portal mode {}",
         scene.up_axis,
         scene.meters_per_unit,
-        scene.time
+        scene.time,
+        portal_mode.name()
     );
     for w in &scene.stage_warnings {
         outln!("  warning: {w}");
@@ -66,10 +69,16 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
                 let _ = writeln!(block, $($arg)*);
             }};
         }
+        // DESIGN.md §8 P2: a portal a dome names is evaluated with the dome, as the mode says.
+        let named = l.portal.as_ref().is_some_and(|p| !p.domes.is_empty());
         let read_only = l.portal.is_some();
         let status = match (&l.light, l.visible) {
             (Some(_), true) => "evaluated",
             (_, false) => "invisible: skipped",
+            (None, true) if named => match portal_mode {
+                PortalMode::Hint => "guides sampling only (hint mode)",
+                PortalMode::Mask => "masks its dome (mask mode)",
+            },
             (None, true) if read_only => "read, not evaluated yet",
             (None, true) => "not evaluated",
         };
@@ -144,6 +153,17 @@ pub fn run(path: &Path, json: bool, time: Option<f64>) -> CliResult {
             match portals.is_empty() {
                 true => put!("  portals  (none)"),
                 false => put!("  portals  {}", portals.join(", ")),
+            }
+            // The visible PortalLights among them: what the dome is evaluated with (P1).
+            if let Some(light) = &l.light
+                && !light.portals.is_empty()
+            {
+                let paths: Vec<&str> = light.portals.iter().map(|p| p.path.as_str()).collect();
+                put!(
+                    "  portals evaluated ({} mode)  {}",
+                    portal_mode.name(),
+                    paths.join(", ")
+                );
             }
         }
         for row in &l.world {

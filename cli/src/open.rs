@@ -18,7 +18,7 @@ pub fn lights(args: &SceneArgs) -> CliResult<Vec<Light>> {
 /// [`lights`] and every file read to compose the stage (its layers).
 fn lights_and_layers(args: &SceneArgs) -> CliResult<(Vec<Light>, Vec<PathBuf>)> {
     let scene = load(&args.scene, args.time.time)?;
-    for w in scene.warnings() {
+    for w in scene.warnings_in(args.portal.portal_mode.into()) {
         eprintln!("warning: {w}");
     }
     let mut lights = scene.evaluable(&args.lights).map_err(|e| match e {
@@ -63,7 +63,9 @@ pub fn evaluator(device: Option<DeviceArg>, args: &SceneArgs) -> CliResult<Evalu
             eval
         }
     };
-    Ok(eval.with_temperature_mode(args.temperature_mode.into()))
+    Ok(eval
+        .with_temperature_mode(args.temperature_mode.into())
+        .with_portal_mode(args.portal.portal_mode.into()))
 }
 
 /// Loads, selects and prepares the lights on the chosen device, then refuses `outputs` that

@@ -583,8 +583,10 @@ cases! {
     mesh_non_finite_point: Case { args: emission!("{in}/non_finite_point.usda", "{in}/dirs.npy"), exit: 2, says: &["non_finite_point.usda", "/Bad", "points", "not finite"], setup: Some(mesh_stages), ..Case::default() };
     mesh_hole_out_of_range: Case { args: emission!("{in}/hole_out_of_range.usda", "{in}/dirs.npy"), exit: 2, says: &["hole_out_of_range.usda", "/Bad", "holeIndices", "3"], setup: Some(mesh_stages), ..Case::default() };
     mesh_triangles_over_the_limit: Case { args: emission!("{in}/mesh_lights.usda", "{in}/dirs.npy"), exit: 2, env: &[("LUXEVAL_MAX_MESH_TRIANGLES", "3")], says: &["mesh_lights.usda", "/World/Signs/Quads", "4 triangles", "LUXEVAL_MAX_MESH_TRIANGLES"], setup: Some(mesh_stages), ..Case::default() };
-    // The dome and the mesh lights are evaluated; the portals are said to be read, not evaluated yet.
-    portals_are_read_and_skipped: Case { args: emission!("{in}/mesh_lights.usda", "{in}/dirs.npy"), exit: 0, lit: true, says: &["/World/Window: portal read, not evaluated yet"], setup: Some(mesh_stages), ..Case::default() };
+    // The dome and the mesh lights are evaluated; a portal the dome names says how it is
+    // evaluated (DESIGN.md §8 P2), one no dome names that it is read, not evaluated.
+    portals_say_how_they_are_evaluated: Case { args: emission!("{in}/mesh_lights.usda", "{in}/dirs.npy"), exit: 0, lit: true, says: &["/World/Window: portal of /World/Sky: guides sampling only (hint mode)", "/World/Skylight: portal read, not evaluated yet"], setup: Some(mesh_stages), ..Case::default() };
+    portal_mode_bogus: Case { args: &["irradiance", "{in}/ok.usda", "--points", "{in}/dirs.npy", "--normals", "{in}/dirs.npy", "-o", "{out}/out.npy", "--portal-mode", "bogus"], exit: 2, says: &["--portal-mode", "bogus", "hint, mask"], ..Case::default() };
 
     // --- Runtime failures: exit 1 ---------------------------------------------------------------
     disk_full_while_writing_npy: Case { args: &["emission", "{in}/ok.usda", "--dirs", "{in}/dirs.npy", "-o", "{out}/out.npy", "--device", "cpu"], exit: 1, fsize: Some(100), says: &["writing", "out.npy"], ..Case::default() };

@@ -19,6 +19,7 @@ mod lights;
 mod maps;
 mod mesh;
 mod pipeline_cache;
+mod portals;
 mod robustness;
 mod sample;
 mod stream;

@@ -26,8 +26,8 @@ fn lights_json_lists_every_input_and_whether_authored() {
 /// doubleSided, subdivision), each portal (size, multiplier, the domes naming it) and each
 /// dome's portals (DESIGN.md §7, §8), with the numbers usd-core and NumPy computed for the
 /// fixture (tests/data/usd/expected/mesh_lights.json, its earliest-time sample); the text
-/// lists the same, and says the mesh lights are evaluated and the portals read, not evaluated
-/// yet.
+/// lists the same, and says the mesh lights are evaluated, the portal the dome names guides
+/// sampling (hint mode, the default) and the one no dome names is read, not evaluated.
 #[test]
 fn lights_lists_mesh_lights_and_portals() {
     let scene = repo_file("tests/data/usd/mesh/mesh_lights.usda");
@@ -76,6 +76,25 @@ fn lights_lists_mesh_lights_and_portals() {
     }
     // Other lights' records have no such fields.
     assert!(record("/World/Sky").get("mesh").is_none());
+    // DESIGN.md §8 P2: the mode, and the dome's portals as evaluated (the PortalLights among
+    // its targets, the mesh light left out), not masked in hint mode.
+    assert_eq!(v["portal_mode"], "hint");
+    assert_eq!(
+        record("/World/Sky")["portals_evaluated"],
+        serde_json::json!(["/World/Window"])
+    );
+    assert_eq!(record("/World/Sky")["masked"], false);
+    let o = luxeval(&["lights", &scene, "--json", "--portal-mode", "mask"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(m["portal_mode"], "mask");
+    let sky = m["lights"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|l| l["path"] == "/World/Sky")
+        .unwrap();
+    assert_eq!(sky["masked"], true);
 
     let o = luxeval(&["lights", &scene]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -84,7 +103,9 @@ fn lights_lists_mesh_lights_and_portals() {
         "/World/Signs/Quads (Mesh) [evaluated]",
         "  mesh  4 triangles (0 hole faces removed, 0 degenerate triangles dropped), area 4.000000, doubleSided false",
         "  tint  (2, 1, 0.5) from emissiveColor of /World/Looks/Glow/Surface (authored)",
-        "/World/Window (PortalLight) [read, not evaluated yet]",
+        "/World/Window (PortalLight) [guides sampling only (hint mode)]",
+        "/World/Skylight (PortalLight) [read, not evaluated yet]",
+        "  portals evaluated (hint mode)  /World/Window",
         "  portal  2 x 1.5, multiplier (4, 2, 1), named by /World/Sky",
         "  portal  1 x 1, multiplier (1, 1, 1), named by no dome",
         "  portals  /World/Window, /World/Signs/Quads",

@@ -13,7 +13,7 @@ Open a stage, then ask for emission, radiance, irradiance or a falloff map with 
 This package mirrors the Rust library (``luxeval::Stage``, ``Evaluator``, ``PreparedScene``):
 
 - :class:`Stage` reads a stage's lights once; its queries prepare the selected lights once per
-  (``lights``, device, ``temperature_mode``, ``texture_filter``) and reuse them, with the GPU pipelines and buffers.
+  (``lights``, device, ``temperature_mode``, ``texture_filter``, ``portal_mode``) and reuse them, with the GPU pipelines and buffers.
 - :class:`InputError` (a ``ValueError``): bad input, naming the file, prim and attribute or the
   argument. :class:`DeviceError` (a ``RuntimeError``): no GPU with ``device="gpu"``, a device
   failure. :class:`DeviceWarning`: ``device="auto"`` found no hardware GPU and uses the CPU reference.

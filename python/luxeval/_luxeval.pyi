@@ -13,6 +13,8 @@ __version__: str
 Device = Literal["auto", "gpu", "cpu"]
 TemperatureMode = Literal["spec", "usd", "planckian"]
 TextureFilter = Literal["bilinear", "nearest"]
+# DESIGN.md §8 P2: hint (portals change no value) or mask (a dome reaches a point only through them).
+PortalMode = Literal["hint", "mask"]
 Lights = Optional[Union[str, Sequence[str]]]
 Vec3 = Union[Sequence[float], npt.ArrayLike]
 Selection = Literal["power", "bound", "exact"]
@@ -42,7 +44,7 @@ class Stage:
     Raises ``InputError`` when the file is missing, unreadable or malformed (naming the file and
     line or prim). Queries take any real dtype in C or Fortran order (C-contiguous float32 is
     used without a copy) and return ``numpy.float32`` arrays (``sample``: a dict of arrays); the lights are prepared once per
-    (lights, device, temperature_mode, texture_filter) and reused. Picklable: unpickling opens the stage again.
+    (lights, device, temperature_mode, texture_filter, portal_mode) and reused. Picklable: unpickling opens the stage again.
     """
 
     def __init__(self, path: Union[str, os.PathLike[str]], time: Optional[float] = None) -> None: ...
@@ -98,6 +100,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
     ) -> npt.NDArray[np.float32]:
         """Radiance leaving each light along each direction (N, 3) → float32 (N, 3), or
         (L, N, 3) with ``per_light=True``."""
@@ -111,6 +114,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
     ) -> npt.NDArray[np.float32]:
         """Radiance arriving at each point from each direction (pairs of (N, 3)) → float32
         (N, 3), or (L, N, 3) with ``per_light=True``."""
@@ -124,6 +128,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
         tolerance: float = 1e-4,
     ) -> npt.NDArray[np.float32]:
         """Diffuse-weighted irradiance at each point on a receiver with the given normal →
@@ -139,6 +144,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
         tolerance: float = 1e-4,
     ) -> npt.NDArray[np.float32]:
         """The summed irradiance at the pixel centres of ``origin + s·u + t·v``, res = (W, H)
@@ -155,6 +161,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
         first_point: int = 0,
     ) -> dict[str, npt.NDArray[Any]]:
         """``count`` (K, 1 to 2**20) directions per point (N, 3) toward the lights, as
@@ -177,6 +184,7 @@ class Stage:
         device: Device = "auto",
         temperature_mode: TemperatureMode = "spec",
         texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
     ) -> npt.NDArray[np.float32]:
         """The density ``sample`` draws each direction with (pairs of (M, 3); ``normals`` as
         given to ``sample``) → float32 (M,), or (L, M) with ``per_light=True`` (rows sum to the

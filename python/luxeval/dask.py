@@ -17,7 +17,7 @@ chunk is evaluated by whichever scheduler computes it: the local threaded schedu
 
 A worker process opens the stage once, on its first chunk, and keeps it (a per-process cache
 keyed by the stage's absolute path and requested time); the stage keeps its prepared lights per
-(``lights``, device, ``temperature_mode``, ``texture_filter``), so the GPU pipelines and buffers are built once per
+(``lights``, device, ``temperature_mode``, ``texture_filter``, ``portal_mode``), so the GPU pipelines and buffers are built once per
 worker, not per chunk. The path must name the same file on every worker (a shared file system).
 
 Devices: each worker picks its own. With ``device="auto"`` (the default) a worker without a hardware GPU
@@ -145,7 +145,9 @@ def _rows(x: Any, name: str, chunks: int) -> da.Array:
     return x.rechunk({1: 3})
 
 
-def _check_options(device: str, temperature_mode: str, texture_filter: str) -> None:
+def _check_options(
+    device: str, temperature_mode: str, texture_filter: str, portal_mode: str = "hint"
+) -> None:
     if device not in ("auto", "gpu", "cpu"):
         raise InputError(f'device: {device!r} is not one of "auto", "gpu", "cpu"')
     if temperature_mode not in ("spec", "usd", "planckian"):
@@ -156,6 +158,8 @@ def _check_options(device: str, temperature_mode: str, texture_filter: str) -> N
         raise InputError(
             f'texture_filter: {texture_filter!r} is not one of "bilinear", "nearest"'
         )
+    if portal_mode not in ("hint", "mask"):
+        raise InputError(f'portal_mode: {portal_mode!r} is not one of "hint", "mask"')
 
 
 def _paired(arrays: Sequence[tuple[Any, str]], chunks: int) -> list[da.Array]:
@@ -184,6 +188,7 @@ def _map(
     temperature_mode: str,
     texture_filter: str,
     chunks: int,
+    portal_mode: str = "hint",
     extra: Optional[dict[str, Any]] = None,
 ) -> da.Array:
     path, requested = _locate(stage, time)
@@ -191,7 +196,7 @@ def _map(
     # reported now, and the number of lights gives the shape of per-light results.
     local = _stage(path, requested)
     n_lights = len(local.light_paths(lights))
-    _check_options(device, temperature_mode, texture_filter)
+    _check_options(device, temperature_mode, texture_filter, portal_mode)
     if isinstance(lights, str):
         lights = [lights]
     options = {
@@ -200,6 +205,7 @@ def _map(
         "device": device,
         "temperature_mode": temperature_mode,
         "texture_filter": texture_filter,
+        "portal_mode": portal_mode,
         **(extra or {}),
     }
     xs = _paired(arrays, chunks)
@@ -233,6 +239,7 @@ def emission(
     device: str = "auto",
     temperature_mode: str = "spec",
     texture_filter: str = "bilinear",
+    portal_mode: str = "hint",
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.emission` over a dask array of directions (N, 3), lazily.
@@ -251,6 +258,7 @@ def emission(
         device=device,
         temperature_mode=temperature_mode,
         texture_filter=texture_filter,
+        portal_mode=portal_mode,
         chunks=chunks,
     )
 
@@ -266,6 +274,7 @@ def radiance(
     device: str = "auto",
     temperature_mode: str = "spec",
     texture_filter: str = "bilinear",
+    portal_mode: str = "hint",
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.radiance` over dask arrays of points and directions (N, 3) each,
@@ -280,6 +289,7 @@ def radiance(
         device=device,
         temperature_mode=temperature_mode,
         texture_filter=texture_filter,
+        portal_mode=portal_mode,
         chunks=chunks,
     )
 
@@ -295,6 +305,7 @@ def irradiance(
     device: str = "auto",
     temperature_mode: str = "spec",
     texture_filter: str = "bilinear",
+    portal_mode: str = "hint",
     tolerance: float = 1e-4,
     chunks: int = 1_000_000,
 ) -> da.Array:
@@ -311,6 +322,7 @@ def irradiance(
         device=device,
         temperature_mode=temperature_mode,
         texture_filter=texture_filter,
+        portal_mode=portal_mode,
         chunks=chunks,
         extra={"tolerance": float(tolerance)},
     )
@@ -385,6 +397,7 @@ def sample(
     device: str = "auto",
     temperature_mode: str = "spec",
     texture_filter: str = "bilinear",
+    portal_mode: str = "hint",
     chunks: int = 1_000_000,
 ) -> dict[str, da.Array]:
     """:meth:`luxeval.Stage.sample` over dask arrays of points (and receiver normals) (N, 3),
@@ -403,7 +416,7 @@ def sample(
     path, requested = _locate(stage, time)
     local = _stage(path, requested)
     local.light_paths(lights)  # a bad selection is reported now
-    _check_options(device, temperature_mode, texture_filter)
+    _check_options(device, temperature_mode, texture_filter, portal_mode)
     count = _integer(
         count, "count", 1, MAX_COUNT,
         f"from 1 to {MAX_COUNT} samples per point (use more seeds for more)",
@@ -420,6 +433,7 @@ def sample(
         "device": device,
         "temperature_mode": temperature_mode,
         "texture_filter": texture_filter,
+        "portal_mode": portal_mode,
     }
     arrays = [(points, "points")] + ([] if normals is None else [(normals, "normals")])
     xs = _paired(arrays, chunks)
@@ -450,6 +464,7 @@ def pdf(
     device: str = "auto",
     temperature_mode: str = "spec",
     texture_filter: str = "bilinear",
+    portal_mode: str = "hint",
     chunks: int = 1_000_000,
 ) -> da.Array:
     """:meth:`luxeval.Stage.pdf` over dask arrays of points, directions (and receiver normals)
@@ -459,7 +474,7 @@ def pdf(
     path, requested = _locate(stage, time)
     local = _stage(path, requested)
     n_lights = len(local.light_paths(lights))
-    _check_options(device, temperature_mode, texture_filter)
+    _check_options(device, temperature_mode, texture_filter, portal_mode)
     _check_selection(selection, normals)
     if isinstance(lights, str):
         lights = [lights]
@@ -470,6 +485,7 @@ def pdf(
         "device": device,
         "temperature_mode": temperature_mode,
         "texture_filter": texture_filter,
+        "portal_mode": portal_mode,
     }
     arrays = [(points, "points"), (dirs, "dirs")]
     arrays += [] if normals is None else [(normals, "normals")]

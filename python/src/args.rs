@@ -19,6 +19,8 @@ pub(crate) struct Options {
     pub(crate) device: Device,
     pub(crate) mode: TemperatureMode,
     pub(crate) filter: TextureFilter,
+    /// How domes read their portals (`--portal-mode`, DESIGN.md §8 P2).
+    pub(crate) portal: luxeval::PortalMode,
     /// Irradiance's relative tolerance (`luxeval irradiance --tolerance`); not part of the
     /// prepared scene, which takes it per call.
     tolerance: Option<f64>,
@@ -30,12 +32,14 @@ impl Options {
         device: &str,
         mode: &str,
         filter: &str,
+        portal: &str,
     ) -> PyResult<Options> {
         Ok(Options {
             select: parse_lights(lights)?,
             device: Device::parse(device)?,
             mode: device::parse_mode(mode)?,
             filter: device::parse_filter(filter)?,
+            portal: device::parse_portal_mode(portal)?,
             tolerance: None,
         })
     }

@@ -44,6 +44,15 @@ pub fn parse_mode(s: &str) -> PyResult<TemperatureMode> {
     }
 }
 
+/// The `portal_mode=` argument (the CLI's `--portal-mode`, DESIGN.md §8 P2).
+pub fn parse_portal_mode(s: &str) -> PyResult<luxeval::PortalMode> {
+    s.parse::<luxeval::PortalMode>().map_err(|_| {
+        errors::input(format!(
+            "portal_mode: {s:?} is not one of \"hint\", \"mask\""
+        ))
+    })
+}
+
 /// The `texture_filter=` argument (the CLI's `--texture-filter`).
 pub fn parse_filter(s: &str) -> PyResult<TextureFilter> {
     match s {

@@ -61,6 +61,7 @@ struct Key {
     gpu: bool,
     mode: TemperatureMode,
     filter: TextureFilter,
+    portal: luxeval::PortalMode,
 }
 
 /// `Stage(path, time)`'s arguments, as pickling records them.
@@ -92,7 +93,7 @@ impl Stage {
                 t.filter = o.filter;
             }
         }
-        let eval = device::evaluator(py, o.device, o.mode)?;
+        let eval = device::evaluator(py, o.device, o.mode)?.with_portal_mode(o.portal);
         let mut select = o.select.clone();
         select.sort();
         select.dedup();
@@ -101,6 +102,7 @@ impl Stage {
             gpu: eval.is_gpu(),
             mode: o.mode,
             filter: o.filter,
+            portal: o.portal,
         };
         if let Some(p) = self.cache().get(&key) {
             return Ok(p.clone());
@@ -133,8 +135,9 @@ impl Stage {
         device: &str,
         mode: &str,
         filter: &str,
+        portal: &str,
     ) -> PyResult<Options> {
-        Options::parse(lights, device, mode, filter)
+        Options::parse(lights, device, mode, filter, portal)
     }
 
     /// `sample`'s and `pdf`'s points and optional normals, checked (rows, pairing, and the
@@ -269,7 +272,7 @@ impl Stage {
         let scene = py.detach(|| {
             no_panic(|| ReadStage::load(&path, time).map_err(|e| errors::lux(e, None)))
         })?;
-        let lights_json = luxeval::lights_json(&scene)
+        let lights_json = luxeval::lights_json(&scene, luxeval::PortalMode::Hint)
             .map(|v| v.to_string())
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
         Ok(Stage {
@@ -334,8 +337,10 @@ impl Stage {
     /// evaluated unshaped)); a mesh light's ``mesh`` (``triangles``, ``area``, ``holes``,
     /// ``degenerate_triangles``, ``folded_faces``, ``tint``, ``tint_source``, ``double_sided``,
     /// ``subdivision_scheme``, ``subdivision``), a portal's ``portal`` (``width``, ``height``,
-    /// its multiplier inputs, ``multiplier``, ``domes``) and a dome's ``portals`` (read, not
-    /// evaluated yet). A new list on each access.
+    /// its multiplier inputs, ``multiplier``, ``domes``) and a dome's ``portals`` (its targets),
+    /// ``portals_evaluated`` (the visible PortalLights among them) and ``masked`` (always
+    /// false here: ``portal_mode=`` is a query's option, DESIGN.md §8 P2). A new list on each
+    /// access.
     #[getter]
     fn lights<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         py.import(intern!(py, "json"))?
@@ -448,7 +453,7 @@ impl Stage {
     /// ``texture_filter``: ``"bilinear"`` or ``"nearest"`` (dome and rect textures).
     /// Raises ``InputError`` for a wrong shape or dtype, a non-finite or zero row, an unknown
     /// light, or a light attribute luxeval cannot evaluate (naming the file, prim, attribute).
-    #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
+    #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint"))]
     fn emission<'py>(
         &self,
         py: Python<'py>,
@@ -458,8 +463,15 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         self.query(py, Query::Emission, dirs, None, per_light, o)
     }
 
@@ -468,7 +480,7 @@ impl Stage {
     ///
     /// ``points``, ``dirs``: (N, 3) each, paired row by row. Returns float32 (N, 3), or
     /// (L, N, 3) with ``per_light=True``. Options and errors as ``emission``.
-    #[pyo3(signature = (points, dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
+    #[pyo3(signature = (points, dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint"))]
     #[allow(clippy::too_many_arguments)]
     fn radiance<'py>(
         &self,
@@ -480,8 +492,15 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         self.query(py, Query::Radiance, points, Some(dirs), per_light, o)
     }
 
@@ -493,7 +512,7 @@ impl Stage {
     /// Returns float32 (N, 3), or (L, N, 3) with ``per_light=True``. Options and errors as
     /// ``emission``. ``tolerance``: relative, from 1e-9 to 0.1, as ``luxeval irradiance
     /// --tolerance`` (the CPU's quadrature stops there; the GPU takes none below 1e-4).
-    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", tolerance = 1e-4))]
+    #[pyo3(signature = (points, normals, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint", tolerance = 1e-4))]
     #[allow(clippy::too_many_arguments)]
     fn irradiance<'py>(
         &self,
@@ -505,10 +524,17 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        portal_mode: &str,
         tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter)?
-            .with_tolerance(tolerance)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?
+        .with_tolerance(tolerance)?;
         self.query(py, Query::Irradiance, points, Some(normals), per_light, o)
     }
 
@@ -519,7 +545,7 @@ impl Stage {
     /// (``origin + v`` side), column 0 at the ``origin`` side: pixel (row j, column i) is at
     /// ``origin + (i + ½)/W·u + (1 − (j + ½)/H)·v``. Options and errors as ``emission``;
     /// ``tolerance`` as ``irradiance``.
-    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", tolerance = 1e-4))]
+    #[pyo3(signature = (origin, u, v, res, *, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint", tolerance = 1e-4))]
     #[allow(clippy::too_many_arguments)]
     fn falloff<'py>(
         &self,
@@ -532,10 +558,17 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        portal_mode: &str,
         tolerance: f64,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = Options::parse(lights, device, temperature_mode, texture_filter)?
-            .with_tolerance(tolerance)?;
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?
+        .with_tolerance(tolerance)?;
         let origin = vec3(py, origin, "origin")?;
         let u = vec3(py, u, "u")?;
         let v = vec3(py, v, "v")?;
@@ -619,9 +652,9 @@ impl Stage {
     /// of ``luxeval sample``. Other options as ``emission``.
     /// Raises ``InputError`` for a count, seed or selection out of range (naming it), missing
     /// normals with ``selection="exact"``, and the errors of ``emission``.
-    #[pyo3(signature = (points, normals = None, *, count = None, seed = None, selection = "bound", lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", first_point = None))]
+    #[pyo3(signature = (points, normals = None, *, count = None, seed = None, selection = "bound", lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint", first_point = None))]
     #[pyo3(
-        text_signature = "(self, points, normals=None, *, count=1, seed=0, selection=\"bound\", lights=None, device=\"auto\", temperature_mode=\"spec\", texture_filter=\"bilinear\", first_point=0)"
+        text_signature = "(self, points, normals=None, *, count=1, seed=0, selection=\"bound\", lights=None, device=\"auto\", temperature_mode=\"spec\", texture_filter=\"bilinear\", portal_mode=\"hint\", first_point=0)"
     )]
     #[allow(clippy::too_many_arguments)]
     fn sample<'py>(
@@ -636,9 +669,17 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        portal_mode: &str,
         first_point: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = self.sampling_options(py, lights, device, temperature_mode, texture_filter)?;
+        let o = self.sampling_options(
+            py,
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         let k = match count {
             Some(c) => args::count(c)?,
             None => 1,
@@ -732,7 +773,7 @@ impl Stage {
     /// row per light, in the order of ``light_paths(lights)``, whose sum is the summed
     /// density). ``selection``, ``device`` and errors as ``sample``; other options as
     /// ``emission``.
-    #[pyo3(signature = (points, dirs, normals = None, *, per_light = false, selection = "bound", lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear"))]
+    #[pyo3(signature = (points, dirs, normals = None, *, per_light = false, selection = "bound", lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint"))]
     #[allow(clippy::too_many_arguments)]
     fn pdf<'py>(
         &self,
@@ -746,8 +787,16 @@ impl Stage {
         device: &str,
         temperature_mode: &str,
         texture_filter: &str,
+        portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = self.sampling_options(py, lights, device, temperature_mode, texture_filter)?;
+        let o = self.sampling_options(
+            py,
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
         let selection = args::parse_selection(selection)?;
         let (p_arr, n_arr) = self.sampling_rows(py, points, normals, selection)?;
         let d_arr = arrays::rows(py, dirs, "dirs", RowKind::Directions)?;

@@ -54,7 +54,8 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3) -> DVec3 {
 /// ([`dome::sh`]), `diffuse` applied: an approximation whose error against [`irradiance`] depends
 /// on the map (README "Dome textures" gives measured figures). `None` for other lights.
 pub fn irradiance_sh9(p: &Prepared, n: DVec3) -> Option<DVec3> {
-    if p.light.kind != LightType::Dome {
+    // A masked dome (DESIGN.md §8 P2) is not a function of the normal alone.
+    if p.light.kind != LightType::Dome || p.portals.is_some() {
         return None;
     }
     let t = dome::tables(p)?;
@@ -65,6 +66,10 @@ pub fn irradiance_sh9(p: &Prepared, n: DVec3) -> Option<DVec3> {
 pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> DVec3 {
     let e = match p.light.kind {
         LightType::Mesh { .. } => super::mesh::irradiance(p, x, n, rule.piece_tolerance()),
+        // A dome masked by its portals (DESIGN.md §8 P2 mask mode), see cpu/portal.rs.
+        LightType::Dome if let Some(portals) = &p.portals => {
+            super::portal::irradiance(p, portals, x, n, rule.piece_tolerance())
+        }
         // A textured dome's irradiance is the exact integral of its filtered texture (DESIGN.md
         // §6 "Dome and texture irradiance: what 'exact' means"), see dome.rs.
         LightType::Dome if p.dome_texture().is_some() => match dome::tables(p) {

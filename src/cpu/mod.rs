@@ -15,6 +15,7 @@ pub mod ies;
 pub mod intensity;
 pub mod irradiance;
 pub mod mesh;
+pub mod portal;
 pub mod power;
 pub mod quadrature;
 pub mod radiance;
@@ -108,8 +109,11 @@ pub fn irradiance_batch(
     let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
         .iter()
         .map(|l| {
-            (matches!(l.light.kind, LightType::Dome) && l.dome_texture().is_some())
-                .then(|| dome_by_normal(l, normals))
+            // A dome masked by portals (DESIGN.md §8 P2) depends on x too: not shared.
+            (matches!(l.light.kind, LightType::Dome)
+                && l.dome_texture().is_some()
+                && l.portals.is_none())
+            .then(|| dome_by_normal(l, normals))
         })
         .collect();
     batch(lights.len(), points.len(), per_light, |k, i| {

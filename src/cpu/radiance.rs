@@ -19,6 +19,9 @@ pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
     if matches!(p.light.kind, LightType::Mesh { .. }) {
         // DESIGN.md §7 M3: the first triangle hit, with the side it is hit on.
         super::mesh::radiance(p, x, w)
+    } else if let Some(portals) = &p.portals {
+        // A dome masked by its portals (DESIGN.md §8 P2 mask mode).
+        super::portal::radiance(p, portals, x, w)
     } else if matches!(p.light.kind, LightType::Dome) {
         // A dome's emission is indexed by the direction toward the environment (DESIGN.md §3),
         // which is ω itself.
@@ -48,6 +51,10 @@ pub fn hits_emitting_surface(p: &Prepared, x: DVec3, w: DVec3) -> bool {
     let xl = p.to_local * (x - p.origin);
     let dl = p.to_local * w;
     match p.light.kind {
+        // A masked dome is seen only through a portal crossed toward its +Z (§8 P2).
+        LightType::Dome if let Some(portals) = &p.portals => {
+            super::portal::crossing(portals, x, w.normalize()).is_some()
+        }
         LightType::Dome | LightType::Distant { .. } => true,
         LightType::Rect { width, height } => rect_hit(xl, dl, width / 2.0, height / 2.0),
         LightType::Disk { radius } => disk_hit(xl, dl, radius),

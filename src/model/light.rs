@@ -13,6 +13,7 @@ use glam::{DMat3, DMat4, DVec3};
 
 use super::asset::Asset;
 use super::mesh::MeshGeometry;
+use super::portal::Portal;
 
 use super::schema;
 use crate::error::{LuxError, Result};
@@ -300,6 +301,10 @@ pub struct Light {
     pub stage_up: UpAxis,
     /// `inputs:texture:*` where `texture:file` is authored (DomeLight, DomeLight_1, RectLight).
     pub texture: Option<Texture>,
+    /// A dome's portals (DESIGN.md §8 P1): the visible PortalLights its `portals` relationship
+    /// names, in relationship order. Empty for every other type, and for a dome that names
+    /// none; what they change depends on the portal mode (P2, `prepare::PortalMode`).
+    pub portals: Vec<Portal>,
 }
 
 impl Light {
@@ -318,6 +323,7 @@ impl Light {
             shaping: None,
             stage_up: UpAxis::Y,
             texture: None,
+            portals: Vec::new(),
         }
     }
 
@@ -394,6 +400,12 @@ impl Light {
         self.texture = Some(texture);
         self
     }
+    /// Adds a portal to a dome (DESIGN.md §8 P1), after those it has: the order of a `portals`
+    /// relationship, which decides between portals overlapping at the same depth.
+    pub fn with_portal(mut self, portal: Portal) -> Self {
+        self.portals.push(portal);
+        self
+    }
     /// Sets the stage's up axis (TILT of IES profiles, DomeLight_1 `poleAxis = scene`).
     pub fn with_stage_up(mut self, up: UpAxis) -> Self {
         self.stage_up = up;
@@ -464,6 +476,8 @@ impl Light {
                 size("inputs:length", length)?;
                 size("inputs:radius", radius)?;
             }
+            // A dome's portals are checked where they are evaluated (mask mode,
+            // `prepare::portal`): hint mode ignores them, as if not named (DESIGN.md §8 P2).
             LightType::Dome => {}
             LightType::Mesh { tint, .. } => {
                 for c in tint.to_array() {

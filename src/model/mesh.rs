@@ -249,6 +249,7 @@ impl MeshLight {
             shaping: self.shaping.clone(),
             stage_up,
             texture: None,
+            portals: Vec::new(),
         }
     }
 }

@@ -15,5 +15,5 @@ pub use light::{
     UpAxis,
 };
 pub use mesh::{MeshGeometry, MeshLight, MeshTopology, MeshTriangle, Tint, TopologyError};
-pub use portal::Portal;
+pub use portal::{Portal, PortalMode};
 pub use value::{Input, Value};

@@ -13,6 +13,7 @@ pub mod ies;
 pub mod ies_kinks;
 pub mod mesh_bvh;
 pub mod normalize;
+pub mod portal;
 pub mod profile;
 pub mod texture;
 pub mod zero_size;
@@ -26,6 +27,7 @@ use crate::model::{Light, LightType, Shaping, Texture, UpAxis};
 use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
+pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
 
 /// A light's IES profile as both backends evaluate it (DESIGN.md §6 I7): the factor along a
@@ -110,6 +112,10 @@ pub struct Prepared {
     /// How the light is evaluated other than as authored, naming the prim (a zero-size light,
     /// [`zero_size`]).
     pub warning: Option<String>,
+    /// A dome masked by its portals (DESIGN.md §8 P2, [`PortalMode::Mask`]): the portals light
+    /// reaches a point through (possibly none that pass light: then the dome lights nothing).
+    /// `None`: not masked (hint mode, another type, a dome naming no visible portal).
+    pub portals: Option<Vec<PreparedPortal>>,
 }
 
 /// What one kind of light carries beyond the shared frame, base radiance and shaping of
@@ -171,7 +177,8 @@ pub enum GpuPath {
     RadianceOnDevice(&'static str),
     /// Every query from the CPU reference: mesh lights the device cannot hold or traverse (a
     /// hierarchy deeper than the kernel's stack, more data than [`MESH_DEVICE_BYTES`], a
-    /// singular transform), and masked domes. The record the kernels see emits nothing.
+    /// singular transform), and domes masked by portals (§8 P2 mask mode), until a kernel
+    /// tests portal crossings. The record the kernels see emits nothing.
     Host(&'static str),
 }
 
@@ -252,6 +259,21 @@ impl Prepared {
     /// Whether the GPU path takes this light's radiance from the CPU reference.
     pub fn radiance_on_host(&self) -> bool {
         matches!(self.gpu_path, GpuPath::Host(_))
+    }
+
+    /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
+    /// portals is masked, and every query of it on a GPU evaluator is the CPU reference's
+    /// (there is no portal kernel). Hint mode changes nothing.
+    pub fn apply_portal_mode(
+        &mut self,
+        mode: PortalMode,
+        temperature: TemperatureMode,
+    ) -> Result<()> {
+        self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
+        if self.portals.is_some() {
+            self.gpu_path = GpuPath::Host("it is masked by portals");
+        }
+        Ok(())
     }
 
     /// Validates `light` and computes its constants for `mode`.
@@ -425,6 +447,7 @@ impl Prepared {
         .flat_map(|a| cache.files(a))
         .collect();
         Ok(Prepared {
+            portals: None,
             warning,
             files_read,
             base,
@@ -693,11 +716,19 @@ pub fn tilt_angle(axis: DVec3, up: UpAxis) -> f64 {
 
 /// Prepares every light, failing on the first invalid one; a file referenced by several lights
 /// is loaded once.
-pub fn prepare(lights: &[Light], mode: TemperatureMode) -> Result<Vec<Prepared>> {
+pub fn prepare(
+    lights: &[Light],
+    mode: TemperatureMode,
+    portal_mode: PortalMode,
+) -> Result<Vec<Prepared>> {
     let mut cache = AssetCache::default();
     lights
         .iter()
-        .map(|l| Prepared::with_assets(l, mode, &mut cache))
+        .map(|l| {
+            let mut p = Prepared::with_assets(l, mode, &mut cache)?;
+            p.apply_portal_mode(portal_mode, mode)?;
+            Ok(p)
+        })
         .collect()
 }
 

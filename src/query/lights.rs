@@ -3,9 +3,8 @@
 
 use glam::DVec3;
 
-use crate::model::Portal;
-use crate::prepare::TemperatureMode;
-use crate::prepare::blackbody::temperature_rgb;
+use crate::model::{LightType, Portal};
+use crate::prepare::{PortalMode, TemperatureMode};
 use crate::usd::Stage;
 
 use super::Reference;
@@ -13,8 +12,10 @@ use super::Reference;
 /// `scene.lights` as JSON, each record with `power` ([`Reference::power`]: `rgb`, `lumens`,
 /// `watts`; null for lights at infinity or not evaluated) and, when the light cannot be prepared
 /// (a missing IES file, ...), `power_error` with the reason. A portal's record adds its
-/// `multiplier` ([`portal_multiplier`]) to its `portal` summary.
-pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
+/// `multiplier` ([`portal_multiplier`]) to its `portal` summary. A dome's record adds
+/// `portals_evaluated` (the visible PortalLights it names, in relationship order: what its
+/// light carries, DESIGN.md §8 P1) and `masked` (whether `mode` masks it by them, P2).
+pub fn lights_json(scene: &Stage, mode: PortalMode) -> serde_json::Result<serde_json::Value> {
     let mut v = serde_json::to_value(&scene.lights)?;
     if let Some(records) = v.as_array_mut() {
         for (json, l) in records.iter_mut().zip(&scene.lights) {
@@ -25,6 +26,11 @@ pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
                 )?;
             }
             let Some(light) = &l.light else { continue };
+            if light.kind == LightType::Dome {
+                let named: Vec<&str> = light.portals.iter().map(|p| p.path.as_str()).collect();
+                json["portals_evaluated"] = serde_json::to_value(&named)?;
+                json["masked"] = (mode == PortalMode::Mask && !named.is_empty()).into();
+            }
             match Reference::new(light, TemperatureMode::default()) {
                 Ok(r) => {
                     json["power"] = serde_json::to_value(r.power())?;
@@ -47,10 +53,5 @@ pub fn lights_json(scene: &Stage) -> serde_json::Result<serde_json::Value> {
 /// A portal's multiplier (DESIGN.md §8 P2): its own LightAPI product `intensity · 2^exposure ·
 /// color ⊙ temperature(T)`, as a light's base radiance is formed.
 pub fn portal_multiplier(p: &Portal, mode: TemperatureMode) -> DVec3 {
-    let tint = if p.enable_color_temperature {
-        temperature_rgb(p.color_temperature, mode)
-    } else {
-        DVec3::ONE
-    };
-    p.intensity * 2f64.powf(p.exposure) * p.color * tint
+    crate::prepare::portal::multiplier(p, mode)
 }

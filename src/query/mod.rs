@@ -15,7 +15,7 @@ use crate::error::{LuxError, Result};
 use crate::gpu::{AdapterSummary, CacheStatus, DeviceLimits, GpuContext, Startup};
 use crate::input::RowKind;
 use crate::model::Light;
-use crate::prepare::TemperatureMode;
+use crate::prepare::{PortalMode, TemperatureMode};
 #[cfg(feature = "usd")]
 mod lights;
 #[cfg(feature = "usd")]
@@ -76,6 +76,8 @@ pub enum Accumulate {
 pub struct Evaluator {
     backend: Backend,
     temperature_mode: TemperatureMode,
+    /// How domes read their portals (DESIGN.md §8 P2).
+    portal_mode: PortalMode,
     /// Relative tolerance of irradiance (None: the reference's 1e-9).
     irradiance_tolerance: Option<f64>,
 }
@@ -86,6 +88,7 @@ impl Evaluator {
         Evaluator {
             backend: Backend::Cpu,
             temperature_mode: TemperatureMode::default(),
+            portal_mode: PortalMode::default(),
             irradiance_tolerance: None,
         }
     }
@@ -96,6 +99,7 @@ impl Evaluator {
         Ok(Evaluator {
             backend: Backend::Gpu(Arc::new(GpuContext::new()?)),
             temperature_mode: TemperatureMode::default(),
+            portal_mode: PortalMode::default(),
             irradiance_tolerance: None,
         })
     }
@@ -116,6 +120,7 @@ impl Evaluator {
                 let eval = Evaluator {
                     backend: Backend::Gpu(Arc::new(ctx)),
                     temperature_mode: TemperatureMode::default(),
+                    portal_mode: PortalMode::default(),
                     irradiance_tolerance: None,
                 };
                 Ok((eval, why))
@@ -138,6 +143,18 @@ impl Evaluator {
 
     pub fn temperature_mode(&self) -> TemperatureMode {
         self.temperature_mode
+    }
+
+    /// How domes read their portals (DESIGN.md §8 P2): [`PortalMode::Hint`] (the default)
+    /// changes no value; [`PortalMode::Mask`] lets a dome that names portals reach a point only
+    /// through them (on every device from the CPU reference).
+    pub fn with_portal_mode(mut self, mode: PortalMode) -> Self {
+        self.portal_mode = mode;
+        self
+    }
+
+    pub fn portal_mode(&self) -> PortalMode {
+        self.portal_mode
     }
 
     /// Computes irradiance to relative tolerance `rel` rather than to the reference's 1e-9
@@ -225,6 +242,7 @@ impl Evaluator {
             self.backend.clone(),
             lights,
             self.temperature_mode,
+            self.portal_mode,
             self.irradiance_tolerance,
         )
     }

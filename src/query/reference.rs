@@ -6,7 +6,7 @@ use glam::DVec3;
 use crate::cpu;
 use crate::error::Result;
 use crate::model::Light;
-use crate::prepare::{Prepared, TemperatureMode};
+use crate::prepare::{PortalMode, Prepared, TemperatureMode};
 
 /// One light, validated and prepared, evaluated in f64 on the CPU.
 #[derive(Clone, Debug)]
@@ -20,6 +20,18 @@ impl Reference {
         Ok(Reference {
             p: Prepared::new(light, mode)?,
         })
+    }
+
+    /// [`Reference::new`] with a dome's portals read as `portal_mode` says (DESIGN.md §8 P2;
+    /// `new` reads them as hints, which change nothing).
+    pub fn with_portal_mode(
+        light: &Light,
+        mode: TemperatureMode,
+        portal_mode: PortalMode,
+    ) -> Result<Self> {
+        let mut p = Prepared::new(light, mode)?;
+        p.apply_portal_mode(portal_mode, mode)?;
+        Ok(Reference { p })
     }
 
     /// How the light is evaluated other than as authored, naming the prim: a zero-size light

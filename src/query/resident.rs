@@ -24,6 +24,7 @@ impl Evaluator {
         Ok(Evaluator {
             backend: Backend::Gpu(std::sync::Arc::new(GpuContext::from_device(device, queue)?)),
             temperature_mode: Default::default(),
+            portal_mode: Default::default(),
             irradiance_tolerance: None,
         })
     }

@@ -524,13 +524,30 @@ impl PreparedScene {
             }
             None => {}
         }
-        Ok(())
+        self.check_sampled()
     }
 
-    /// GPU-resident sampling refuses a scene holding a light every query of which the host
-    /// computes (`GpuPath::Host`: mesh lights, drawn by the CPU reference): the device cannot
-    /// draw its rows. `PreparedScene::sample` samples such a scene on the CPU reference.
+    /// Sampling refuses a dome masked by portals (§8 P2 mask mode; hint mode samples as
+    /// without portals): its lights would be drawn with a density that misses where its light
+    /// comes from.
+    pub(super) fn check_sampled(&self) -> Result<()> {
+        match self.lights.iter().find(|p| p.portals.is_some()) {
+            Some(p) => Err(LuxError::NotSupported {
+                light: p.light.path.clone(),
+                query: "sampling".into(),
+                reason: "a dome masked by its portals (--portal-mode mask) is evaluated but not \
+                         sampled yet; sample with --portal-mode hint or leave it out with --light"
+                    .into(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// GPU-resident sampling refuses a scene holding a light whose rows the CPU reference draws
+    /// (`Prepared::on_host`: mesh lights, through their BVH): the device cannot draw them.
+    /// `PreparedScene::sample` samples such a scene on the CPU reference.
     pub(super) fn check_sampled_on_device(&self) -> Result<()> {
+        self.check_sampled()?;
         match self.lights.iter().find(|p| p.on_host()) {
             Some(p) => Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),

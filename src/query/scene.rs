@@ -10,7 +10,7 @@ use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
 use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, mesh_atlas, record, texture_atlas};
 use crate::model::Light;
-use crate::prepare::{self, Prepared, TemperatureMode};
+use crate::prepare::{self, PortalMode, Prepared, TemperatureMode};
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
 /// uploaded and the input/output buffers of the last size class kept), answering emission,
@@ -56,9 +56,10 @@ impl PreparedScene {
         backend: Backend,
         lights: &[Light],
         mode: TemperatureMode,
+        portal_mode: PortalMode,
         irradiance_tolerance: Option<f64>,
     ) -> Result<Self> {
-        let mut scene = Self::from_prepared(backend, prepare::prepare(lights, mode)?)?;
+        let mut scene = Self::from_prepared(backend, prepare::prepare(lights, mode, portal_mode)?)?;
         if let Some(rel) = irradiance_tolerance {
             scene.rule = Adaptive::for_tolerance(rel);
         }

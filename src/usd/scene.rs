@@ -70,8 +70,9 @@ pub struct StageLight {
         skip_serializing_if = "Option::is_none"
     )]
     pub mesh: Option<MeshLight>,
-    /// A `PortalLight`, read (DESIGN.md §8 P1) with the domes that name it; not evaluated yet.
-    /// Serialized as a summary, absent for other lights.
+    /// A `PortalLight`, read (DESIGN.md §8 P1) with the domes that name it; never a light of
+    /// its own: a dome's [`Light::portals`] carries it (P2). Serialized as a summary, absent for
+    /// other lights.
     #[serde(
         serialize_with = "super::portals::summary",
         skip_serializing_if = "Option::is_none"
@@ -207,20 +208,33 @@ impl Stage {
     /// listed but skipped by the queries (unsupported type or feature, invisible), naming the
     /// prim.
     pub fn warnings(&self) -> Vec<String> {
-        let lights = self
-            .lights
-            .iter()
-            .filter_map(|l| match (&l.light, &l.warning) {
-                (None, Some(w)) => Some(w.clone()),
-                (None, None) => Some(format!("{}: not evaluated", l.path)),
-                (Some(_), _) if !l.visible => Some(format!(
-                    "{}: invisible at {}, skipped",
-                    l.path,
-                    describe_time(self.time)
-                )),
-                _ => None,
-            });
+        self.warnings_in(crate::model::PortalMode::default())
+    }
+
+    /// [`Stage::warnings`] for the queries of `mode`: a portal a dome names says how it is
+    /// evaluated ("guides sampling only (hint mode)", "masks /World/Sky (mask mode)"), DESIGN.md
+    /// §8 P2.
+    pub fn warnings_in(&self, mode: crate::model::PortalMode) -> Vec<String> {
+        let when = describe_time(self.time);
+        let lights = self.lights.iter().filter_map(|l| {
+            super::portals::named_portal_warning(l, mode, &when)
+                .map(Some)
+                .unwrap_or_else(|| Self::light_warning(l, self.time))
+        });
         self.stage_warnings.iter().cloned().chain(lights).collect()
+    }
+
+    fn light_warning(l: &StageLight, time: TimeRule) -> Option<String> {
+        match (&l.light, &l.warning) {
+            (None, Some(w)) => Some(w.clone()),
+            (None, None) => Some(format!("{}: not evaluated", l.path)),
+            (Some(_), _) if !l.visible => Some(format!(
+                "{}: invisible at {}, skipped",
+                l.path,
+                describe_time(time)
+            )),
+            _ => None,
+        }
     }
 
     /// One line saying what the lights a query evaluates (visible, evaluable, `select`ed as
@@ -403,13 +417,6 @@ fn describe_time(rule: TimeRule) -> String {
     }
 }
 
-fn join(first: String, then: Option<String>) -> String {
-    match then {
-        Some(then) => format!("{first}; {then}"),
-        None => first,
-    }
-}
-
 impl StageLight {
     fn from_prim(p: usd::LightPrim, up: UpAxis, max_mesh_triangles: u64) -> StageLight {
         let (mut mesh, mut portal) = (None, None);
@@ -421,10 +428,11 @@ impl StageLight {
                 mesh = Some(m);
                 (Some(light), caveat, None)
             }
+            // What a portal's warning says depends on whether a dome names it (portals::attach)
+            // and on the portal mode (Stage::warnings_in): only its own caveat here.
             Ok((Read::Portal(pl), caveat)) => {
-                let read = format!("{}: portal read, not evaluated yet: skipped", p.path);
                 portal = Some(pl);
-                (None, Some(join(read, caveat)), None)
+                (None, caveat, None)
             }
             Err(NotEvaluated::Skipped(why)) => (None, Some(why), None),
             Err(NotEvaluated::Refused(r)) => (

@@ -1,0 +1,152 @@
+//! Portals from the command line (DESIGN.md §8 P2): `--portal-mode` on the scene commands, the
+//! window fixture (tests/data/usd/portal/window.usda, checked to open with usd-core) evaluated
+//! in both modes against Lambert's formula computed here.
+
+use std::path::Path;
+
+use luxeval_cli::io::npy;
+
+use crate::support::*;
+
+/// Unit-radiance irradiance of a planar polygon wholly above the receiver's horizon, from the
+/// vectors `v` from x to its vertices: `½ |Σ θ_i n·û_i|` (Lambert 1760).
+fn lambert(v: &[[f64; 3]], n: [f64; 3]) -> f64 {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let cross = |a: [f64; 3], b: [f64; 3]| {
+        [
+            a[1] * b[2] - a[2] * b[1],
+            a[2] * b[0] - a[0] * b[2],
+            a[0] * b[1] - a[1] * b[0],
+        ]
+    };
+    let unit = |a: [f64; 3]| {
+        let l = dot(a, a).sqrt();
+        a.map(|c| c / l)
+    };
+    let mut s = 0.0;
+    for i in 0..v.len() {
+        let (a, b) = (unit(v[i]), unit(v[(i + 1) % v.len()]));
+        s += dot(a, b).clamp(-1.0, 1.0).acos() * dot(n, unit(cross(a, b)));
+    }
+    0.5 * s.abs()
+}
+
+fn irradiance(dir: &Path, extra: &[&str], per_light: bool) -> (Vec<u64>, Vec<f32>) {
+    let points = dir.join("p.npy");
+    let normals = dir.join("n.npy");
+    // Receivers at the origin facing the window (+Z) and away from it (−Z); one on the
+    // window's +Z side (z = 4) facing −Z, which the dome does not reach through it.
+    npy::write_f32(&points, &[3, 3], &[[0.0; 3], [0.0; 3], [0.0, 1.0, 4.0]]).unwrap();
+    npy::write_f32(
+        &normals,
+        &[3, 3],
+        &[[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, -1.0]],
+    )
+    .unwrap();
+    let out = dir.join("e.npy");
+    let mut args = vec![
+        "irradiance",
+        "REPLACE",
+        "--points",
+        points.to_str().unwrap(),
+        "--normals",
+        normals.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--device",
+        "cpu",
+    ];
+    let scene = repo_file("tests/data/usd/portal/window.usda");
+    args[1] = &scene;
+    if per_light {
+        args.push("--per-light");
+    }
+    args.extend_from_slice(extra);
+    let o = luxeval(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    read_npy_f32(&out)
+}
+
+/// `--portal-mode mask` changes the irradiance of a stage with a window portal: the dome's 2
+/// nits times the window's multiplier 0.5 times Lambert's formula of the 2 × 1 window at
+/// z = 3 (centre (0, 1)), 0 facing away and from the window's +Z side; hint mode (the default)
+/// is the unmasked dome, π · 2. The dome also names an invisible 10 × 10 portal in front of the
+/// window with multiplier 100: ignored, as if not named (P1). Portals are never rows of
+/// `--per-light`.
+#[test]
+fn portal_mode_mask_changes_irradiance_through_a_window() {
+    let dir = tempfile::tempdir().unwrap();
+    let (shape, hint) = irradiance(dir.path(), &[], false);
+    assert_eq!(shape, vec![3, 3]);
+    // π L for a uniform dome of L = 2 on a receiver facing up.
+    let pi_l = (std::f64::consts::PI * 2.0) as f32;
+    assert_eq!(&hint[0..3], &[pi_l; 3]);
+    let (_, explicit) = irradiance(dir.path(), &["--portal-mode", "hint"], false);
+    assert_eq!(explicit, hint);
+
+    let (shape, mask) = irradiance(dir.path(), &["--portal-mode", "mask"], false);
+    assert_eq!(shape, vec![3, 3]);
+    let window = [
+        [-1.0, 0.5, 3.0],
+        [1.0, 0.5, 3.0],
+        [1.0, 1.5, 3.0],
+        [-1.0, 1.5, 3.0],
+    ];
+    let want = 2.0 * 0.5 * lambert(&window, [0.0, 0.0, 1.0]);
+    for &c in &mask[0..3] {
+        let got = c as f64;
+        assert!((got - want).abs() <= 1e-6 * want, "{got} vs {want}");
+    }
+    assert_eq!(&mask[3..9], &[0.0; 6]);
+    assert_ne!(mask, hint);
+
+    // One dome, one row block: the portals are not lights of their own.
+    let (shape, per_light) = irradiance(dir.path(), &["--portal-mode", "mask"], true);
+    assert_eq!(shape, vec![1, 3, 3]);
+    assert_eq!(per_light, mask);
+}
+
+/// Every scene command takes `--portal-mode` (DESIGN.md §4), and sampling refuses a masked
+/// dome, naming it, rather than draw with a density that misses the portals.
+#[test]
+fn every_scene_command_takes_portal_mode() {
+    for cmd in [
+        "emission",
+        "radiance",
+        "irradiance",
+        "intensity",
+        "falloff",
+        "check",
+        "lights",
+        "sample",
+        "pdf",
+    ] {
+        let o = luxeval(&[cmd, "--help"]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains("--portal-mode"), "{cmd}: {text}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let points = dir.path().join("p.npy");
+    npy::write_f32(&points, &[1, 3], &[[0.0; 3]]).unwrap();
+    let scene = repo_file("tests/data/usd/portal/window.usda");
+    let out = dir.path().join("s.npz");
+    let o = luxeval(&[
+        "sample",
+        &scene,
+        "--points",
+        points.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--device",
+        "cpu",
+        "--portal-mode",
+        "mask",
+    ]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("/World/Sky") && err.contains("portal"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}
