@@ -464,12 +464,17 @@ fn scene_lights_and_warnings() {
 
     let evaluable = scene.evaluable(&[]).unwrap();
     let paths: Vec<&str> = evaluable.iter().map(|l| l.path.as_str()).collect();
+    // A Mesh with MeshLightAPI is a light the queries evaluate (DESIGN.md §7).
+    let mesh = evaluable.iter().find(|l| l.path == "/World/Defaults/MeshLight");
+    assert!(
+        mesh.is_some_and(|l| l.kind.usd_type() == "Mesh"),
+        "{paths:?}"
+    );
     for skipped in [
         "/World/Hidden/HiddenByParent",
         "/World/HiddenSelf",
         "/World/Blink", // invisible at 0, visible from 2
         "/World/Defaults/Portal",
-        "/World/Defaults/MeshLight",
     ] {
         assert!(!paths.contains(&skipped), "{skipped} evaluated");
         assert!(
