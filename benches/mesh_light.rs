@@ -1,7 +1,8 @@
 //! Criterion benchmarks of a mesh light (DESIGN.md §7) on the CPU reference, at the sizes of
 //! issue "Mesh lights and portals": preparing a 100,000-triangle mesh light (its BVH included),
-//! the radiance of 1,000,000 rays against it, and its exact self-occluded irradiance at one
-//! receiver. `cargo bench --ignore-rust-version --features testkit --bench mesh_light`.
+//! the radiance of 1,000,000 rays against it (and on a GPU evaluator, where one opens), and its
+//! exact self-occluded irradiance at one receiver.
+//! `cargo bench --ignore-rust-version --features testkit --bench mesh_light`.
 //!
 //! The mesh is a bumpy torus (250 × 200 quads, fronts outward): non-convex, so rays and
 //! receivers meet self-occlusion.
@@ -80,6 +81,17 @@ fn mesh_light(c: &mut Criterion) {
                 .expect("radiance")
         })
     });
+    // The same rays on a GPU evaluator, where there is one (the kernel traverses the BVH on
+    // the device: GpuPath::RadianceOnDevice); Mesa's lavapipe proves it runs, not its speed.
+    match Evaluator::gpu() {
+        Ok(g) => {
+            let dev = g.prepare(std::slice::from_ref(&light)).expect("prepare on the GPU");
+            group.bench_function("radiance 1M rays on the GPU", |b| {
+                b.iter(|| dev.radiance(&points, &dirs, Accumulate::Sum).expect("radiance"))
+            });
+        }
+        Err(e) => eprintln!("no GPU adapter ({e}): the GPU radiance is not measured"),
+    }
     group.throughput(Throughput::Elements(1));
     // A receiver inside the ring, above the torus' plane, facing down into it.
     let x = [[0.5f32, 1.0, 0.3]];
