@@ -72,15 +72,16 @@ impl Portal {
     /// A `width × height` portal at the origin (light passing toward −Z) with the LightAPI
     /// fallbacks for its multiplier (1), named by no dome yet.
     pub fn new(width: f64, height: f64) -> Self {
+        use super::schema::light_api as f;
         Portal {
             path: "<PortalLight>".into(),
             width,
             height,
-            intensity: 1.0,
-            exposure: 0.0,
-            color: DVec3::ONE,
-            enable_color_temperature: false,
-            color_temperature: 6500.0,
+            intensity: f::INTENSITY,
+            exposure: f::EXPOSURE,
+            color: DVec3::from_array(f::COLOR),
+            enable_color_temperature: f::ENABLE_COLOR_TEMPERATURE,
+            color_temperature: f::COLOR_TEMPERATURE,
             world: DMat4::IDENTITY,
             domes: Vec::new(),
         }
