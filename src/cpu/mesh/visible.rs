@@ -60,11 +60,13 @@
 
 mod clip;
 #[cfg(test)]
+mod old;
+#[cfg(test)]
 mod tests;
 
 use crate::cpu::irradiance::closed::polygon_irradiance;
 use crate::model::MeshTriangle;
-use clip::{Line, Poly, Side};
+use clip::{Line, Pieces, Poly, Scratch, Side, Small};
 use glam::{DVec2, DVec3};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -125,7 +127,13 @@ impl Surface<'_> {
     #[allow(dead_code)]
     pub(crate) fn visible_from(&self, x: DVec3) -> Vec<Piece> {
         let mut out = Vec::new();
-        self.pieces_from(x, |_| true, |_| true, |piece| out.push(piece));
+        self.pieces_from(x, |_| true, |_| true, |triangle, emitting, verts| {
+            out.push(Piece {
+                triangle,
+                emitting,
+                verts: verts.to_vec(),
+            })
+        });
         out
     }
 
@@ -135,9 +143,13 @@ impl Surface<'_> {
     pub(crate) fn emitting_above(&self, x: DVec3, n: DVec3) -> Vec<Piece> {
         let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
         let mut out = Vec::new();
-        self.pieces_from(x, |s| s.emitting && above(s), above, |piece| {
-            if piece.emitting {
-                out.push(piece)
+        self.pieces_from(x, |s| s.emitting && above(s), above, |triangle, emitting, verts| {
+            if emitting {
+                out.push(Piece {
+                    triangle,
+                    emitting,
+                    verts: verts.to_vec(),
+                })
             }
         });
         out
@@ -154,9 +166,10 @@ impl Surface<'_> {
         let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
         let wanted = |s: &Seen| s.emitting && above(s);
         // A triangle wholly below the horizon hides only directions below it: left out.
-        self.pieces_from(x, wanted, above, |piece| {
-            if piece.emitting {
-                sum += lambert(&piece.verts, n);
+        let mut buf = Vec::new();
+        self.pieces_from(x, wanted, above, |_, emitting, verts| {
+            if emitting {
+                sum += lambert(verts, n, &mut buf);
             }
         });
         sum
@@ -189,10 +202,10 @@ impl Surface<'_> {
                 continue;
             }
             let emitting = if self.double_sided { true } else { nw > 0.0 };
-            let poly: Poly =
-                t.p.iter()
-                    .map(|&p| DVec2::new((p - o).dot(a), (p - o).dot(b)))
-                    .collect();
+            let mut poly = Poly::default();
+            for &p in &t.p {
+                poly.add(DVec2::new((p - o).dot(a), (p - o).dot(b)));
+            }
             // Height over (u, v): s = (n·(p0 − o) − u n·a − v n·b) / (n·w).
             let z = DVec3::new(-nhat.dot(a), -nhat.dot(b), nhat.dot(t.p[0] - o)) / nw;
             if let Some(p) = Proj::new(i as u32, emitting, emitting, poly, z) {
@@ -207,20 +220,22 @@ impl Surface<'_> {
         area
     }
 
-    /// Calls `sink` with every visible piece seen from x of the triangles `wanted` accepts;
-    /// the triangles `occludes` accepts hide them (a wanted triangle must be one).
+    /// Calls `sink` with every visible piece seen from x of the triangles `wanted` accepts
+    /// (its triangle, whether the side seen emits, and its vertices as vectors from x); the
+    /// triangles `occludes` accepts hide them (a wanted triangle must be one).
     fn pieces_from(
         &self,
         x: DVec3,
         wanted: impl Fn(&Seen) -> bool,
         occludes: impl Fn(&Seen) -> bool,
-        mut sink: impl FnMut(Piece),
+        mut sink: impl FnMut(u32, bool, &[DVec3]),
     ) {
         let seen: Vec<Option<Seen>> = self
             .triangles
             .iter()
             .map(|t| self.seen(t, x).filter(&occludes))
             .collect();
+        let mut verts: Vec<DVec3> = Vec::new();
         for [e, a, b] in FACES {
             // The pyramid's four planes through x, inside where m·w ≥ 0.
             let planes = [e - a, e + a, e - b, e + b];
@@ -231,7 +246,10 @@ impl Surface<'_> {
                     continue;
                 }
                 // Each vertex carries the set of pyramid planes it was cut on (see clip3).
-                let mut w3: Vec<(DVec3, u8)> = s.q.iter().map(|&q| (q, 0)).collect();
+                let mut w3 = Clip3::default();
+                for &q in &s.q {
+                    w3.add((q, 0));
+                }
                 for (bit, m) in planes.iter().enumerate() {
                     w3 = clip3(&w3, *m, 1 << bit);
                     if w3.len() < 3 {
@@ -251,21 +269,19 @@ impl Surface<'_> {
                 // square inside the triangle is then reached by cutting segments between far
                 // vertices, whose rounding (relative to their length) is large relative to
                 // the corner's distance; the corner itself is known exactly.
-                let poly: Poly = w3
-                    .iter()
-                    .map(|&(w, cut)| {
-                        let mut uv = DVec2::new(w.dot(a), w.dot(b)) / w.dot(e);
-                        for (bit, (axis, value)) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)]
-                            .into_iter()
-                            .enumerate()
-                        {
-                            if cut & (1 << bit) != 0 {
-                                uv[axis] = value;
-                            }
+                let mut poly = Poly::default();
+                for &(w, cut) in w3.iter() {
+                    let mut uv = DVec2::new(w.dot(a), w.dot(b)) / w.dot(e);
+                    for (bit, (axis, value)) in [(0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)]
+                        .into_iter()
+                        .enumerate()
+                    {
+                        if cut & (1 << bit) != 0 {
+                            uv[axis] = value;
                         }
-                        uv
-                    })
-                    .collect();
+                    }
+                    poly.add(uv);
+                }
                 // Inverse depth h = n·(e + u a + v b) / c.
                 let z = DVec3::new(s.n.dot(a), s.n.dot(b), s.n.dot(e)) / s.c;
                 if let Some(p) = Proj::new(i as u32, s.emitting, wanted(s), poly, z) {
@@ -274,22 +290,16 @@ impl Surface<'_> {
             }
             let view = View::new(polys, 0.0);
             view.visible(|p, pieces| {
-                for piece in pieces {
-                    let verts = piece
-                        .iter()
-                        .map(|uv| {
-                            let w = e + uv.x * a + uv.y * b;
-                            let h = p.depth(*uv);
-                            // h > 0 inside the triangle's projection; the guard is for rounding
-                            // only (the direction is what Lambert's formula needs).
-                            if h > 0.0 { w / h } else { w }
-                        })
-                        .collect();
-                    sink(Piece {
-                        triangle: p.tri,
-                        emitting: p.emitting,
-                        verts,
-                    });
+                for piece in pieces.iter() {
+                    verts.clear();
+                    verts.extend(piece.iter().map(|uv| {
+                        let w = e + uv.x * a + uv.y * b;
+                        let h = p.depth(*uv);
+                        // h > 0 inside the triangle's projection; the guard is for rounding
+                        // only (the direction is what Lambert's formula needs).
+                        if h > 0.0 { w / h } else { w }
+                    }));
+                    sink(p.tri, p.emitting, &verts);
                 }
             });
         }
@@ -319,7 +329,7 @@ struct Proj {
     /// Whether its visible part is asked for (all projected triangles occlude).
     wanted: bool,
     poly: Poly,
-    lines: Vec<Line>,
+    lines: Small<Line, 8>,
     /// Nearness z(u, v) = z.x u + z.y v + z.z, larger nearer the viewer.
     z: DVec3,
     /// max |z| over the polygon: the scale of its depth ties.
@@ -331,7 +341,16 @@ struct Proj {
 impl Proj {
     /// None when the polygon is degenerate (no area) or not finite.
     fn new(tri: u32, emitting: bool, wanted: bool, mut poly: Poly, z: DVec3) -> Option<Proj> {
-        poly.dedup();
+        // Repeated vertices out (Vec::dedup), then a last one equal to the first.
+        let mut m = 0;
+        let v = poly.as_mut_slice();
+        for k in 0..v.len() {
+            if m == 0 || v[k] != v[m - 1] {
+                v[m] = v[k];
+                m += 1;
+            }
+        }
+        poly.retain_first(m);
         while poly.len() > 1 && poly[0] == poly[poly.len() - 1] {
             poly.pop();
         }
@@ -340,7 +359,7 @@ impl Proj {
             return None;
         }
         if a2 < 0.0 {
-            poly.reverse();
+            poly.as_mut_slice().reverse();
         }
         let lines = clip::edge_lines(&poly);
         let (lo, hi) = clip::bounds(&poly);
@@ -369,7 +388,7 @@ enum Hider {
     /// All of proj(j) (its polygon and edge lines are the [`Proj`]'s).
     Whole,
     /// The part of proj(j) nearer than i, and its edge lines.
-    Part(Poly, Vec<Line>),
+    Part(Poly, Small<Line, 8>),
 }
 
 /// The projected triangles of one chart.
@@ -380,9 +399,10 @@ struct View {
     tiny: f64,
     /// A floor under the depth scale of ties (the orthographic heights can all be near zero).
     zfloor: f64,
-    /// The candidate grid: cells of the chart's bounding box, each listing the polygons whose
-    /// boxes meet it.
-    grid: Vec<Vec<u32>>,
+    /// The candidate grid: cells of the chart's bounding box, cell c listing the polygons
+    /// whose boxes meet it in `members[start[c]..start[c + 1]]`.
+    start: Vec<u32>,
+    members: Vec<u32>,
     g: usize,
     glo: DVec2,
     cell: DVec2,
@@ -408,85 +428,139 @@ impl View {
             tol,
             tiny: tol * tol,
             zfloor,
-            grid: vec![Vec::new(); g * g],
+            start: vec![0; g * g + 1],
+            members: Vec::new(),
             g,
             glo,
             cell,
         };
-        for (k, p) in view.polys.iter().enumerate() {
-            let ((x0, y0), (x1, y1)) = view.cells(p);
+        // Counting sort of (cell, polygon) pairs: counts, prefix sums, then the members.
+        for p in &view.polys {
+            let ((x0, y0), (x1, y1)) = view.cells(p.lo, p.hi);
             for y in y0..=y1 {
                 for x in x0..=x1 {
-                    view.grid[y * g + x].push(k as u32);
+                    view.start[y * g + x + 1] += 1;
+                }
+            }
+        }
+        for c in 0..g * g {
+            view.start[c + 1] += view.start[c];
+        }
+        let mut fill: Vec<u32> = view.start[..g * g].to_vec();
+        view.members = vec![0; view.start[g * g] as usize];
+        for (k, p) in view.polys.iter().enumerate() {
+            let ((x0, y0), (x1, y1)) = view.cells(p.lo, p.hi);
+            for y in y0..=y1 {
+                for x in x0..=x1 {
+                    let f = &mut fill[y * g + x];
+                    view.members[*f as usize] = k as u32;
+                    *f += 1;
                 }
             }
         }
         view
     }
 
-    /// The cell range a polygon's box covers (widened by the tolerance).
-    fn cells(&self, p: &Proj) -> ((usize, usize), (usize, usize)) {
-        let c = |v: DVec2| {
-            let r = ((v - self.glo) / self.cell).floor();
-            let clamp = |f: f64| (f.max(0.0) as usize).min(self.g - 1);
-            (clamp(r.x), clamp(r.y))
-        };
-        (c(p.lo - self.tol), c(p.hi + self.tol))
+    /// The cell of a point (clamped to the grid).
+    fn cell_of(&self, v: DVec2) -> (usize, usize) {
+        // Truncation is the floor on the non-negative values kept (and NaN goes to 0).
+        let r = (v - self.glo) / self.cell;
+        let clamp = |f: f64| (f.max(0.0) as usize).min(self.g - 1);
+        (clamp(r.x), clamp(r.y))
+    }
+
+    /// The cell range a box covers (widened by the tolerance).
+    fn cells(&self, lo: DVec2, hi: DVec2) -> ((usize, usize), (usize, usize)) {
+        (self.cell_of(lo - self.tol), self.cell_of(hi + self.tol))
+    }
+
+    /// The depth tolerance of ties between i and j.
+    fn ztol(&self, i: &Proj, j: &Proj) -> f64 {
+        DEPTH_TOL * (i.zmax + j.zmax + self.zfloor)
     }
 
     /// The part of j that may hide i: proj(j) ∩ {j nearer than i}, or None.
     fn hider(&self, i: &Proj, j: &Proj) -> Option<Hider> {
-        let d: Vec<f64> = j.poly.iter().map(|&q| j.depth(q) - i.depth(q)).collect();
-        let tol = DEPTH_TOL * (i.zmax + j.zmax + self.zfloor);
+        let mut d = [0.0; 8];
+        for (d, &q) in d.iter_mut().zip(j.poly.iter()) {
+            *d = j.depth(q) - i.depth(q);
+        }
+        let d = &d[..j.poly.len()];
+        let tol = self.ztol(i, j);
         if d.iter().all(|v| v.abs() <= tol) {
             // Coplanar: the first in the slice is nearer (DESIGN.md M1).
             return (j.tri < i.tri).then_some(Hider::Whole);
         }
-        match clip::split(&j.poly, &d, tol) {
+        let mut nearer = Poly::default();
+        match clip::split(&j.poly, d, tol, &mut nearer, &mut clip::Drop) {
             Side::Inside => Some(Hider::Whole),
             Side::Outside => None,
-            Side::Split(nearer, _) => {
+            Side::Split => {
                 let lines = clip::edge_lines(&nearer);
                 Some(Hider::Part(nearer, lines))
             }
         }
     }
 
+    /// Whether j is farther than i (by more than twice their tie tolerance) all over the box
+    /// where their boxes (widened by the length tolerance) meet: then no part of j nearer than
+    /// i, even up to the tolerance, meets proj(i), and j hides nothing of it. The depth
+    /// difference is affine, so its largest value over the box is at a corner.
+    fn behind(&self, i: &Proj, j: &Proj) -> bool {
+        let lo = i.lo.max(j.lo) - self.tol;
+        let hi = i.hi.min(j.hi) + self.tol;
+        let dz = j.z - i.z;
+        let top = dz.z + (dz.x * lo.x).max(dz.x * hi.x) + (dz.y * lo.y).max(dz.y * hi.y);
+        top < -2.0 * self.ztol(i, j)
+    }
+
     /// Calls `sink` with each wanted polygon and its visible pieces (none when it is hidden).
-    fn visible(&self, mut sink: impl FnMut(&Proj, &[Poly])) {
-        let mut stamp = vec![usize::MAX; self.polys.len()];
-        let mut cand: Vec<(f64, usize)> = Vec::new();
-        let mut next: Vec<Poly> = Vec::new();
+    fn visible(&self, mut sink: impl FnMut(&Proj, &Pieces)) {
+        let mut cand: Vec<(f64, u32)> = Vec::new();
+        let mut stamp = vec![u32::MAX; self.polys.len()];
+        let mut pieces = Pieces::default();
+        let mut next = Pieces::default();
+        let mut scratch = Scratch::default();
         for (i, pi) in self.polys.iter().enumerate() {
             if !pi.wanted {
                 continue;
             }
             cand.clear();
-            let ((x0, y0), (x1, y1)) = self.cells(pi);
+            let (ilo, ihi) = (pi.lo - self.tol, pi.hi + self.tol);
+            let ((x0, y0), (x1, y1)) = self.cells(pi.lo, pi.hi);
             let centre = pi.poly.iter().copied().sum::<DVec2>() / pi.poly.len() as f64;
             for y in y0..=y1 {
                 for x in x0..=x1 {
-                    for &k in &self.grid[y * self.g + x] {
-                        let k = k as usize;
-                        if k == i || stamp[k] == i {
+                    let c = y * self.g + x;
+                    for &k in &self.members[self.start[c] as usize..self.start[c + 1] as usize] {
+                        let pk = &self.polys[k as usize];
+                        if k as usize == i || !(pk.lo.cmple(ihi).all() && pk.hi.cmpge(ilo).all())
+                        {
                             continue;
                         }
-                        stamp[k] = i;
-                        let pk = &self.polys[k];
-                        if pk.lo.cmple(pi.hi + self.tol).all()
-                            && pk.hi.cmpge(pi.lo - self.tol).all()
-                        {
-                            cand.push((pk.depth(centre), k));
+                        if stamp[k as usize] == i as u32 {
+                            continue;
                         }
+                        stamp[k as usize] = i as u32;
+                        if self.behind(pi, pk) {
+                            continue;
+                        }
+                        cand.push((pk.depth(centre), k));
                     }
                 }
             }
             // Nearest first: the big occluders in front usually hide the most, so the pieces
             // disappear before they fragment. The order changes nothing in the result.
-            cand.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let mut pieces: Vec<Poly> = vec![pi.poly.clone()];
+            cand.sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+            pieces.clear();
+            pieces.push(&pi.poly);
+            let (mut plo, mut phi) = (pi.lo, pi.hi);
             for &(_, k) in &cand {
-                let pk = &self.polys[k];
+                let pk = &self.polys[k as usize];
+                // Nothing left where pk is.
+                if !(pk.lo.cmple(phi + self.tol).all() && pk.hi.cmpge(plo - self.tol).all()) {
+                    continue;
+                }
                 let Some(hider) = self.hider(pi, pk) else {
                     continue;
                 };
@@ -496,14 +570,21 @@ impl View {
                 };
                 let (hlo, hhi) = clip::bounds(hider);
                 next.clear();
-                for piece in pieces.drain(..) {
+                for n in 0..pieces.len() {
                     // Cheapest rejections first: boxes, then the hider's edges (no allocation),
                     // then the piece's own edges.
-                    let (plo, phi) = clip::bounds(&piece);
+                    let (piece, lo, hi) = pieces.get(n);
                     let boxes_meet =
-                        plo.cmple(hhi + self.tol).all() && phi.cmpge(hlo - self.tol).all();
-                    if boxes_meet && clip::overlap(&piece, hider, hider_lines, self.tol) {
-                        clip::subtract(piece, hider_lines, self.tol, self.tiny, &mut next);
+                        lo.cmple(hhi + self.tol).all() && hi.cmpge(hlo - self.tol).all();
+                    if boxes_meet && clip::overlap(piece, hider, hider_lines, self.tol) {
+                        clip::subtract(
+                            piece,
+                            hider_lines,
+                            self.tol,
+                            self.tiny,
+                            &mut next,
+                            &mut scratch,
+                        );
                     } else {
                         next.push(piece);
                     }
@@ -512,6 +593,7 @@ impl View {
                 if pieces.is_empty() {
                     break;
                 }
+                (plo, phi) = pieces.bounds();
             }
             if !pieces.is_empty() {
                 sink(pi, &pieces);
@@ -520,28 +602,36 @@ impl View {
     }
 }
 
+/// At most 7 vertices (a triangle clipped by four planes), each with its set of planes.
+type Clip3 = Small<(DVec3, u8), 8>;
+
 /// Sutherland–Hodgman against one plane through the origin: the part of the convex polygon
 /// where m·w ≥ 0. Each vertex carries a set of planes (bits): a vertex made on this plane gets
 /// `bit` and the planes its segment's two ends share (the planes the segment lies in).
-fn clip3(p: &[(DVec3, u8)], m: DVec3, bit: u8) -> Vec<(DVec3, u8)> {
-    let mut out = Vec::with_capacity(p.len() + 1);
+fn clip3(p: &[(DVec3, u8)], m: DVec3, bit: u8) -> Clip3 {
+    let mut out = Clip3::default();
+    clip3_into(p, m, bit, |v| out.add(v));
+    out
+}
+
+/// [`clip3`] for any number of vertices, each vertex of the result given to `out` in order.
+fn clip3_into(p: &[(DVec3, u8)], m: DVec3, bit: u8, mut out: impl FnMut((DVec3, u8))) {
     for k in 0..p.len() {
         let ((a, ma), (b, mb)) = (p[k], p[(k + 1) % p.len()]);
         let (da, db) = (m.dot(a), m.dot(b));
         if da >= 0.0 {
-            out.push((a, ma));
+            out((a, ma));
         }
         if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
-            out.push((a + (b - a) * (da / (da - db)), (ma & mb) | bit));
+            out((a + (b - a) * (da / (da - db)), (ma & mb) | bit));
         }
     }
-    out
 }
 
 /// [`polygon_irradiance`] with the vertex list rotated so that its orientation test (the sign
 /// of the first corner's turn against q0) is made at the sharpest corner: a piece can have a
 /// corner that is nearly straight (a cut through a vertex), where that sign is rounding.
-fn lambert(q: &[DVec3], n: DVec3) -> f64 {
+fn lambert(q: &[DVec3], n: DVec3, buf: &mut Vec<DVec3>) -> f64 {
     let m = q.len();
     if m < 3 {
         return 0.0;
@@ -556,8 +646,9 @@ fn lambert(q: &[DVec3], n: DVec3) -> f64 {
     if best == 0 {
         return polygon_irradiance(q, n);
     }
-    let rotated: Vec<DVec3> = q[best..].iter().chain(&q[..best]).copied().collect();
-    polygon_irradiance(&rotated, n)
+    buf.clear();
+    buf.extend(q[best..].iter().chain(&q[..best]));
+    polygon_irradiance(buf, n)
 }
 
 /// One cell of [`integrate_piece`]: a spherical triangle (unit vertices), its four children's
@@ -642,10 +733,8 @@ pub(crate) fn integrate_piece(
     /// A bound on the work: cells (each 28 evaluations of f when made).
     const MAX_CELLS: usize = 20_000;
     let poly: Vec<(DVec3, u8)> = verts.iter().map(|&q| (q, 0)).collect();
-    let units: Vec<DVec3> = clip3(&poly, n, 0)
-        .iter()
-        .filter_map(|(q, _)| q.try_normalize())
-        .collect();
+    let mut units: Vec<DVec3> = Vec::new();
+    clip3_into(&poly, n, 0, |(q, _)| units.extend(q.try_normalize()));
     if units.len() < 3 {
         return DVec3::ZERO;
     }

@@ -1217,3 +1217,78 @@ fn timing_ring_of_2000_triangles() {
     );
     assert!(a.is_finite());
 }
+
+/// The bench's bumpy torus (benches/mesh_light.rs): `around × across` quads, each fanned
+/// (a, b, c), (a, c, d).
+fn bumpy_torus(around: usize, across: usize) -> Vec<MeshTriangle> {
+    use std::f64::consts::TAU;
+    let p = |i: usize, j: usize| {
+        let a = TAU * (i % around) as f64 / around as f64;
+        let b = TAU * (j % across) as f64 / across as f64;
+        let tube = 0.5 * (1.0 + 0.05 * (7.0 * a).sin());
+        let rho = 2.0 + tube * b.cos();
+        v(rho * a.cos(), tube * b.sin(), rho * a.sin())
+    };
+    let mut out = Vec::with_capacity(2 * around * across);
+    for i in 0..around {
+        for j in 0..across {
+            quad(&mut out, p(i, j), p(i, j + 1), p(i + 1, j + 1), p(i + 1, j));
+        }
+    }
+    out
+}
+
+/// Old (the module before the performance work, `old.rs`) against new, alternating in one run,
+/// on the bench's 100k-triangle torus: irradiance at the bench's receiver, projected area, and
+/// many receivers in parallel (rayon) on a 2,000-triangle ring. Prints the times and asserts
+/// the results agree. `cargo test --release ... timing_old_against_new -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timing_old_against_new() {
+    use rayon::prelude::*;
+    let reps: usize = std::env::var("TIMING_REPS").ok().and_then(|s| s.parse().ok()).unwrap_or(5);
+    let t = bumpy_torus(250, 200);
+    assert_eq!(t.len(), 100_000);
+    let new = Surface { triangles: &t, double_sided: false };
+    let old = old::Surface { triangles: &t, double_sided: false };
+    let (x, n) = (v(0.5, 1.0, 0.3), DVec3::NEG_Y);
+    let w = v(0.3, 0.8, 0.5);
+    let time = |f: &mut dyn FnMut() -> f64| {
+        let start = Instant::now();
+        let r = f();
+        (start.elapsed().as_secs_f64() * 1e3, r)
+    };
+    let ring = ring(125, 8, 1.0, 0.3);
+    let rnew = Surface { triangles: &ring, double_sided: false };
+    let rold = old::Surface { triangles: &ring, double_sided: false };
+    let receivers: Vec<(DVec3, DVec3)> = (0..256)
+        .map(|k| {
+            let (i, j) = ((k % 16) as f64, (k / 16) as f64);
+            (v(-1.6 + 0.2 * i, -1.6 + 0.2 * j, 0.5), DVec3::NEG_Z)
+        })
+        .collect();
+    let mut best = [f64::INFINITY; 6];
+    let mut sums = [0.0; 6];
+    for _ in 0..reps {
+        let r = [
+            time(&mut || old.cosine_solid_angle(x, n)),
+            time(&mut || new.cosine_solid_angle(x, n)),
+            time(&mut || old.projected_area(w)),
+            time(&mut || new.projected_area(w)),
+            time(&mut || receivers.par_iter().map(|&(x, n)| rold.cosine_solid_angle(x, n)).sum()),
+            time(&mut || receivers.par_iter().map(|&(x, n)| rnew.cosine_solid_angle(x, n)).sum()),
+        ];
+        for (k, (ms, v)) in r.into_iter().enumerate() {
+            best[k] = best[k].min(ms);
+            sums[k] = v;
+        }
+    }
+    println!(
+        "100k torus irradiance: old {:.1} ms new {:.1} ms (×{:.2}); projected_area: old {:.1} ms new {:.1} ms (×{:.2}); 256 receivers on 2000-ring in parallel: old {:.1} ms new {:.1} ms (×{:.2})",
+        best[0], best[1], best[0] / best[1], best[2], best[3], best[2] / best[3], best[4], best[5], best[4] / best[5]
+    );
+    println!("values: {:.15} {:.15} | {:.15} {:.15} | {:.15} {:.15}", sums[0], sums[1], sums[2], sums[3], sums[4], sums[5]);
+    for k in [0, 2, 4] {
+        assert!(rel(sums[k], sums[k + 1]) < 1e-12, "{} vs {}", sums[k], sums[k + 1]);
+    }
+}
