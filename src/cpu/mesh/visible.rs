@@ -68,6 +68,7 @@ use crate::cpu::irradiance::closed::polygon_irradiance;
 use crate::model::MeshTriangle;
 use clip::{Line, Pieces, Poly, Scratch, Side, Small};
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
@@ -127,13 +128,19 @@ impl Surface<'_> {
     #[allow(dead_code)]
     pub(crate) fn visible_from(&self, x: DVec3) -> Vec<Piece> {
         let mut out = Vec::new();
-        self.pieces_from(x, |_| true, |_| true, |triangle, emitting, verts| {
-            out.push(Piece {
-                triangle,
-                emitting,
-                verts: verts.to_vec(),
-            })
-        });
+        self.pieces_from(
+            x,
+            |_| true,
+            |_| true,
+            |triangle, emitting, verts, _, out| {
+                out.push(Piece {
+                    triangle,
+                    emitting,
+                    verts: verts.to_vec(),
+                })
+            },
+            |piece| out.push(piece),
+        );
         out
     }
 
@@ -143,15 +150,21 @@ impl Surface<'_> {
     pub(crate) fn emitting_above(&self, x: DVec3, n: DVec3) -> Vec<Piece> {
         let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
         let mut out = Vec::new();
-        self.pieces_from(x, |s| s.emitting && above(s), above, |triangle, emitting, verts| {
-            if emitting {
-                out.push(Piece {
-                    triangle,
-                    emitting,
-                    verts: verts.to_vec(),
-                })
-            }
-        });
+        self.pieces_from(
+            x,
+            |s| s.emitting && above(s),
+            above,
+            |triangle, emitting, verts, _, out| {
+                if emitting {
+                    out.push(Piece {
+                        triangle,
+                        emitting,
+                        verts: verts.to_vec(),
+                    })
+                }
+            },
+            |piece| out.push(piece),
+        );
         out
     }
 
@@ -166,12 +179,17 @@ impl Surface<'_> {
         let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
         let wanted = |s: &Seen| s.emitting && above(s);
         // A triangle wholly below the horizon hides only directions below it: left out.
-        let mut buf = Vec::new();
-        self.pieces_from(x, wanted, above, |_, emitting, verts| {
-            if emitting {
-                sum += lambert(verts, n, &mut buf);
-            }
-        });
+        self.pieces_from(
+            x,
+            wanted,
+            above,
+            |_, emitting, verts, buf, out| {
+                if emitting {
+                    out.push(lambert(verts, n, buf))
+                }
+            },
+            |l| sum += l,
+        );
         sum
     }
 
@@ -214,43 +232,59 @@ impl Surface<'_> {
         }
         let view = View::new(polys, extent);
         let mut area = 0.0;
-        view.visible(|_, pieces| {
-            area += pieces.iter().map(|p| 0.5 * clip::area2(p)).sum::<f64>();
-        });
+        for a in view.visible(|_, pieces, _, out| {
+            out.push(pieces.iter().map(|p| 0.5 * clip::area2(p)).sum::<f64>())
+        }) {
+            area += a;
+        }
         area
     }
 
-    /// Calls `sink` with every visible piece seen from x of the triangles `wanted` accepts
-    /// (its triangle, whether the side seen emits, and its vertices as vectors from x); the
-    /// triangles `occludes` accepts hide them (a wanted triangle must be one).
-    fn pieces_from(
+    /// Calls `map` with every visible piece seen from x of the triangles `wanted` accepts (its
+    /// triangle, whether the side seen emits, its vertices as vectors from x, and a buffer),
+    /// in parallel, and `sink` with what it appended to its output, in order; the triangles
+    /// `occludes` accepts hide them (a wanted triangle must be one).
+    fn pieces_from<R: Send>(
         &self,
         x: DVec3,
         wanted: impl Fn(&Seen) -> bool,
         occludes: impl Fn(&Seen) -> bool,
-        mut sink: impl FnMut(u32, bool, &[DVec3]),
+        map: impl Fn(u32, bool, &[DVec3], &mut Vec<DVec3>, &mut Vec<R>) + Sync,
+        mut sink: impl FnMut(R),
     ) {
         let seen: Vec<Option<Seen>> = self
             .triangles
             .iter()
             .map(|t| self.seen(t, x).filter(&occludes))
             .collect();
-        let mut verts: Vec<DVec3> = Vec::new();
+        // One buffer of projected triangles for the six charts, sized for the fullest: a
+        // Proj is large (its polygon and lines in place), and growing it would copy them.
+        let mut polys = Vec::new();
+        let mut inside: Vec<u32> = Vec::new();
         for [e, a, b] in FACES {
             // The pyramid's four planes through x, inside where m·w ≥ 0.
             let planes = [e - a, e + a, e - b, e + b];
-            let mut polys = Vec::new();
-            for (i, s) in seen.iter().enumerate() {
-                let Some(s) = s else { continue };
-                if planes.iter().any(|m| s.q.iter().all(|q| m.dot(*q) < 0.0)) {
-                    continue;
-                }
+            inside.clear();
+            inside.extend(seen.iter().enumerate().filter_map(|(i, s)| {
+                let s = s.as_ref()?;
+                let out = planes.iter().any(|m| s.q.iter().all(|q| m.dot(*q) < 0.0));
+                (!out).then_some(i as u32)
+            }));
+            polys.clear();
+            polys.reserve(inside.len());
+            for &i in &inside {
+                let i = i as usize;
+                let Some(s) = &seen[i] else { continue };
                 // Each vertex carries the set of pyramid planes it was cut on (see clip3).
                 let mut w3 = Clip3::default();
                 for &q in &s.q {
                     w3.add((q, 0));
                 }
                 for (bit, m) in planes.iter().enumerate() {
+                    // Most triangles lie inside most of the planes: nothing to cut.
+                    if w3.iter().all(|(w, _)| m.dot(*w) >= 0.0) {
+                        continue;
+                    }
                     w3 = clip3(&w3, *m, 1 << bit);
                     if w3.len() < 3 {
                         break;
@@ -288,20 +322,22 @@ impl Surface<'_> {
                     polys.push(p);
                 }
             }
-            let view = View::new(polys, 0.0);
-            view.visible(|p, pieces| {
+            let view = View::new(std::mem::take(&mut polys), 0.0);
+            let results = view.visible(|p, pieces, bufs, out| {
                 for piece in pieces.iter() {
-                    verts.clear();
-                    verts.extend(piece.iter().map(|uv| {
+                    bufs.verts.clear();
+                    bufs.verts.extend(piece.iter().map(|uv| {
                         let w = e + uv.x * a + uv.y * b;
                         let h = p.depth(*uv);
                         // h > 0 inside the triangle's projection; the guard is for rounding
                         // only (the direction is what Lambert's formula needs).
                         if h > 0.0 { w / h } else { w }
                     }));
-                    sink(p.tri, p.emitting, &verts);
+                    map(p.tri, p.emitting, &bufs.verts, &mut bufs.lambert, out);
                 }
             });
+            results.for_each(&mut sink);
+            polys = view.polys;
         }
     }
 
@@ -391,9 +427,27 @@ enum Hider {
     Part(Poly, Small<Line, 8>),
 }
 
+/// A polygon in a cell of the grid, its box kept with it (the scan of a cell reads no
+/// polygon).
+#[derive(Clone, Copy)]
+struct Member {
+    lo: DVec2,
+    hi: DVec2,
+    k: u32,
+}
+
+/// A polygon's depth function and its scale ([`Proj::z`], [`Proj::zmax`]).
+#[derive(Clone, Copy)]
+struct Depth {
+    z: DVec3,
+    zmax: f64,
+}
+
 /// The projected triangles of one chart.
 struct View {
     polys: Vec<Proj>,
+    /// Their depths, in a compact array (read for every candidate).
+    depths: Vec<Depth>,
     /// The chart's length tolerance (see [`clip`]) and the smallest doubled area kept.
     tol: f64,
     tiny: f64,
@@ -402,7 +456,7 @@ struct View {
     /// The candidate grid: cells of the chart's bounding box, cell c listing the polygons
     /// whose boxes meet it in `members[start[c]..start[c + 1]]`.
     start: Vec<u32>,
-    members: Vec<u32>,
+    members: Vec<Member>,
     g: usize,
     glo: DVec2,
     cell: DVec2,
@@ -420,11 +474,32 @@ impl View {
             (ghi - glo).max_element()
         };
         let tol = LENGTH_TOL * extent;
-        // About one polygon per cell on average, and a bounded grid.
-        let g = ((polys.len() as f64).sqrt().ceil() as usize).clamp(1, 256);
+        // Cells about the size of a typical polygon (the median of the boxes' larger sides):
+        // a polygon then meets a few cells and a cell a few polygons. A bounded grid.
+        let mut sizes: Vec<f64> = polys.iter().map(|p| (p.hi - p.lo).max_element()).collect();
+        let typical = if sizes.is_empty() {
+            0.0
+        } else {
+            let mid = sizes.len() / 2;
+            *sizes.select_nth_unstable_by(mid, f64::total_cmp).1
+        };
+        let per = std::env::var("GRID_K").ok().and_then(|s| s.parse().ok()).unwrap_or(1.0);
+        let g = if typical > 0.0 && extent.is_finite() {
+            ((extent / (per * typical)).ceil().min(256.0) as usize).max(1)
+        } else {
+            1
+        };
         let cell = ((ghi - glo) / g as f64).max(DVec2::splat(f64::MIN_POSITIVE));
+        let depths = polys
+            .iter()
+            .map(|p| Depth {
+                z: p.z,
+                zmax: p.zmax,
+            })
+            .collect();
         let mut view = View {
             polys,
+            depths,
             tol,
             tiny: tol * tol,
             zfloor,
@@ -447,13 +522,24 @@ impl View {
             view.start[c + 1] += view.start[c];
         }
         let mut fill: Vec<u32> = view.start[..g * g].to_vec();
-        view.members = vec![0; view.start[g * g] as usize];
+        view.members = vec![
+            Member {
+                lo: DVec2::ZERO,
+                hi: DVec2::ZERO,
+                k: 0
+            };
+            view.start[g * g] as usize
+        ];
         for (k, p) in view.polys.iter().enumerate() {
             let ((x0, y0), (x1, y1)) = view.cells(p.lo, p.hi);
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let f = &mut fill[y * g + x];
-                    view.members[*f as usize] = k as u32;
+                    view.members[*f as usize] = Member {
+                        lo: p.lo,
+                        hi: p.hi,
+                        k: k as u32,
+                    };
                     *f += 1;
                 }
             }
@@ -502,29 +588,61 @@ impl View {
         }
     }
 
-    /// Whether j is farther than i (by more than twice their tie tolerance) all over the box
+    /// Whether j (its box and depth given: read from compact arrays, not from the large
+    /// [`Proj`]) is farther than i by more than twice their tie tolerance all over the box
     /// where their boxes (widened by the length tolerance) meet: then no part of j nearer than
     /// i, even up to the tolerance, meets proj(i), and j hides nothing of it. The depth
     /// difference is affine, so its largest value over the box is at a corner.
-    fn behind(&self, i: &Proj, j: &Proj) -> bool {
+    fn behind(&self, i: &Proj, j: &Member, jz: &Depth) -> bool {
         let lo = i.lo.max(j.lo) - self.tol;
         let hi = i.hi.min(j.hi) + self.tol;
-        let dz = j.z - i.z;
+        let dz = jz.z - i.z;
         let top = dz.z + (dz.x * lo.x).max(dz.x * hi.x) + (dz.y * lo.y).max(dz.y * hi.y);
-        top < -2.0 * self.ztol(i, j)
+        top < -2.0 * DEPTH_TOL * (i.zmax + jz.zmax + self.zfloor)
     }
 
-    /// Calls `sink` with each wanted polygon and its visible pieces (none when it is hidden).
-    fn visible(&self, mut sink: impl FnMut(&Proj, &Pieces)) {
-        let mut cand: Vec<(f64, u32)> = Vec::new();
-        let mut stamp = vec![u32::MAX; self.polys.len()];
-        let mut pieces = Pieces::default();
-        let mut next = Pieces::default();
-        let mut scratch = Scratch::default();
-        for (i, pi) in self.polys.iter().enumerate() {
-            if !pi.wanted {
-                continue;
-            }
+    /// Calls `per` with each wanted polygon and its visible pieces (not when it is hidden),
+    /// and returns what it appended to its output, in the polygons' order. The polygons are
+    /// shared out in fixed chunks among rayon's threads, and the outputs put back in order:
+    /// the result does not depend on the number of threads.
+    fn visible<R: Send>(
+        &self,
+        per: impl Fn(&Proj, &Pieces, &mut Bufs, &mut Vec<R>) + Sync,
+    ) -> impl Iterator<Item = R> {
+        /// Polygons per chunk: enough to make a chunk's work large beside its scheduling.
+        const CHUNK: usize = 256;
+        let n = self.polys.len();
+        let chunks: Vec<Vec<R>> = (0..n.div_ceil(CHUNK))
+            .into_par_iter()
+            .map_init(
+                || Work::new(n),
+                |w, c| {
+                    let mut out = Vec::new();
+                    for i in c * CHUNK..n.min((c + 1) * CHUNK) {
+                        let pi = &self.polys[i];
+                        if pi.wanted && self.visible_one(i, w) {
+                            per(pi, &w.pieces, &mut w.bufs, &mut out);
+                        }
+                    }
+                    out
+                },
+            )
+            .collect();
+        chunks.into_iter().flatten()
+    }
+
+    /// The visible pieces of polygon i, in `w.pieces`; false when it is hidden.
+    fn visible_one(&self, i: usize, w: &mut Work) -> bool {
+        let Work {
+            cand,
+            stamp,
+            pieces,
+            next,
+            scratch,
+            ..
+        } = w;
+        let pi = &self.polys[i];
+        {
             cand.clear();
             let (ilo, ihi) = (pi.lo - self.tol, pi.hi + self.tol);
             let ((x0, y0), (x1, y1)) = self.cells(pi.lo, pi.hi);
@@ -532,17 +650,22 @@ impl View {
             for y in y0..=y1 {
                 for x in x0..=x1 {
                     let c = y * self.g + x;
-                    for &k in &self.members[self.start[c] as usize..self.start[c + 1] as usize] {
-                        let pk = &self.polys[k as usize];
-                        if k as usize == i || !(pk.lo.cmple(ihi).all() && pk.hi.cmpge(ilo).all())
-                        {
+                    for m in &self.members[self.start[c] as usize..self.start[c + 1] as usize] {
+                        let k = m.k;
+                        if k as usize == i || !(m.lo.cmple(ihi).all() && m.hi.cmpge(ilo).all()) {
                             continue;
                         }
                         if stamp[k as usize] == i as u32 {
                             continue;
                         }
                         stamp[k as usize] = i as u32;
-                        if self.behind(pi, pk) {
+                        if self.behind(pi, m, &self.depths[k as usize]) {
+                            continue;
+                        }
+                        let pk = &self.polys[k as usize];
+                        // The pieces lie in proj(i) and a hider in proj(k): when an edge line
+                        // of either separates the two (up to the tolerance) k hides nothing.
+                        if clip::separated(&pi.poly, &pi.lines, &pk.poly, &pk.lines, self.tol) {
                             continue;
                         }
                         cand.push((pk.depth(centre), k));
@@ -555,7 +678,7 @@ impl View {
             pieces.clear();
             pieces.push(&pi.poly);
             let (mut plo, mut phi) = (pi.lo, pi.hi);
-            for &(_, k) in &cand {
+            for &(_, k) in cand.iter() {
                 let pk = &self.polys[k as usize];
                 // Nothing left where pk is.
                 if !(pk.lo.cmple(phi + self.tol).all() && pk.hi.cmpge(plo - self.tol).all()) {
@@ -582,25 +705,55 @@ impl View {
                             hider_lines,
                             self.tol,
                             self.tiny,
-                            &mut next,
-                            &mut scratch,
+                            next,
+                            scratch,
                         );
                     } else {
                         next.push(piece);
                     }
                 }
-                std::mem::swap(&mut pieces, &mut next);
+                std::mem::swap(pieces, next);
                 if pieces.is_empty() {
                     break;
                 }
                 (plo, phi) = pieces.bounds();
             }
-            if !pieces.is_empty() {
-                sink(pi, &pieces);
-            }
+            !pieces.is_empty()
         }
     }
 }
+
+/// Buffers for the callers' use in [`View::visible`].
+#[derive(Default)]
+struct Bufs {
+    verts: Vec<DVec3>,
+    lambert: Vec<DVec3>,
+}
+
+/// A thread's scratch in [`View::visible`].
+struct Work {
+    cand: Vec<(f64, u32)>,
+    /// stamp[k] = i when polygon k has been met already as a candidate of polygon i.
+    stamp: Vec<u32>,
+    pieces: Pieces,
+    next: Pieces,
+    scratch: Scratch,
+    bufs: Bufs,
+}
+
+impl Work {
+    fn new(n: usize) -> Work {
+        Work {
+            cand: Vec::new(),
+            stamp: vec![u32::MAX; n],
+            pieces: Pieces::default(),
+            next: Pieces::default(),
+            scratch: Scratch::default(),
+            bufs: Bufs::default(),
+        }
+    }
+}
+
 
 /// At most 7 vertices (a triangle clipped by four planes), each with its set of planes.
 type Clip3 = Small<(DVec3, u8), 8>;
