@@ -419,7 +419,9 @@ impl Proj {
     }
 }
 
-/// What of a triangle j may hide a triangle i ([`View::hider`]).
+/// What of a triangle j may hide a triangle i ([`View::hider`]). Made for a few candidates
+/// only, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
 enum Hider {
     /// All of proj(j) (its polygon and edge lines are the [`Proj`]'s).
     Whole,
@@ -483,9 +485,8 @@ impl View {
             let mid = sizes.len() / 2;
             *sizes.select_nth_unstable_by(mid, f64::total_cmp).1
         };
-        let per = std::env::var("GRID_K").ok().and_then(|s| s.parse().ok()).unwrap_or(1.0);
         let g = if typical > 0.0 && extent.is_finite() {
-            ((extent / (per * typical)).ceil().min(256.0) as usize).max(1)
+            ((extent / typical).ceil().min(256.0) as usize).max(1)
         } else {
             1
         };

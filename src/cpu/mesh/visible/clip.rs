@@ -113,10 +113,6 @@ impl<T: Copy + Default, const N: usize> Small<T, N> {
         self.n += 1;
     }
 
-    pub(super) fn clear(&mut self) {
-        self.n = 0;
-    }
-
     pub(super) fn pop(&mut self) {
         self.n -= 1;
     }
