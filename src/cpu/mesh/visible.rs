@@ -247,31 +247,49 @@ impl Surface<'_> {
     fn pieces_from<R: Send>(
         &self,
         x: DVec3,
-        wanted: impl Fn(&Seen) -> bool,
-        occludes: impl Fn(&Seen) -> bool,
+        wanted: impl Fn(&Seen) -> bool + Sync,
+        occludes: impl Fn(&Seen) -> bool + Sync,
         map: impl Fn(u32, bool, &[DVec3], &mut Vec<DVec3>, &mut Vec<R>) + Sync,
-        mut sink: impl FnMut(R),
+        sink: impl FnMut(R),
     ) {
         let seen: Vec<Option<Seen>> = self
             .triangles
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|t| self.seen(t, x).filter(&occludes))
             .collect();
-        // One buffer of projected triangles for the six charts, sized for the fullest: a
-        // Proj is large (its polygon and lines in place), and growing it would copy them.
-        let mut polys = Vec::new();
-        let mut inside: Vec<u32> = Vec::new();
-        for [e, a, b] in FACES {
+        // The six charts in parallel (each its triangles in chunks in parallel too), their
+        // results put back in the charts' order.
+        let charts: Vec<Vec<R>> = FACES
+            .par_iter()
+            .map(|&face| self.chart(&seen, face, &wanted, &map))
+            .collect();
+        charts.into_iter().flatten().for_each(sink);
+    }
+
+    /// [`Surface::pieces_from`] in one chart: what `map` made of each visible piece, in order.
+    fn chart<R: Send>(
+        &self,
+        seen: &[Option<Seen>],
+        [e, a, b]: [DVec3; 3],
+        wanted: &(impl Fn(&Seen) -> bool + Sync),
+        map: &(impl Fn(u32, bool, &[DVec3], &mut Vec<DVec3>, &mut Vec<R>) + Sync),
+    ) -> Vec<R> {
+        {
             // The pyramid's four planes through x, inside where m·w ≥ 0.
             let planes = [e - a, e + a, e - b, e + b];
-            inside.clear();
-            inside.extend(seen.iter().enumerate().filter_map(|(i, s)| {
-                let s = s.as_ref()?;
-                let out = planes.iter().any(|m| s.q.iter().all(|q| m.dot(*q) < 0.0));
-                (!out).then_some(i as u32)
-            }));
-            polys.clear();
-            polys.reserve(inside.len());
+            let inside: Vec<u32> = seen
+                .iter()
+                .enumerate()
+                .filter_map(|(i, s)| {
+                    let s = s.as_ref()?;
+                    let out = planes.iter().any(|m| s.q.iter().all(|q| m.dot(*q) < 0.0));
+                    (!out).then_some(i as u32)
+                })
+                .collect();
+            // Sized at once: a Proj is large (its polygon and lines in place), and growing
+            // the buffer would copy them.
+            let mut polys = Vec::with_capacity(inside.len());
             for &i in &inside {
                 let i = i as usize;
                 let Some(s) = &seen[i] else { continue };
@@ -322,7 +340,7 @@ impl Surface<'_> {
                     polys.push(p);
                 }
             }
-            let view = View::new(std::mem::take(&mut polys), 0.0);
+            let view = View::new(polys, 0.0);
             let results = view.visible(|p, pieces, bufs, out| {
                 for piece in pieces.iter() {
                     bufs.verts.clear();
@@ -336,8 +354,7 @@ impl Surface<'_> {
                     map(p.tri, p.emitting, &bufs.verts, &mut bufs.lambert, out);
                 }
             });
-            results.for_each(&mut sink);
-            polys = view.polys;
+            results.collect()
         }
     }
 
