@@ -733,14 +733,7 @@ impl View {
                     let boxes_meet =
                         lo.cmple(hhi + self.tol).all() && hi.cmpge(hlo - self.tol).all();
                     if boxes_meet && clip::overlap(piece, hider, hider_lines, self.tol) {
-                        clip::subtract(
-                            piece,
-                            hider_lines,
-                            self.tol,
-                            self.tiny,
-                            next,
-                            scratch,
-                        );
+                        clip::subtract(piece, hider_lines, self.tol, self.tiny, next, scratch);
                     } else {
                         next.push(piece);
                     }
@@ -786,7 +779,6 @@ impl Work {
         }
     }
 }
-
 
 /// At most 7 vertices (a triangle clipped by four planes), each with its set of planes.
 type Clip3 = Small<(DVec3, u8), 8>;

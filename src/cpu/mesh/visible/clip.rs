@@ -221,7 +221,13 @@ pub(super) fn overlap(p: &[DVec2], s: &[DVec2], s_lines: &[Line], tol: f64) -> b
 /// Whether an edge line of p or of s leaves the other outside (up to the tolerance): the two
 /// convex polygons overlap in no more than the tolerance ([`overlap`] with both polygons'
 /// edge lines known).
-pub(super) fn separated(p: &[DVec2], p_lines: &[Line], s: &[DVec2], s_lines: &[Line], tol: f64) -> bool {
+pub(super) fn separated(
+    p: &[DVec2],
+    p_lines: &[Line],
+    s: &[DVec2],
+    s_lines: &[Line],
+    tol: f64,
+) -> bool {
     let separates = |l: &Line, q: &[DVec2]| q.iter().all(|&v| l.eval(v) <= tol);
     s_lines.iter().any(|l| separates(l, p)) || p_lines.iter().any(|l| separates(l, s))
 }

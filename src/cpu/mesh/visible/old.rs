@@ -78,11 +78,16 @@ impl Surface<'_> {
     pub(crate) fn emitting_above(&self, x: DVec3, n: DVec3) -> Vec<Piece> {
         let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
         let mut out = Vec::new();
-        self.pieces_from(x, |s| s.emitting && above(s), above, |piece| {
-            if piece.emitting {
-                out.push(piece)
-            }
-        });
+        self.pieces_from(
+            x,
+            |s| s.emitting && above(s),
+            above,
+            |piece| {
+                if piece.emitting {
+                    out.push(piece)
+                }
+            },
+        );
         out
     }
 

@@ -1246,11 +1246,20 @@ fn bumpy_torus(around: usize, across: usize) -> Vec<MeshTriangle> {
 #[ignore]
 fn timing_old_against_new() {
     use rayon::prelude::*;
-    let reps: usize = std::env::var("TIMING_REPS").ok().and_then(|s| s.parse().ok()).unwrap_or(5);
+    let reps: usize = std::env::var("TIMING_REPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
     let t = bumpy_torus(250, 200);
     assert_eq!(t.len(), 100_000);
-    let new = Surface { triangles: &t, double_sided: false };
-    let old = old::Surface { triangles: &t, double_sided: false };
+    let new = Surface {
+        triangles: &t,
+        double_sided: false,
+    };
+    let old = old::Surface {
+        triangles: &t,
+        double_sided: false,
+    };
     let (x, n) = (v(0.5, 1.0, 0.3), DVec3::NEG_Y);
     let w = v(0.3, 0.8, 0.5);
     let time = |f: &mut dyn FnMut() -> f64| {
@@ -1259,8 +1268,14 @@ fn timing_old_against_new() {
         (start.elapsed().as_secs_f64() * 1e3, r)
     };
     let ring = ring(125, 8, 1.0, 0.3);
-    let rnew = Surface { triangles: &ring, double_sided: false };
-    let rold = old::Surface { triangles: &ring, double_sided: false };
+    let rnew = Surface {
+        triangles: &ring,
+        double_sided: false,
+    };
+    let rold = old::Surface {
+        triangles: &ring,
+        double_sided: false,
+    };
     let receivers: Vec<(DVec3, DVec3)> = (0..256)
         .map(|k| {
             let (i, j) = ((k % 16) as f64, (k / 16) as f64);
@@ -1281,8 +1296,18 @@ fn timing_old_against_new() {
             time(&mut || new.cosine_solid_angle(x, n)),
             time(&mut || old.projected_area(w)),
             time(&mut || new.projected_area(w)),
-            time(&mut || receivers.par_iter().map(|&(x, n)| rold.cosine_solid_angle(x, n)).sum()),
-            time(&mut || receivers.par_iter().map(|&(x, n)| rnew.cosine_solid_angle(x, n)).sum()),
+            time(&mut || {
+                receivers
+                    .par_iter()
+                    .map(|&(x, n)| rold.cosine_solid_angle(x, n))
+                    .sum()
+            }),
+            time(&mut || {
+                receivers
+                    .par_iter()
+                    .map(|&(x, n)| rnew.cosine_solid_angle(x, n))
+                    .sum()
+            }),
         ];
         for (k, (ms, v)) in r.into_iter().enumerate() {
             best[k] = best[k].min(ms);
@@ -1291,10 +1316,26 @@ fn timing_old_against_new() {
     }
     println!(
         "100k torus irradiance: old {:.1} ms new {:.1} ms (×{:.2}); projected_area: old {:.1} ms new {:.1} ms (×{:.2}); 256 receivers on 2000-ring in parallel: old {:.1} ms new {:.1} ms (×{:.2})",
-        best[0], best[1], best[0] / best[1], best[2], best[3], best[2] / best[3], best[4], best[5], best[4] / best[5]
+        best[0],
+        best[1],
+        best[0] / best[1],
+        best[2],
+        best[3],
+        best[2] / best[3],
+        best[4],
+        best[5],
+        best[4] / best[5]
     );
-    println!("values: {:.15} {:.15} | {:.15} {:.15} | {:.15} {:.15}", sums[0], sums[1], sums[2], sums[3], sums[4], sums[5]);
+    println!(
+        "values: {:.15} {:.15} | {:.15} {:.15} | {:.15} {:.15}",
+        sums[0], sums[1], sums[2], sums[3], sums[4], sums[5]
+    );
     for k in [0, 2, 4] {
-        assert!(rel(sums[k], sums[k + 1]) < 1e-12, "{} vs {}", sums[k], sums[k + 1]);
+        assert!(
+            rel(sums[k], sums[k + 1]) < 1e-12,
+            "{} vs {}",
+            sums[k],
+            sums[k + 1]
+        );
     }
 }
