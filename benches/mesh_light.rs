@@ -85,9 +85,14 @@ fn mesh_light(c: &mut Criterion) {
     // the device: GpuPath::RadianceOnDevice); Mesa's lavapipe proves it runs, not its speed.
     match Evaluator::gpu() {
         Ok(g) => {
-            let dev = g.prepare(std::slice::from_ref(&light)).expect("prepare on the GPU");
+            let dev = g
+                .prepare(std::slice::from_ref(&light))
+                .expect("prepare on the GPU");
             group.bench_function("radiance 1M rays on the GPU", |b| {
-                b.iter(|| dev.radiance(&points, &dirs, Accumulate::Sum).expect("radiance"))
+                b.iter(|| {
+                    dev.radiance(&points, &dirs, Accumulate::Sum)
+                        .expect("radiance")
+                })
             });
         }
         Err(e) => eprintln!("no GPU adapter ({e}): the GPU radiance is not measured"),

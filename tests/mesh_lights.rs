@@ -191,7 +191,9 @@ fn ring(k: usize) -> MeshGeometry {
 #[test]
 fn exact_self_occluded_irradiance_matches_a_monte_carlo_of_first_hit_radiance() {
     let mut rng = Rng::new(11);
-    let cases: Vec<(&str, Light, Vec<(DVec3, DVec3)>)> = vec![
+    // (name, light, receivers as (point, normal)).
+    type Case = (&'static str, Light, Vec<(DVec3, DVec3)>);
+    let cases: Vec<Case> = vec![
         (
             "L prism",
             Light::mesh(l_prism()).with_intensity(2.0),

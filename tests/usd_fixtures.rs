@@ -465,7 +465,9 @@ fn scene_lights_and_warnings() {
     let evaluable = scene.evaluable(&[]).unwrap();
     let paths: Vec<&str> = evaluable.iter().map(|l| l.path.as_str()).collect();
     // A Mesh with MeshLightAPI is a light the queries evaluate (DESIGN.md §7).
-    let mesh = evaluable.iter().find(|l| l.path == "/World/Defaults/MeshLight");
+    let mesh = evaluable
+        .iter()
+        .find(|l| l.path == "/World/Defaults/MeshLight");
     assert!(
         mesh.is_some_and(|l| l.kind.usd_type() == "Mesh"),
         "{paths:?}"

@@ -338,7 +338,6 @@ impl PreparedScene {
         )
     }
 
-    #[allow(clippy::too_many_arguments)]
     /// Refuses a GPU-resident query of a scene holding a light every query of which the host
     /// computes (`GpuPath::Host`: mesh lights): the kernels give 0 for it, which this path
     /// would return as if it were the answer.
@@ -366,6 +365,7 @@ impl PreparedScene {
         }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,

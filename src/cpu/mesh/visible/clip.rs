@@ -10,12 +10,12 @@
 
 use glam::DVec2;
 
-/// A convex polygon, counter-clockwise.
-pub(super) type Poly = Vec<DVec2>;
+/// A triangle's convex polygon in a chart, counter-clockwise (at most 7 vertices, see [`Small`]).
+pub(super) type Poly = Small<DVec2, 8>;
 
 /// The line n·p + c = 0 with n a unit vector: [`Line::eval`] is the signed distance, positive
 /// on the left of the edge it was built from (the inside of a counter-clockwise polygon).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub(super) struct Line {
     n: DVec2,
     c: f64,
@@ -38,11 +38,16 @@ impl Line {
     }
 }
 
-/// The edge lines of a counter-clockwise convex polygon (its inside is where all are ≥ 0).
-pub(super) fn edge_lines(p: &[DVec2]) -> Vec<Line> {
-    (0..p.len())
-        .filter_map(|k| Line::through(p[k], p[(k + 1) % p.len()]))
-        .collect()
+/// The edge lines of a counter-clockwise convex polygon of at most 8 vertices (its inside is
+/// where all are ≥ 0).
+pub(super) fn edge_lines(p: &[DVec2]) -> Small<Line, 8> {
+    let mut out = Small::default();
+    for k in 0..p.len() {
+        if let Some(l) = Line::through(p[k], p[(k + 1) % p.len()]) {
+            out.add(l);
+        }
+    }
+    out
 }
 
 /// Twice the signed area (shoelace formula): positive when counter-clockwise.
@@ -63,19 +68,114 @@ pub(super) fn bounds(p: &[DVec2]) -> (DVec2, DVec2) {
 }
 
 /// Where a convex polygon lies with respect to a signed function given at its vertices.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(super) enum Side {
     /// Every vertex ≥ −tol: the polygon is (up to the tolerance) on the non-negative side.
     Inside,
     /// Every vertex ≤ tol (and some below −tol).
     Outside,
-    /// Both sides: (the part where d ≥ 0, the part where d ≤ 0), both convex.
-    Split(Poly, Poly),
+    /// Both sides: [`split`] wrote the part where d ≥ 0 and the part where d ≤ 0, both convex.
+    Split,
+}
+
+/// Somewhere to put a polygon's vertices: a growable buffer or a fixed one ([`Small`]).
+pub(super) trait Push {
+    fn push(&mut self, v: DVec2);
+}
+
+impl Push for Vec<DVec2> {
+    fn push(&mut self, v: DVec2) {
+        Vec::push(self, v)
+    }
+}
+
+/// A convex polygon of at most N vertices, in place (no allocation): a triangle clipped by the
+/// four planes of a cube map's pyramid has at most 7, and cut once more by a line at most 8.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Small<T: Copy + Default, const N: usize> {
+    v: [T; N],
+    n: usize,
+}
+
+impl<T: Copy + Default, const N: usize> Default for Small<T, N> {
+    fn default() -> Self {
+        Small {
+            v: [T::default(); N],
+            n: 0,
+        }
+    }
+}
+
+impl<T: Copy + Default, const N: usize> Small<T, N> {
+    /// Appends v; panics past N (the bounds above are geometric facts, not tolerances).
+    pub(super) fn add(&mut self, v: T) {
+        self.v[self.n] = v;
+        self.n += 1;
+    }
+
+    pub(super) fn pop(&mut self) {
+        self.n -= 1;
+    }
+
+    pub(super) fn retain_first(&mut self, n: usize) {
+        self.n = self.n.min(n);
+    }
+
+    pub(super) fn as_mut_slice(&mut self) -> &mut [T] {
+        &mut self.v[..self.n]
+    }
+}
+
+impl<T: Copy + Default, const N: usize> std::ops::Deref for Small<T, N> {
+    type Target = [T];
+    fn deref(&self) -> &[T] {
+        &self.v[..self.n]
+    }
+}
+
+impl<const N: usize> Push for Small<DVec2, N> {
+    fn push(&mut self, v: DVec2) {
+        self.add(v)
+    }
+}
+
+/// A sink that drops what it is given (the side of a split that is not wanted).
+pub(super) struct Drop;
+
+impl Push for Drop {
+    fn push(&mut self, _: DVec2) {}
+}
+
+/// Where a polygon lies with respect to the signed values `d` at its vertices, up to `tol`.
+pub(super) fn classify(d: &[f64], tol: f64) -> Side {
+    let (mut neg, mut pos) = (false, false);
+    for &v in d {
+        neg |= v < -tol;
+        pos |= v > tol;
+    }
+    match (neg, pos) {
+        (false, _) => Side::Inside,
+        (true, false) => Side::Outside,
+        (true, true) => Side::Split,
+    }
 }
 
 /// Splits a convex polygon by an affine function given by its values `d` at the vertices
-/// (Sutherland–Hodgman for one clipping line, both outputs kept). The crossing points are
-/// interpolated linearly, which is exact for an affine function.
-pub(super) fn split(p: &[DVec2], d: &[f64], tol: f64) -> Side {
+/// (Sutherland–Hodgman for one clipping line, both outputs kept): appends the part where
+/// d ≥ 0 to `inside` and the part where d ≤ 0 to `outside`, when [`classify`] says `Split`
+/// (otherwise nothing is written). The crossing points are interpolated linearly, which is
+/// exact for an affine function.
+pub(super) fn split(
+    p: &[DVec2],
+    d: &[f64],
+    tol: f64,
+    inside: &mut impl Push,
+    outside: &mut impl Push,
+) -> Side {
+    let side = classify(d, tol);
+    if side != Side::Split {
+        return side;
+    }
     let class = |v: f64| -> i8 {
         if v > tol {
             1
@@ -85,19 +185,9 @@ pub(super) fn split(p: &[DVec2], d: &[f64], tol: f64) -> Side {
             0
         }
     };
-    let has_neg = d.iter().any(|&v| class(v) < 0);
-    if !has_neg {
-        return Side::Inside;
-    }
-    let has_pos = d.iter().any(|&v| class(v) > 0);
-    if !has_pos {
-        return Side::Outside;
-    }
     let n = p.len();
-    let mut inside = Vec::with_capacity(n + 2);
-    let mut outside = Vec::with_capacity(n + 2);
     for k in 0..n {
-        let j = (k + 1) % n;
+        let j = if k + 1 == n { 0 } else { k + 1 };
         let (sa, sb) = (class(d[k]), class(d[j]));
         if sa >= 0 {
             inside.push(p[k]);
@@ -113,7 +203,7 @@ pub(super) fn split(p: &[DVec2], d: &[f64], tol: f64) -> Side {
             outside.push(m);
         }
     }
-    Side::Split(inside, outside)
+    Side::Split
 }
 
 /// Whether two convex polygons overlap in more than the tolerance: by the separating axis
@@ -128,27 +218,108 @@ pub(super) fn overlap(p: &[DVec2], s: &[DVec2], s_lines: &[Line], tol: f64) -> b
         .any(|k| Line::through(p[k], p[(k + 1) % p.len()]).is_some_and(|l| separates(&l, s)))
 }
 
+/// Whether an edge line of p or of s leaves the other outside (up to the tolerance): the two
+/// convex polygons overlap in no more than the tolerance ([`overlap`] with both polygons'
+/// edge lines known).
+pub(super) fn separated(
+    p: &[DVec2],
+    p_lines: &[Line],
+    s: &[DVec2],
+    s_lines: &[Line],
+    tol: f64,
+) -> bool {
+    let separates = |l: &Line, q: &[DVec2]| q.iter().all(|&v| l.eval(v) <= tol);
+    s_lines.iter().any(|l| separates(l, p)) || p_lines.iter().any(|l| separates(l, s))
+}
+
+/// Convex polygons stored one after the other in one buffer (no allocation per polygon), each
+/// with its bounding box.
+#[derive(Default)]
+pub(super) struct Pieces {
+    verts: Vec<DVec2>,
+    /// (first vertex, end, box min, box max) of each polygon.
+    index: Vec<(usize, usize, DVec2, DVec2)>,
+}
+
+impl Pieces {
+    pub(super) fn clear(&mut self) {
+        self.verts.clear();
+        self.index.clear();
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    pub(super) fn is_empty(&self) -> bool {
+        self.index.is_empty()
+    }
+
+    pub(super) fn push(&mut self, p: &[DVec2]) {
+        let (lo, hi) = bounds(p);
+        let start = self.verts.len();
+        self.verts.extend_from_slice(p);
+        self.index.push((start, self.verts.len(), lo, hi));
+    }
+
+    /// The k-th polygon and its box.
+    pub(super) fn get(&self, k: usize) -> (&[DVec2], DVec2, DVec2) {
+        let (a, b, lo, hi) = self.index[k];
+        (&self.verts[a..b], lo, hi)
+    }
+
+    pub(super) fn iter(&self) -> impl Iterator<Item = &[DVec2]> {
+        self.index.iter().map(|&(a, b, _, _)| &self.verts[a..b])
+    }
+
+    /// The box of all the polygons.
+    pub(super) fn bounds(&self) -> (DVec2, DVec2) {
+        self.index.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &(_, _, a, b)| (lo.min(a), hi.max(b)),
+        )
+    }
+}
+
+/// Scratch buffers of [`subtract`].
+#[derive(Default)]
+pub(super) struct Scratch {
+    rest: Vec<DVec2>,
+    inside: Vec<DVec2>,
+    outside: Vec<DVec2>,
+    d: Vec<f64>,
+}
+
 /// Appends to `out` the convex pieces of p outside the convex polygon s (given by its edge
 /// lines): the part outside s's first edge, then of the rest the part outside the second edge,
 /// and so on; what is left at the end is inside s and is dropped. Pieces of no more than
 /// `tiny` doubled area are dropped too.
-pub(super) fn subtract(p: Poly, s_lines: &[Line], tol: f64, tiny: f64, out: &mut Vec<Poly>) {
-    let mut rest = p;
-    let mut d = Vec::with_capacity(rest.len() + 2);
+pub(super) fn subtract(
+    p: &[DVec2],
+    s_lines: &[Line],
+    tol: f64,
+    tiny: f64,
+    out: &mut Pieces,
+    w: &mut Scratch,
+) {
+    w.rest.clear();
+    w.rest.extend_from_slice(p);
     for l in s_lines {
-        d.clear();
-        d.extend(rest.iter().map(|&v| l.eval(v)));
-        match split(&rest, &d, tol) {
+        w.d.clear();
+        w.d.extend(w.rest.iter().map(|&v| l.eval(v)));
+        w.inside.clear();
+        w.outside.clear();
+        match split(&w.rest, &w.d, tol, &mut w.inside, &mut w.outside) {
             Side::Inside => {}
             Side::Outside => {
-                out.push(rest);
+                out.push(&w.rest);
                 return;
             }
-            Side::Split(inside, outside) => {
-                if area2(&outside) > tiny {
-                    out.push(outside);
+            Side::Split => {
+                if area2(&w.outside) > tiny {
+                    out.push(&w.outside);
                 }
-                rest = inside;
+                std::mem::swap(&mut w.rest, &mut w.inside);
             }
         }
     }
