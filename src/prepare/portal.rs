@@ -27,7 +27,6 @@ pub fn multiplier(p: &Portal, mode: TemperatureMode) -> DVec3 {
 /// One portal of a masked dome, in world space.
 #[derive(Clone, Debug)]
 pub struct PreparedPortal {
-    pub path: String,
     /// World-space centre.
     pub origin: DVec3,
     /// World → local linear map (the inverse of the portal's world 3×3).
@@ -85,7 +84,6 @@ pub fn prepare_portals(
         let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
             .map(|(a, b)| origin + linear * DVec3::new(a * half.x, b * half.y, 0.0));
         out.push(PreparedPortal {
-            path: p.path.clone(),
             origin,
             to_local,
             half,
