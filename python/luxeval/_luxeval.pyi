@@ -67,9 +67,9 @@ class Stage:
     def lights(self) -> list[dict[str, Any]]:
         """Every light of the stage in traversal order, as the records of
         ``luxeval lights --json`` (with ``light_filters``, ``link_collections`` and
-        ``shaping_without_api``: read, not applied; a mesh light's ``mesh``, a portal's
-        ``portal`` and a dome's ``portals``: read, not evaluated yet). A new list on each
-        access."""
+        ``shaping_without_api``: read, not applied; a mesh light's ``mesh`` summary, a portal's
+        ``portal`` and a dome's ``portals``, ``portals_evaluated`` and ``masked``). A new list
+        on each access."""
     @property
     def light_lists(self) -> list[dict[str, Any]]:
         """The stage's light lists (ListAPI / LightListAPI; not read by luxeval): ``path``,

@@ -328,7 +328,8 @@ impl Stage {
     /// ``luxeval lights --json`` (``path``, ``usd_type``, ``applied_schemas``, ``visible``,
     /// ``world`` (row-vector, ``world[3]`` is the translation), ``inputs`` (each with ``name``,
     /// ``value``, ``authored``), ``evaluable``, ``warning``, ``power`` (``rgb``, ``lumens``,
-    /// ``watts``; ``None`` for lights at infinity or not evaluated) and, when the light cannot be
+    /// ``watts``; ``None`` for lights at infinity, mesh lights (their flux is not computed) or
+    /// lights not evaluated) and, when the light cannot be
     /// prepared, ``power_error``; and what luxeval reads but does not apply: ``light_filters``
     /// (the ``light:filters`` targets), ``link_collections`` (the light-link and shadow-link
     /// collections that restrict the light, each with ``name``, ``include_root``,
