@@ -6,7 +6,7 @@
 //!   transmits); crossings toward −Z are ignored (portals are not opaque); none → 0.
 //! - `irradiance(x, n)`: x sees the dome through the portals whose −Z side it is on (only those
 //!   are crossed toward +Z, a portal being planar). Their visible parts seen from x, nearest
-//!   first and overlaps counted once for the nearer ([`Surface::visible_from`] on two triangles
+//!   first and overlaps counted once for the nearer ([`Surface::emitting_above`] on two triangles
 //!   a portal, ties to the earlier portal in the `portals` relationship), are convex planar
 //!   polygons. An untextured dome is uniform, so each piece is `L ⊙ multiplier` times Lambert's
 //!   formula clipped at the horizon ([`polygon_irradiance`]): exact. A textured dome's radiance
@@ -87,7 +87,8 @@ pub fn irradiance(p: &Prepared, portals: &[PreparedPortal], x: DVec3, n: DVec3, 
     };
     let textured = p.dome_texture().is_some();
     let mut sum = DVec3::ZERO;
-    for piece in surface.visible_from(x) {
+    // Portals wholly below the receiver's horizon neither pass light it receives nor hide any.
+    for piece in surface.emitting_above(x, n) {
         let m = portals[owner[piece.triangle as usize]].multiplier;
         if textured {
             let e = integrate_piece(&piece.verts, n, rel, &mut |w: DVec3| emission(p, w));

@@ -146,6 +146,9 @@ pub enum KindData {
         /// The running sum of the triangles' areas, in order (the last is the mesh's area):
         /// the table a point is drawn by area from (DESIGN.md §9 S2 "by their geometry").
         cumulative_area: std::sync::Arc<Vec<f64>>,
+        /// The farthest vertex's distance from the prim's origin ([`Prepared::bound_radius`]),
+        /// computed once: the light choice reads it per receiver.
+        bound_radius: f64,
     },
 }
 
@@ -210,14 +213,12 @@ impl Prepared {
             LightType::Sphere { radius, .. } => DVec3::splat(radius),
             LightType::Cylinder { length, radius, .. } => DVec3::new(length / 2.0, radius, radius),
             LightType::Dome | LightType::Distant { .. } => DVec3::ZERO,
-            // World-space triangles: the farthest vertex from the origin.
-            LightType::Mesh { ref geometry, .. } => {
-                return geometry
-                    .triangles
-                    .iter()
-                    .flat_map(|t| t.p)
-                    .map(|v| v.distance(self.origin))
-                    .fold(0.0, f64::max);
+            // World-space triangles: the farthest vertex from the origin, found when prepared.
+            LightType::Mesh { .. } => {
+                return match self.kind {
+                    KindData::Mesh { bound_radius, .. } => bound_radius,
+                    _ => 0.0,
+                };
             }
         };
         ext.x * self.linear.x_axis.length()
@@ -391,6 +392,12 @@ impl Prepared {
                         })
                         .collect(),
                 ),
+                bound_radius: geometry
+                    .triangles
+                    .iter()
+                    .flat_map(|t| t.p)
+                    .map(|v| v.distance(light.origin()))
+                    .fold(0.0, f64::max),
             },
             _ => {
                 // A texture on any other type is refused rather than evaluated as if untextured.

@@ -119,6 +119,22 @@ pub fn polygon_irradiance(q: &[DVec3], n: DVec3) -> f64 {
     }
     // Orientation: +1 when the vertices run counter-clockwise seen from x.
     let sigma = ((q[1] - q[0]).cross(q[2] - q[1])).dot(q[0]).signum();
+    let clipped = clip_above(q, n);
+    let mut sum = 0.0;
+    for i in 0..clipped.len() {
+        let (a, b) = (clipped[i], clipped[(i + 1) % clipped.len()]);
+        let c = a.cross(b);
+        let len = c.length();
+        if len > 0.0 {
+            sum += len.atan2(a.dot(b)) * n.dot(c) / len;
+        }
+    }
+    (0.5 * sigma * sum).max(0.0)
+}
+
+/// The polygon `q` (vectors from x) clipped to the receiver's upper half-space `n·ω ≥ 0`
+/// (Sutherland & Hodgman 1974).
+pub fn clip_above(q: &[DVec3], n: DVec3) -> Vec<DVec3> {
     let mut clipped: Vec<DVec3> = Vec::with_capacity(q.len() + 1);
     for i in 0..q.len() {
         let (a, b) = (q[i], q[(i + 1) % q.len()]);
@@ -130,16 +146,7 @@ pub fn polygon_irradiance(q: &[DVec3], n: DVec3) -> f64 {
             clipped.push(a + (b - a) * (da / (da - db)));
         }
     }
-    let mut sum = 0.0;
-    for i in 0..clipped.len() {
-        let (a, b) = (clipped[i], clipped[(i + 1) % clipped.len()]);
-        let c = a.cross(b);
-        let len = c.length();
-        if len > 0.0 {
-            sum += len.atan2(a.dot(b)) * n.dot(c) / len;
-        }
-    }
-    (0.5 * sigma * sum).max(0.0)
+    clipped
 }
 
 /// treatAsPoint: the full-size sphere's intensity from its origin (DESIGN.md §2).

@@ -20,19 +20,22 @@ pub(crate) mod visible;
 use glam::DVec3;
 
 use super::shaping::shaping;
-use crate::model::LightType;
+use crate::model::{LightType, MeshTriangle};
+use crate::prepare::mesh_bvh::MeshBvh;
 use crate::prepare::{KindData, Prepared};
 
-/// A prepared mesh light's parts: its triangles, hierarchy, distinct front directions and
-/// whether both sides emit. `None` for other lights.
-fn parts(
-    p: &Prepared,
-) -> Option<(
-    &[crate::model::MeshTriangle],
-    &crate::prepare::mesh_bvh::MeshBvh,
-    &[DVec3],
-    bool,
-)> {
+/// What a prepared mesh light carries, read together: its model's triangles and sides and its
+/// prepared hierarchy, front directions and running area sum.
+pub(crate) struct MeshParts<'a> {
+    pub triangles: &'a [MeshTriangle],
+    pub double_sided: bool,
+    pub bvh: &'a MeshBvh,
+    pub fronts: &'a [DVec3],
+    pub cumulative_area: &'a [f64],
+}
+
+/// A prepared mesh light's [`MeshParts`]; `None` for other lights.
+pub(crate) fn parts(p: &Prepared) -> Option<MeshParts<'_>> {
     match (&p.light.kind, &p.kind) {
         (
             LightType::Mesh {
@@ -40,8 +43,19 @@ fn parts(
                 double_sided,
                 ..
             },
-            KindData::Mesh { bvh, fronts, .. },
-        ) => Some((&geometry.triangles, bvh, fronts, *double_sided)),
+            KindData::Mesh {
+                bvh,
+                fronts,
+                cumulative_area,
+                ..
+            },
+        ) => Some(MeshParts {
+            triangles: &geometry.triangles,
+            double_sided: *double_sided,
+            bvh,
+            fronts,
+            cumulative_area,
+        }),
         _ => None,
     }
 }
@@ -49,12 +63,12 @@ fn parts(
 /// M3 `emission(ω)`: `L(ω)` where some triangle emits along the unit direction `e`
 /// (`n·e > 0`, or `≠ 0` when double-sided), else 0.
 pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
-    let Some((_, _, fronts, double_sided)) = parts(p) else {
+    let Some(m) = parts(p) else {
         return DVec3::ZERO;
     };
-    let emits = fronts.iter().any(|n| {
+    let emits = m.fronts.iter().any(|n| {
         let c = n.dot(e);
-        c > 0.0 || (double_sided && c != 0.0)
+        c > 0.0 || (m.double_sided && c != 0.0)
     });
     if emits {
         p.base * shaping(p, e)
@@ -67,11 +81,11 @@ pub fn emission(p: &Prepared, e: DVec3) -> DVec3 {
 /// the emission back along −ω; 0 where it meets a non-emitting side (the mesh is opaque to its
 /// own light) or nothing.
 pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
-    let Some((_, bvh, _, double_sided)) = parts(p) else {
+    let Some(m) = parts(p) else {
         return DVec3::ZERO;
     };
-    match ray::first_hit(bvh, x, w) {
-        Some(h) if h.front || double_sided => p.base * shaping(p, -w),
+    match ray::first_hit(m.bvh, x, w) {
+        Some(h) if h.front || m.double_sided => p.base * shaping(p, -w),
         _ => DVec3::ZERO,
     }
 }
@@ -79,12 +93,12 @@ pub fn radiance(p: &Prepared, x: DVec3, w: DVec3) -> DVec3 {
 /// The emitting area visible from the unit direction `e` at infinity, projected on the plane
 /// ⟂ e, self-occlusion included: M3 `intensity(e) = L(e) · projected_area(e)`.
 pub fn projected_area(p: &Prepared, e: DVec3) -> f64 {
-    let Some((triangles, _, _, double_sided)) = parts(p) else {
+    let Some(m) = parts(p) else {
         return 0.0;
     };
     visible::Surface {
-        triangles,
-        double_sided,
+        triangles: m.triangles,
+        double_sided: m.double_sided,
     }
     .projected_area(e)
 }
@@ -94,12 +108,12 @@ pub fn projected_area(p: &Prepared, e: DVec3) -> f64 {
 /// formula clipped at the horizon (exact); shaped, the shaping of the emission direction `−ω`
 /// integrated over the same pieces.
 pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3, rel: f64) -> DVec3 {
-    let Some((triangles, _, _, double_sided)) = parts(p) else {
+    let Some(m) = parts(p) else {
         return DVec3::ZERO;
     };
     let surface = visible::Surface {
-        triangles,
-        double_sided,
+        triangles: m.triangles,
+        double_sided: m.double_sided,
     };
     if p.shaping.is_none() {
         return p.base * surface.cosine_solid_angle(x, n);

@@ -14,26 +14,18 @@
 use glam::DVec3;
 
 use super::ray;
-use crate::model::{LightType, MeshTriangle};
+use crate::model::MeshTriangle;
+use crate::prepare::Prepared;
 use crate::prepare::mesh_bvh::MeshBvh;
-use crate::prepare::{KindData, Prepared};
 
-/// A prepared mesh light's triangles, hierarchy and running area sum; `None` for other lights
-/// and for a mesh without area.
+/// A prepared mesh light's triangles, hierarchy and running area sum ([`super::parts`]);
+/// `None` for other lights and for a mesh without area.
 pub fn parts(p: &Prepared) -> Option<(&[MeshTriangle], &MeshBvh, &[f64])> {
-    match (&p.light.kind, &p.kind) {
-        (
-            LightType::Mesh { geometry, .. },
-            KindData::Mesh {
-                bvh,
-                cumulative_area,
-                ..
-            },
-        ) if cumulative_area.last().is_some_and(|a| *a > 0.0) => {
-            Some((&geometry.triangles, bvh, cumulative_area))
-        }
-        _ => None,
-    }
+    let m = super::parts(p)?;
+    m.cumulative_area
+        .last()
+        .is_some_and(|a| *a > 0.0)
+        .then_some((m.triangles, m.bvh, m.cumulative_area))
 }
 
 /// A direction from `x` toward a point drawn by area for `u` (u[0], u[1] the point, u[2] the

@@ -26,6 +26,7 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 
+use crate::cpu::irradiance::closed::clip_above;
 use crate::cpu::quadrature::{Tolerance, integrate};
 use crate::cpu::shaping::shaping;
 use crate::prepare::Prepared;
@@ -33,7 +34,7 @@ use crate::prepare::Prepared;
 /// `∫ S(−ω) max(0, n·ω) dω` over the convex planar polygon `verts` (vectors from the receiver,
 /// any orientation), S the light's RGB shaping factor, to relative tolerance `rel`.
 pub fn piece(p: &Prepared, verts: &[DVec3], n: DVec3, rel: f64) -> DVec3 {
-    let poly: Vec<DVec3> = clip_horizon(verts, n)
+    let poly: Vec<DVec3> = clip_above(verts, n)
         .into_iter()
         .filter_map(DVec3::try_normalize)
         .collect();
@@ -184,22 +185,6 @@ pub fn piece(p: &Prepared, verts: &[DVec3], n: DVec3, rel: f64) -> DVec3 {
         );
     }
     total
-}
-
-/// `q` clipped to the receiver's upper half-space `n·ω ≥ 0` (Sutherland–Hodgman).
-fn clip_horizon(q: &[DVec3], n: DVec3) -> Vec<DVec3> {
-    let mut out = Vec::with_capacity(q.len() + 1);
-    for i in 0..q.len() {
-        let (a, b) = (q[i], q[(i + 1) % q.len()]);
-        let (da, db) = (n.dot(a), n.dot(b));
-        if da >= 0.0 {
-            out.push(a);
-        }
-        if (da >= 0.0) != (db >= 0.0) {
-            out.push(a + (b - a) * (da / (da - db)));
-        }
-    }
-    out
 }
 
 /// The arcs `[a, b]` of φ (a < b, within one turn) where `ω(θ, φ) = c cos θ + sin θ (u cos φ +

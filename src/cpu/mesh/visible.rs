@@ -83,7 +83,6 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// Which sides emit.
-#[allow(dead_code)]
 pub(crate) struct Surface<'a> {
     pub triangles: &'a [MeshTriangle],
     pub double_sided: bool,
@@ -92,10 +91,12 @@ pub(crate) struct Surface<'a> {
 /// A visible part of one triangle as seen from x: its vertices as vectors from x (points of the
 /// triangle: convex, planar, in order), the triangle's index in the slice, and whether the side
 /// seen emits.
-#[allow(dead_code)]
 #[derive(Clone, Debug)]
 pub(crate) struct Piece {
     pub triangle: u32,
+    /// Whether the side seen emits: the callers ask for emitting pieces only
+    /// ([`Surface::emitting_above`]); the tests read it from [`Surface::visible_from`]'s.
+    #[cfg_attr(not(test), allow(dead_code))]
     pub emitting: bool,
     pub verts: Vec<DVec3>,
 }
@@ -134,14 +135,34 @@ const DEPTH_TOL: f64 = 1e-12;
 
 impl Surface<'_> {
     /// Every visible piece of the surface seen from x (both emitting and not), self-occlusion
-    /// exact.
-    #[allow(dead_code)]
+    /// exact: what the tests check coverage with (the queries need only
+    /// [`Surface::emitting_above`]).
+    #[cfg(test)]
     pub(crate) fn visible_from(&self, x: DVec3) -> Vec<Piece> {
+        self.collect_pieces(x, |_| true, |_| true)
+    }
+
+    /// The visible pieces seen from x of the emitting triangles with a point above the
+    /// horizon of the unit normal n: what irradiance integrates. A triangle wholly below the
+    /// horizon is left out as an occluder too: it can hide only directions below the horizon.
+    pub(crate) fn emitting_above(&self, x: DVec3, n: DVec3) -> Vec<Piece> {
+        let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
+        self.collect_pieces(x, |s| s.emitting && above(s), above)
+    }
+
+    /// The visible pieces of the triangles `wanted` accepts, hidden by those `occludes` accepts
+    /// ([`Surface::pieces_from`]), as [`Piece`]s.
+    fn collect_pieces(
+        &self,
+        x: DVec3,
+        wanted: impl Fn(&Seen) -> bool + Sync,
+        occludes: impl Fn(&Seen) -> bool + Sync,
+    ) -> Vec<Piece> {
         let mut out = Vec::new();
         self.pieces_from(
             x,
-            |_| true,
-            |_| true,
+            wanted,
+            occludes,
             |triangle, emitting, verts, _, out| {
                 out.push(Piece {
                     triangle,
@@ -154,34 +175,9 @@ impl Surface<'_> {
         out
     }
 
-    /// The visible pieces seen from x of the emitting triangles with a point above the
-    /// horizon of the unit normal n: what irradiance integrates. A triangle wholly below the
-    /// horizon is left out as an occluder too: it can hide only directions below the horizon.
-    pub(crate) fn emitting_above(&self, x: DVec3, n: DVec3) -> Vec<Piece> {
-        let above = |s: &Seen| s.q.iter().any(|q| n.dot(*q) > 0.0);
-        let mut out = Vec::new();
-        self.pieces_from(
-            x,
-            |s| s.emitting && above(s),
-            above,
-            |triangle, emitting, verts, _, out| {
-                if emitting {
-                    out.push(Piece {
-                        triangle,
-                        emitting,
-                        verts: verts.to_vec(),
-                    })
-                }
-            },
-            |piece| out.push(piece),
-        );
-        out
-    }
-
     /// Unit-radiance irradiance at x for the unit receiver normal n: the sum over the visible
     /// emitting pieces of Lambert's formula clipped at the horizon (the unshaped M3 irradiance
     /// over L).
-    #[allow(dead_code)]
     pub(crate) fn cosine_solid_angle(&self, x: DVec3, n: DVec3) -> f64 {
         let mut sum = 0.0;
         // Only emitting triangles with a vertex above the horizon can add anything; the others
@@ -205,7 +201,6 @@ impl Surface<'_> {
 
     /// The emitting area visible from direction w at infinity, projected on the plane ⟂ w
     /// (intensity(w) / L(w)). w need not be normalised; zero gives zero.
-    #[allow(dead_code)]
     pub(crate) fn projected_area(&self, w: DVec3) -> f64 {
         let w = w.normalize_or_zero();
         if w == DVec3::ZERO || self.triangles.is_empty() {
@@ -901,7 +896,6 @@ fn radon7() -> [([f64; 3], f64); 7] {
 /// triangle. Cells are split in four at their edges' midpoints pushed out to the sphere
 /// (geodesic subdivision: the four children tile the parent exactly), largest error first,
 /// the error of a cell being its rule value against its children's sum.
-#[allow(dead_code)]
 pub(crate) fn integrate_piece(
     verts: &[DVec3],
     n: DVec3,

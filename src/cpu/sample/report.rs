@@ -217,56 +217,30 @@ pub fn strategy_variance(
             out.luxeval = rel(integrate(&g_lux, range.0, range.1, depth, 2, tol).0, i);
             out.cosine = rel(integrate(&g_cos, range.0, range.1, depth, 2, tol).0, i);
         }
-        (LightType::Dome, _) => {
-            // The receiver's hemisphere about n: t = 1 − cos θ ∈ [0, 1].
+        (LightType::Dome | LightType::Mesh { .. }, _) => {
+            // The receiver's hemisphere about n: t = 1 − cos θ ∈ [0, 1] (a pdf of 0 where f > 0
+            // is an infinite variance, as f²/0 says).
             let dir = |t: f64, phi: f64| cone_dir(&n, t, phi);
             let g = |pdf: &dyn Fn(DVec3) -> f64, t: f64, phi: f64| {
                 let w = dir(t, phi);
                 let fv = f(w);
                 if fv > 0.0 { fv * fv / pdf(w) } else { 0.0 }
             };
-            let lux = |w: DVec3| at.pdf(p, x, w);
-            let uni = |_: DVec3| 1.0 / (4.0 * PI);
-            let cos = |w: DVec3| n.dot(w) / PI;
             let range = ((0.0, 1.0), (0.0, 2.0 * PI));
-            out.luxeval = rel(
-                integrate(&|t, ph| g(&lux, t, ph), range.0, range.1, depth, 3, tol).0,
-                i,
-            );
-            out.area = rel(
-                integrate(&|t, ph| g(&uni, t, ph), range.0, range.1, depth, 3, tol).0,
-                i,
-            );
-            out.cosine = rel(
-                integrate(&|t, ph| g(&cos, t, ph), range.0, range.1, depth, 3, tol).0,
-                i,
-            );
-        }
-        (LightType::Mesh { .. }, _) => {
-            // Over the receiver's hemisphere, as for a dome: luxeval's strategy is the uniform
-            // area density (cpu::mesh::sample), so the area baseline is the same figure.
-            let dir = |t: f64, phi: f64| cone_dir(&n, t, phi);
-            let g = |pdf: &dyn Fn(DVec3) -> f64, t: f64, phi: f64| {
-                let w = dir(t, phi);
-                let fv = f(w);
-                if !(fv > 0.0) {
-                    return 0.0;
-                }
-                let d = pdf(w);
-                if d > 0.0 { fv * fv / d } else { f64::INFINITY }
+            let variance = |pdf: &dyn Fn(DVec3) -> f64| {
+                rel(
+                    integrate(&|t, ph| g(pdf, t, ph), range.0, range.1, depth, 3, tol).0,
+                    i,
+                )
             };
-            let lux = |w: DVec3| at.pdf(p, x, w);
-            let cos = |w: DVec3| n.dot(w) / PI;
-            let range = ((0.0, 1.0), (0.0, 2.0 * PI));
-            out.luxeval = rel(
-                integrate(&|t, ph| g(&lux, t, ph), range.0, range.1, depth, 3, tol).0,
-                i,
-            );
-            out.area = out.luxeval;
-            out.cosine = rel(
-                integrate(&|t, ph| g(&cos, t, ph), range.0, range.1, depth, 3, tol).0,
-                i,
-            );
+            out.luxeval = variance(&|w| at.pdf(p, x, w));
+            out.cosine = variance(&|w| n.dot(w) / PI);
+            out.area = match p.light.kind {
+                // The area baseline of a dome at infinity: uniform over the sphere.
+                LightType::Dome => variance(&|_| 1.0 / (4.0 * PI)),
+                // A mesh light's strategy is the uniform area density (cpu::mesh::sample).
+                _ => out.luxeval,
+            };
         }
         (LightType::Distant { .. }, _) => {}
         _ => {
