@@ -4,51 +4,16 @@
 //! exact self-occluded irradiance at one receiver.
 //! `cargo bench --ignore-rust-version --features testkit --bench mesh_light`.
 //!
-//! The mesh is a bumpy torus (250 × 200 quads, fronts outward): non-convex, so rays and
-//! receivers meet self-occlusion.
-
-use std::f64::consts::TAU;
+//! The mesh is the synthetic bumpy torus (`testkit::torus`, 250 × 200 quads, fronts outward; the
+//! one `luxeval bench` times): non-convex, so rays and receivers meet self-occlusion.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DMat4, DVec3};
-use luxeval::testkit::Rng;
-use luxeval::{Accumulate, Evaluator, Light, MeshGeometry, MeshTopology};
-
-/// A torus of `around × across` quads (ring radius 2, tube 0.5, a bump of 5 % along the ring).
-fn torus(around: usize, across: usize) -> MeshGeometry {
-    let mut points = Vec::with_capacity(around * across);
-    for i in 0..around {
-        let a = TAU * i as f64 / around as f64;
-        for j in 0..across {
-            let b = TAU * j as f64 / across as f64;
-            let tube = 0.5 * (1.0 + 0.05 * (7.0 * a).sin());
-            let rho = 2.0 + tube * b.cos();
-            points.push([rho * a.cos(), tube * b.sin(), rho * a.sin()]);
-        }
-    }
-    let v = |i: usize, j: usize| ((i % around) * across + (j % across)) as i32;
-    let mut indices = Vec::with_capacity(4 * around * across);
-    for i in 0..around {
-        for j in 0..across {
-            indices.extend([v(i, j), v(i, j + 1), v(i + 1, j + 1), v(i + 1, j)]);
-        }
-    }
-    let counts = vec![4; around * across];
-    MeshGeometry::triangulate(
-        &MeshTopology {
-            points: &points,
-            face_vertex_counts: &counts,
-            face_vertex_indices: &indices,
-            hole_indices: &[],
-            left_handed: false,
-        },
-        DMat4::IDENTITY,
-    )
-    .expect("a valid torus")
-}
+use luxeval::testkit::{Rng, torus};
+use luxeval::{Accumulate, Evaluator, Light};
 
 fn mesh_light(c: &mut Criterion) {
-    let geometry = torus(250, 200);
+    let geometry = torus(250, 200).geometry(DMat4::IDENTITY);
     assert_eq!(geometry.triangles.len(), 100_000);
     let light = Light::mesh(geometry);
     let cpu = Evaluator::cpu();

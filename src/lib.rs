@@ -94,7 +94,7 @@ pub use query::{
 };
 #[cfg(feature = "usd")]
 pub use query::{lights_json, portal_multiplier};
-pub use synthetic::{Rng, synthetic_lights};
+pub use synthetic::{Rng, synthetic_lights, synthetic_mesh_light};
 #[cfg(feature = "usd")]
 pub use usd::{
     LightList, LinkCollection, RefusedInput, Stage, StageInfo, StageLight, TimeRule, UsdStage,

@@ -43,6 +43,7 @@ pub(crate) const ENV_MAX_MESH_TRIANGLES: &str = "LUXEVAL_MAX_MESH_TRIANGLES";
 /// around the chain; usd-core has no such limit). Not configurable: luxeval cannot change its USD
 /// reader, so a longer chain is refused with this limit named instead of being composed without
 /// its light. `tests/bad_inputs.rs` checks both sides of it.
+#[cfg(feature = "usd")]
 pub(crate) const MAX_ARC_DEPTH: u64 = 98;
 
 impl Default for Limits {

@@ -33,6 +33,7 @@ mod irradiance;
 mod layers;
 mod luxtest_check;
 mod math;
+mod mesh_conformance;
 mod mesh_lights;
 mod rect_conformance;
 mod resident;

@@ -37,6 +37,13 @@ pub struct BenchArgs {
     /// Skip the dome measurement.
     #[arg(long)]
     no_dome: bool,
+    /// Triangles of the synthetic mesh light (a bumpy torus) whose preparation, radiance and
+    /// exact irradiance are timed.
+    #[arg(long, default_value_t = 100_000)]
+    mesh_triangles: usize,
+    /// Skip the mesh-light measurement.
+    #[arg(long)]
+    no_mesh: bool,
     /// Skip the cold-start measurement (two child processes that open the GPU and compile every
     /// pipeline, without and with the pipeline cache).
     #[arg(long)]
@@ -106,6 +113,8 @@ struct Report {
     command_speedups: Vec<(String, f64)>,
     sweep: Vec<Row>,
     dome: Vec<crate::bench_dome::DomeRow>,
+    /// The mesh light's preparation, radiance and irradiance on each device.
+    mesh: Vec<crate::bench_mesh::MeshRow>,
     /// This process's peak resident set (Linux VmHWM), bytes.
     peak_rss_bytes: Option<u64>,
 }
@@ -208,6 +217,16 @@ pub fn run(args: BenchArgs) -> CliResult {
             args.lights,
             limits.max_prims,
             luxeval::Limits::raise_hint(luxeval::Limits::ENV_MAX_PRIMS)
+        )));
+    }
+    if !args.no_mesh
+        && (args.mesh_triangles < 18 || args.mesh_triangles as u64 > limits.max_mesh_triangles)
+    {
+        return Err(Failure::bad_input(format!(
+            "--mesh-triangles {} must be from 18 (the smallest torus) to the limit of {} ({})",
+            args.mesh_triangles,
+            limits.max_mesh_triangles,
+            luxeval::Limits::raise_hint(luxeval::Limits::ENV_MAX_MESH_TRIANGLES)
         )));
     }
     if args.repeat > MAX_REPEAT {
@@ -363,6 +382,15 @@ pub fn run(args: BenchArgs) -> CliResult {
             args.repeat.min(3),
         )?
     };
+    let mesh = if args.no_mesh {
+        Vec::new()
+    } else {
+        let on: Vec<(Evaluator, usize)> = evaluators
+            .iter()
+            .map(|(e, m)| (e.clone(), (*m).min(1 << 20)))
+            .collect();
+        crate::bench_mesh::run(&on, args.mesh_triangles, args.repeat.min(3))?
+    };
     if args.json {
         let report = Report {
             queries: rows,
@@ -373,6 +401,7 @@ pub fn run(args: BenchArgs) -> CliResult {
             command_speedups,
             sweep,
             dome,
+            mesh,
             peak_rss_bytes: peak_rss(),
         };
         outln!(
@@ -411,6 +440,29 @@ pub fn run(args: BenchArgs) -> CliResult {
             d.cpu_seconds
                 .map_or("n/a".to_string(), |c| format!("{c:.2} s"))
         );
+    }
+    for r in &mesh {
+        match r.query {
+            "prepare" => outln!(
+                "mesh light, {} triangles, prepared (BVH included) on {}: median {:.3} s",
+                r.triangles,
+                r.device,
+                r.median_seconds
+            ),
+            "radiance" => outln!(
+                "mesh light, {} triangles, radiance of {} rays on {}: {:.4e} rays/s",
+                r.triangles,
+                r.samples,
+                r.device,
+                r.per_second
+            ),
+            _ => outln!(
+                "mesh light, {} triangles, exact irradiance on {}: median {:.1} ms per receiver",
+                r.triangles,
+                r.device,
+                r.median_seconds / r.samples as f64 * 1e3
+            ),
+        }
     }
     for r in &latency {
         outln!(

@@ -18,6 +18,7 @@ mod args;
 mod bench;
 mod bench_command;
 mod bench_dome;
+mod bench_mesh;
 mod bench_startup;
 mod check;
 mod exit;

@@ -330,6 +330,7 @@ fn bench_command_times_the_command_on_each_device() {
         "--repeat",
         "2",
         "--no-dome",
+        "--no-mesh",
         "--no-startup",
         "--json",
         "--command",
@@ -355,6 +356,45 @@ fn bench_command_times_the_command_on_each_device() {
     let (shape, values) = read_npy_f32(&out);
     assert_eq!(shape, vec![4096, 3]);
     assert_eq!(values, studio_emission_on_cpu(Accumulate::Sum).1);
+}
+
+/// `bench` times a synthetic mesh light on each device: preparation, radiance and exact
+/// irradiance, with the triangle count asked for (a bumpy torus: 2 · 21 · 17 = 714 ≥ 700).
+#[test]
+fn bench_times_a_mesh_light_on_each_device() {
+    let gpu = common::gpu().is_some();
+    let o = luxeval(&[
+        "bench",
+        "--samples",
+        "256",
+        "--cpu-samples",
+        "256",
+        "--lights",
+        "1",
+        "--repeat",
+        "1",
+        "--no-dome",
+        "--no-startup",
+        "--mesh-triangles",
+        "700",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = v["mesh"].as_array().unwrap();
+    assert_eq!(rows.len(), 3 * (1 + usize::from(gpu)), "{rows:?}");
+    for r in rows {
+        let t = r["triangles"].as_u64().unwrap();
+        assert!((700..800).contains(&t), "{r}");
+        assert!(r["median_seconds"].as_f64().unwrap() > 0.0, "{r}");
+        let expect = match r["query"].as_str().unwrap() {
+            "prepare" => 1,
+            "radiance" => 256,
+            "irradiance" => 8,
+            other => panic!("unexpected mesh row {other}"),
+        };
+        assert_eq!(r["samples"].as_u64().unwrap(), expect, "{r}");
+    }
 }
 
 #[test]

@@ -80,6 +80,21 @@ pub fn radiance_samples(r: &Reference, n: usize, rng: &mut Rng) -> (Vec<[f32; 3]
                     rng.cone(-p.axis, (2.0 * p.distant_half_angle()).max(1e-3)),
                 )
             }
+            // A dome masked by portals (DESIGN.md §8 P2): most rays aim at a point of a
+            // portal's parallelogram grown by 10 % on each side (so that they cross its edges
+            // both ways) from its −Z side, where the crossing counts.
+            LightType::Dome
+                if p.portals.as_ref().is_some_and(|q| !q.is_empty()) && rng.chance(0.7) =>
+            {
+                let portals = p.portals.as_deref().unwrap_or_default();
+                let q = &portals[rng.below(portals.len())];
+                let (u, v) = (rng.range(-0.1, 1.1), rng.range(-0.1, 1.1));
+                let c = q.corners;
+                let target = c[0] + (c[1] - c[0]) * u + (c[3] - c[0]) * v;
+                let x = target - q.normal * rng.range(0.2, 4.0) + rng.unit() * rng.range(0.0, 2.0);
+                let w = (target - x).normalize();
+                (x, if w.is_finite() { w } else { rng.unit() })
+            }
             LightType::Dome => (
                 DVec3::new(
                     rng.range(-5.0, 5.0),
