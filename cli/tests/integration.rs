@@ -20,6 +20,7 @@ mod maps;
 mod mesh;
 mod pipeline_cache;
 mod portals;
+mod random_stages;
 mod robustness;
 mod sample;
 mod stream;
