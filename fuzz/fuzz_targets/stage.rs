@@ -50,6 +50,14 @@ pub fn load(ext: &str, data: &[u8]) {
         if let Ok(lights) = scene.evaluable(&[]) {
             for l in &lights {
                 let _ = luxeval::Reference::new(l, luxeval::TemperatureMode::Spec);
+                // Mask mode reads a dome's portals (whatever its `portals` relationship named).
+                if !l.portals.is_empty() {
+                    let _ = luxeval::Reference::with_portal_mode(
+                        l,
+                        luxeval::TemperatureMode::Spec,
+                        luxeval::PortalMode::Mask,
+                    );
+                }
             }
         }
     }
