@@ -104,6 +104,20 @@ class Stage:
     ) -> npt.NDArray[np.float32]:
         """Radiance leaving each light along each direction (N, 3) → float32 (N, 3), or
         (L, N, 3) with ``per_light=True``."""
+    def intensity(
+        self,
+        dirs: npt.ArrayLike,
+        *,
+        per_light: bool = False,
+        lights: Lights = None,
+        device: Device = "auto",
+        temperature_mode: TemperatureMode = "spec",
+        texture_filter: TextureFilter = "bilinear",
+        portal_mode: PortalMode = "hint",
+    ) -> npt.NDArray[np.float32]:
+        """Far-field intensity of each light along each direction (N, 3) → float32 (N, 3), or
+        (L, N, 3) with ``per_light=True``: emission × projected area (a mesh light's visible
+        emitting area); 0 for distant and dome lights."""
     def radiance(
         self,
         points: npt.ArrayLike,

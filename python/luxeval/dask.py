@@ -43,6 +43,7 @@ from ._luxeval import InputError, Stage
 
 __all__ = [
     "emission",
+    "intensity",
     "radiance",
     "irradiance",
     "sample",
@@ -250,6 +251,36 @@ def emission(
     """
     return _map(
         "emission",
+        stage,
+        [(dirs, "dirs")],
+        time=time,
+        per_light=per_light,
+        lights=lights,
+        device=device,
+        temperature_mode=temperature_mode,
+        texture_filter=texture_filter,
+        portal_mode=portal_mode,
+        chunks=chunks,
+    )
+
+
+def intensity(
+    stage: StageLike,
+    dirs: Any,
+    *,
+    time: Optional[float] = None,
+    per_light: bool = False,
+    lights: Union[None, str, Sequence[str]] = None,
+    device: str = "auto",
+    temperature_mode: str = "spec",
+    texture_filter: str = "bilinear",
+    portal_mode: str = "hint",
+    chunks: int = 1_000_000,
+) -> da.Array:
+    """:meth:`luxeval.Stage.intensity` over a dask array of directions (N, 3), lazily.
+    Arguments as :func:`emission`."""
+    return _map(
+        "intensity",
         stage,
         [(dirs, "dirs")],
         time=time,

@@ -70,6 +70,7 @@ type StageArgs = (String, Option<f64>);
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Query {
     Emission,
+    Intensity,
     Radiance,
     Irradiance,
 }
@@ -188,7 +189,7 @@ impl Stage {
         o: Options,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (a_name, a_kind, b_name) = match q {
-            Query::Emission => ("dirs", RowKind::Directions, ""),
+            Query::Emission | Query::Intensity => ("dirs", RowKind::Directions, ""),
             Query::Radiance => ("points", RowKind::Points, "dirs"),
             Query::Irradiance => ("points", RowKind::Points, "normals"),
         };
@@ -204,7 +205,7 @@ impl Stage {
             Some(b) => arrays::as_vec3(b)?,
             None => &[],
         };
-        if q != Query::Emission {
+        if !matches!(q, Query::Emission | Query::Intensity) {
             paired(a_name, a_rows.len(), b_name, b_rows.len())?;
         }
         let scene = self.prepare_for(py, &o)?;
@@ -235,6 +236,7 @@ impl Stage {
                     let a = &a_rows[start..end];
                     let rows = match q {
                         Query::Emission => scene.emission(a, acc),
+                        Query::Intensity => scene.intensity(a, acc),
                         Query::Radiance => scene.radiance(a, &b_rows[start..end], acc),
                         Query::Irradiance => o.irradiance(scene, a, &b_rows[start..end], acc),
                     }
@@ -474,6 +476,35 @@ impl Stage {
             portal_mode,
         )?;
         self.query(py, Query::Emission, dirs, None, per_light, o)
+    }
+
+    /// The far-field intensity of each light along each direction, ``emission × projected
+    /// area`` (cd for lights in nits; 0 for distant and dome lights, which are at infinity), as
+    /// ``luxeval intensity``. A mesh light's projected area is its visible emitting
+    /// area seen along ``dirs``, self-occlusion included.
+    ///
+    /// ``dirs``: (N, 3), any real dtype. Returns float32 (N, 3), or (L, N, 3) with
+    /// ``per_light=True``. Options and errors as ``emission``.
+    #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint"))]
+    fn intensity<'py>(
+        &self,
+        py: Python<'py>,
+        dirs: &Bound<'py, PyAny>,
+        per_light: bool,
+        lights: Option<&Bound<'py, PyAny>>,
+        device: &str,
+        temperature_mode: &str,
+        texture_filter: &str,
+        portal_mode: &str,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let o = Options::parse(
+            lights,
+            device,
+            temperature_mode,
+            texture_filter,
+            portal_mode,
+        )?;
+        self.query(py, Query::Intensity, dirs, None, per_light, o)
     }
 
     /// The radiance arriving at each point from each direction:

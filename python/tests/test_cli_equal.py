@@ -228,3 +228,18 @@ def test_mesh_light_queries_equal_cli(cli, tmp_path):
     want = cli_query(cli, tmp_path, "emission", NEON, {"dirs": dirs}, "--device", "cpu")
     np.testing.assert_array_equal(got, want)
     assert np.count_nonzero(got) > 0
+    # Intensity: the visible emitting area along each direction, self-occlusion included.
+    got = stage.intensity(dirs, device="cpu")
+    want = cli_query(cli, tmp_path, "intensity", NEON, {"dirs": dirs}, "--device", "cpu")
+    np.testing.assert_array_equal(got, want)
+    assert np.count_nonzero(got[:, 0]) > 150
+
+
+@pytest.mark.parametrize("per_light", [False, True], ids=["sum", "per-light"])
+def test_studio_intensity_equals_cli(cli, tmp_path, device, per_light):
+    dirs = np.load(STUDIO.parent / "dirs.npy")
+    got = luxeval.Stage(STUDIO).intensity(dirs, per_light=per_light, device=device)
+    want = cli_query(cli, tmp_path, "intensity", STUDIO, {"dirs": dirs}, *_flags(device, per_light))
+    assert got.dtype == np.float32 and got.shape == want.shape
+    np.testing.assert_array_equal(got, want)
+    assert np.count_nonzero(got) > 0

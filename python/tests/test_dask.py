@@ -33,6 +33,7 @@ def test_two_workers_give_the_single_process_result(client):
     up = np.abs(sphere_dirs(4000, seed=23))
     lazy = {
         "emission": ldask.emission(STUDIO, da.from_array(dirs, chunks=(500, 3))),
+        "intensity": ldask.intensity(STUDIO, da.from_array(dirs, chunks=(1000, 3)), per_light=True),
         "radiance": ldask.radiance(
             str(STUDIO), da.from_array(points, chunks=(500, 3)), da.from_array(up, chunks=(700, 3)),
             per_light=True,
@@ -49,6 +50,8 @@ def test_two_workers_give_the_single_process_result(client):
 
     stage = luxeval.Stage(STUDIO)
     np.testing.assert_array_equal(got["emission"], stage.emission(dirs))
+    np.testing.assert_array_equal(got["intensity"], stage.intensity(dirs, per_light=True))
+    assert got["intensity"].shape == (6, 4000, 3) and np.count_nonzero(got["intensity"]) > 0
     np.testing.assert_array_equal(got["radiance"], stage.radiance(points, up, per_light=True))
     np.testing.assert_array_equal(
         got["irradiance"],
@@ -57,7 +60,7 @@ def test_two_workers_give_the_single_process_result(client):
     )
     assert np.count_nonzero(got["emission"]) > 0 and np.count_nonzero(got["radiance"]) > 0
 
-    # 20 chunks over two workers: each worker opened the stage at most once and prepared each
+    # 24 chunks over two workers: each worker opened the stage at most once and prepared each
     # light selection once.
     info = client.run(ldask.cache_info)
     assert len(info) == 2
