@@ -153,9 +153,9 @@ pub enum KindData {
 }
 
 /// Where the GPU path takes a light's values from: the one decision, made per light when it is
-/// prepared, that the record (`FLAG_HOST_IRRADIANCE`, or a record that emits nothing), the
-/// host's sums in `query::PreparedScene`, the GPU-resident refusals and the conformance check
-/// all read.
+/// prepared, that the record (`FLAG_HOST_IRRADIANCE`, `FLAG_MESH_FRONTS`, or a record that emits
+/// nothing), the mesh atlas, the host's sums in `query::PreparedScene`, the GPU-resident
+/// refusals and the conformance check all read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GpuPath {
     /// Every query on the device.
@@ -172,18 +172,41 @@ pub enum GpuPath {
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
+    /// - Domes masked by portals (§8 P2 mask mode): emission is the dome's own and radiance
+    ///   tests the portal crossings on the device (shaders/portal.wgsl, the portals in the mesh
+    ///   atlas); irradiance needs the portals' visible pieces (cpu::portal::irradiance), which
+    ///   have no kernel. A dome's intensity is 0 on both paths.
     HostIrradiance(&'static str),
-    /// Radiance on the device (the first hit through the mesh's BVH, shaders/mesh/ray.wgsl);
-    /// emission, intensity and irradiance from the CPU reference: mesh lights (DESIGN.md §7).
-    /// Their emission tests every distinct front direction, their intensity and irradiance
-    /// need the exact visible pieces (cpu::mesh::visible): none has a kernel yet.
+    /// Emission and radiance on the device (the mesh's distinct front directions and its BVH in
+    /// the mesh atlas: shaders/emission.wgsl, shaders/mesh/ray.wgsl); intensity and irradiance
+    /// from the CPU reference: mesh lights (DESIGN.md §7) with at most
+    /// [`MESH_FRONTS_ON_DEVICE`] front directions. Their intensity and irradiance need the exact
+    /// visible pieces (cpu::mesh::visible), which have no kernel.
+    HostIntensity(&'static str),
+    /// Radiance on the device; emission, intensity and irradiance from the CPU reference: mesh
+    /// lights with more than [`MESH_FRONTS_ON_DEVICE`] front directions (the emission kernel
+    /// tests each in turn).
     RadianceOnDevice(&'static str),
     /// Every query from the CPU reference: mesh lights the device cannot hold or traverse (a
     /// hierarchy deeper than the kernel's stack, more data than [`MESH_DEVICE_BYTES`], a
-    /// singular transform), and domes masked by portals (§8 P2 mask mode), until a kernel
-    /// tests portal crossings. The record the kernels see emits nothing.
+    /// singular transform), and domes masked by more than [`PORTALS_ON_DEVICE`] portals. The
+    /// record the kernels see emits nothing.
     Host(&'static str),
 }
+
+/// The most distinct front directions of a mesh light whose emission the kernel tests
+/// ([`GpuPath::HostIntensity`]); a mesh with more takes its emission from the host
+/// ([`GpuPath::RadianceOnDevice`]). The kernel loops once per direction: 4096 keeps one mesh
+/// well inside lavapipe's 65,535 loop iterations per invocation (with room for a dozen such
+/// meshes in one dispatch) and bounds the cost of a direction that no front faces (every front
+/// is read) at about the cost of a BVH traversal; flat, boxy and low-polygon lights have a
+/// handful, a smooth closed mesh about as many as triangles (those past 4096 stay on the host).
+pub const MESH_FRONTS_ON_DEVICE: usize = 4096;
+
+/// The most portals of a masked dome whose crossings the radiance kernel tests (one loop
+/// iteration each, for lavapipe's budget as [`MESH_FRONTS_ON_DEVICE`]); a dome masked by more is
+/// evaluated on the host ([`GpuPath::Host`]).
+pub const PORTALS_ON_DEVICE: usize = 4096;
 
 /// The most bytes of BVH nodes and triangles one mesh light may take on the device (32 bytes a
 /// node, 40 a triangle: about 800,000 triangles); a larger mesh is evaluated on the host
@@ -248,9 +271,19 @@ impl Prepared {
         !matches!(self.gpu_path, GpuPath::Device)
     }
 
-    /// Whether the GPU path takes this light's emission and intensity from the CPU reference
-    /// ([`Prepared::gpu_path`]): some query besides irradiance is the host's.
+    /// Whether the GPU path takes this light's intensity from the CPU reference
+    /// ([`Prepared::gpu_path`]): some query besides irradiance is the host's (a light whose
+    /// emission is the host's has its intensity there too). Sampling reads it: a scene holding
+    /// such a light is sampled on the CPU reference.
     pub fn on_host(&self) -> bool {
+        matches!(
+            self.gpu_path,
+            GpuPath::HostIntensity(_) | GpuPath::RadianceOnDevice(_) | GpuPath::Host(_)
+        )
+    }
+
+    /// Whether the GPU path takes this light's emission from the CPU reference.
+    pub fn emission_on_host(&self) -> bool {
         matches!(
             self.gpu_path,
             GpuPath::RadianceOnDevice(_) | GpuPath::Host(_)
@@ -263,16 +296,21 @@ impl Prepared {
     }
 
     /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
-    /// portals is masked, and every query of it on a GPU evaluator is the CPU reference's
-    /// (there is no portal kernel). Hint mode changes nothing.
+    /// portals is masked; on a GPU evaluator its emission and radiance are the device's (the
+    /// radiance kernel tests the portal crossings) and its irradiance the CPU reference's
+    /// ([`GpuPath::HostIrradiance`]). Hint mode changes nothing.
     pub fn apply_portal_mode(
         &mut self,
         mode: PortalMode,
         temperature: TemperatureMode,
     ) -> Result<()> {
         self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
-        if self.portals.is_some() {
-            self.gpu_path = GpuPath::Host("it is masked by portals");
+        if let Some(portals) = &self.portals {
+            self.gpu_path = if portals.len() > PORTALS_ON_DEVICE {
+                GpuPath::Host("it is masked by more portals than the radiance kernel tests")
+            } else {
+                GpuPath::HostIrradiance("it is masked by portals")
+            };
         }
         Ok(())
     }
@@ -415,7 +453,7 @@ impl Prepared {
                 KindData::Shape
             }
         };
-        let gpu_path = if let KindData::Mesh { bvh, .. } = &kind {
+        let gpu_path = if let KindData::Mesh { bvh, fronts, .. } = &kind {
             let bytes = 32 * bvh.nodes.len() as u64 + 40 * bvh.order.len() as u64;
             if bvh.depth() > MESH_STACK {
                 GpuPath::Host("it is a mesh light whose BVH is deeper than the kernel's stack")
@@ -423,8 +461,12 @@ impl Prepared {
                 GpuPath::Host("it is a mesh light too large for the device")
             } else if !to_local.is_finite() {
                 GpuPath::Host("it is a mesh light with a singular transform")
+            } else if fronts.len() > MESH_FRONTS_ON_DEVICE {
+                GpuPath::RadianceOnDevice(
+                    "it is a mesh light facing more directions than the emission kernel tests",
+                )
             } else {
-                GpuPath::RadianceOnDevice("it is a mesh light")
+                GpuPath::HostIntensity("it is a mesh light")
             }
         } else if ies.is_some() {
             GpuPath::HostIrradiance("it is IES-shaped")
