@@ -34,6 +34,7 @@ mod layers;
 mod luxtest_check;
 mod math;
 mod mesh_lights;
+mod portal_gpu;
 mod rect_conformance;
 mod resident;
 mod robustness;

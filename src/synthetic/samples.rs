@@ -80,14 +80,27 @@ pub fn radiance_samples(r: &Reference, n: usize, rng: &mut Rng) -> (Vec<[f32; 3]
                     rng.cone(-p.axis, (2.0 * p.distant_half_angle()).max(1e-3)),
                 )
             }
-            LightType::Dome => (
-                DVec3::new(
+            LightType::Dome => {
+                let x = DVec3::new(
                     rng.range(-5.0, 5.0),
                     rng.range(-5.0, 5.0),
                     rng.range(-5.0, 5.0),
-                ),
-                rng.unit(),
-            ),
+                );
+                match &p.portals {
+                    // A masked dome (DESIGN.md §8 P2): half the rays aim at a point on or just
+                    // beyond one of its portals, so that crossings and their edges are tested
+                    // (a uniform direction from a random point rarely meets a small window).
+                    Some(portals) if !portals.is_empty() && rng.chance(0.5) => {
+                        let q = &portals[(rng.range(0.0, portals.len() as f64) as usize)
+                            .min(portals.len() - 1)];
+                        let (a, b) = (rng.range(-0.1, 1.1), rng.range(-0.1, 1.1));
+                        let c = q.corners;
+                        let target = c[0] + a * (c[1] - c[0]) + b * (c[3] - c[0]);
+                        (x, (target - x).try_normalize().unwrap_or(DVec3::Z))
+                    }
+                    _ => (x, rng.unit()),
+                }
+            }
             _ => {
                 // Origin in local space: a random direction at 1.05..6 sizes from the centre,
                 // biased to the emitting side for one-sided shapes.
