@@ -116,6 +116,96 @@ fn up(v: f64) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{Light, MeshGeometry, MeshTopology, Portal};
+    use crate::prepare::{GpuPath, MESH_FRONTS_ON_DEVICE, PortalMode, Prepared, TemperatureMode};
+    use glam::{DMat4, DVec3};
+
+    /// A fan of `k` triangles about the origin, each tilted differently: `k` distinct fronts.
+    fn fan(k: usize) -> Light {
+        let mut points = vec![[0.0, 0.0, 0.0]];
+        for i in 0..=k {
+            let t = 3.0 * i as f64 / k as f64;
+            points.push([t.cos(), t.sin(), 0.1 * (i % 7) as f64]);
+        }
+        let counts = vec![3; k];
+        let indices: Vec<i32> = (0..k as i32).flat_map(|i| [0, i + 1, i + 2]).collect();
+        let geometry = MeshGeometry::triangulate(
+            &MeshTopology {
+                points: &points,
+                face_vertex_counts: &counts,
+                face_vertex_indices: &indices,
+                hole_indices: &[],
+                left_handed: false,
+            },
+            DMat4::IDENTITY,
+        )
+        .unwrap();
+        Light::mesh(geometry)
+    }
+
+    fn prep(l: &Light) -> Prepared {
+        Prepared::new(l, TemperatureMode::Spec).unwrap()
+    }
+
+    /// A mesh facing at most MESH_FRONTS_ON_DEVICE directions has its fronts in the atlas after
+    /// its triangles (`tex.w`: the count, then xyz each); one facing more has none, and its
+    /// emission is the host's (the one decision, GpuPath).
+    #[test]
+    fn fronts_follow_the_triangles_up_to_the_cap() {
+        let small = prep(&fan(10));
+        assert_eq!(small.gpu_path, GpuPath::HostIntensity("it is a mesh light"));
+        let big = prep(&fan(MESH_FRONTS_ON_DEVICE + 1));
+        assert!(matches!(big.gpu_path, GpuPath::RadianceOnDevice(_)));
+        assert!(big.emission_on_host() && !big.radiance_on_host());
+        let (data, words) = scene_atlas(&[small.clone(), big]);
+        let w = words[0].unwrap();
+        let KindData::Mesh { fronts, bvh, .. } = &small.kind else {
+            unreachable!()
+        };
+        assert_eq!(fronts.len(), 10);
+        assert_eq!(w[3], w[2] + TRIANGLE_WORDS * bvh.order.len() as u32);
+        assert_eq!(data[w[3] as usize].to_bits(), 10);
+        for (k, n) in fronts.iter().enumerate() {
+            let at = w[3] as usize + 1 + 3 * k;
+            assert_eq!(&data[at..at + 3], &n.to_array().map(|c| c as f32));
+        }
+        assert_eq!(words[1].unwrap()[3], 0);
+    }
+
+    /// A masked dome's portals: count, then PORTAL_WORDS each, in order; `tex.w` their offset.
+    #[test]
+    fn portals_are_packed_in_order() {
+        let dome = Light::dome()
+            .with_portal(
+                Portal::new(2.0, 1.0)
+                    .with_transform(DMat4::from_translation(DVec3::new(0.0, 0.0, 3.0)))
+                    .with_intensity(2.0),
+            )
+            .with_portal(
+                Portal::new(1.0, 4.0).with_transform(DMat4::from_scale(DVec3::splat(2.0))),
+            );
+        let mut p = prep(&dome);
+        p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
+            .unwrap();
+        assert_eq!(
+            p.gpu_path,
+            GpuPath::HostIrradiance("it is masked by portals")
+        );
+        let (data, words) = scene_atlas(&[prep(&fan(3)), p]);
+        let at = words[1].unwrap()[3] as usize;
+        assert!(at > 0);
+        assert_eq!(data[at].to_bits(), 2);
+        let first = &data[at + 1..at + 1 + PORTAL_WORDS as usize];
+        assert_eq!(&first[..6], &[0.0, 0.0, 3.0, 0.0, 0.0, 1.0]);
+        assert_eq!(&first[15..], &[1.0, 0.5, 2.0, 2.0, 2.0]);
+        let second = &data[at + 1 + PORTAL_WORDS as usize..];
+        assert_eq!(second.len(), PORTAL_WORDS as usize);
+        // World → local of a uniform scale 2: rows of 0.5·I; half extents in local units.
+        assert_eq!(
+            &second[6..17],
+            &[0.5, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 0.5, 2.0]
+        );
+    }
 
     #[test]
     fn boxes_round_outward() {

@@ -103,8 +103,8 @@ pub struct Prepared {
     pub ies: Option<PreparedIes>,
     /// What only this kind of light carries.
     pub kind: KindData,
-    /// Where the GPU path takes this light's irradiance from, decided once here (see
-    /// [`GpuPath`]).
+    /// Which of this light's queries the GPU path takes from the device and which from the CPU
+    /// reference, decided once here (see [`GpuPath`]).
     pub gpu_path: GpuPath,
     /// The files on disk its assets were read from (IES profile, TILT file, texture, or the
     /// package holding them), so that no output is written over one of them.
@@ -113,7 +113,8 @@ pub struct Prepared {
     /// [`zero_size`]).
     pub warning: Option<String>,
     /// A dome masked by its portals (DESIGN.md §8 P2, [`PortalMode::Mask`]): the portals light
-    /// reaches a point through (possibly none that pass light: then the dome lights nothing).
+    /// reaches a point through (possibly none that pass light: then the dome lights nothing). On
+    /// the device they are in the mesh atlas (`gpu::mesh_atlas`, shaders/portal.wgsl).
     /// `None`: not masked (hint mode, another type, a dome naming no visible portal).
     pub portals: Option<Vec<PreparedPortal>>,
 }
