@@ -81,7 +81,7 @@ fn portals() -> Vec<(Portal, DMat4, f64, f64)> {
         .enumerate()
         .map(|(i, (world, w, h, (intensity, exposure, color)))| {
             let p = Portal::new(w, h)
-                .with_path(&format!("/P{i}"))
+                .with_path(format!("/P{i}"))
                 .with_transform(world)
                 .with_intensity(intensity)
                 .with_exposure(exposure)
