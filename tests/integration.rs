@@ -33,6 +33,7 @@ mod irradiance;
 mod layers;
 mod luxtest_check;
 mod math;
+mod mesh_emission_gpu;
 mod mesh_lights;
 mod portal_gpu;
 mod rect_conformance;
