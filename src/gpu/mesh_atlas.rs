@@ -172,6 +172,24 @@ mod tests {
         assert_eq!(words[1].unwrap()[3], 0);
     }
 
+    /// A dome masked by more portals than the kernel tests (lavapipe's loop budget) stays on the
+    /// host on every query, and nothing of it goes to the atlas.
+    #[test]
+    fn a_dome_masked_by_too_many_portals_stays_on_the_host() {
+        let dome = (0..=crate::prepare::PORTALS_ON_DEVICE).fold(Light::dome(), |l, i| {
+            l.with_portal(
+                Portal::new(0.5, 0.5)
+                    .with_transform(DMat4::from_translation(DVec3::new(i as f64, 0.0, 3.0))),
+            )
+        });
+        let mut p = prep(&dome);
+        p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
+            .unwrap();
+        assert!(matches!(p.gpu_path, GpuPath::Host(_)) && p.radiance_on_host());
+        let (data, words) = scene_atlas(&[p]);
+        assert!(data.is_empty() && words == [None]);
+    }
+
     /// A masked dome's portals: count, then PORTAL_WORDS each, in order; `tex.w` their offset.
     #[test]
     fn portals_are_packed_in_order() {
