@@ -71,13 +71,14 @@ pub fn mesh_edge_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, w: D
 /// How far the ray `x + tω`, t > 0, is from changing which portal of a masked dome it passes
 /// through (DESIGN.md §8 P2), as a rect light's silhouette is measured (the fraction of the
 /// portal's larger half extent): the crossing point's distance to each portal's edges, the
-/// ray's origin's distance to each portal's plane, and the grazing angle. The minimum over every
+/// ray's origin's distance to each portal's plane, and the grazing angle, minimised over every
 /// portal whose plane the ray meets (a crossing toward −Z or outside the rectangle may turn into
-/// one that counts under f32 rounding, and a near tie in depth between two portals changes the
-/// multiplier: both are caught by the edge and plane distances of a portal the ray nearly
-/// meets).
+/// one that counts under f32 rounding); and the relative gap in depth between the nearest
+/// crossing that counts and the next (where two portals cut through each other the nearer may
+/// change, and with it the multiplier).
 pub fn portal_margin(portals: &[crate::prepare::PreparedPortal], x: DVec3, w: DVec3) -> f64 {
     let mut m = f64::INFINITY;
+    let mut depths = Vec::new();
     for q in portals {
         let xl = q.to_local * (x - q.origin);
         let dl = q.to_local * w;
@@ -86,7 +87,15 @@ pub fn portal_margin(portals: &[crate::prepare::PreparedPortal], x: DVec3, w: DV
         if dl.z != 0.0 && -xl.z / dl.z > 0.0 {
             let h = xl - xl.z / dl.z * dl;
             m = m.min(((h.x.abs() - q.half.x).abs() / s).min((h.y.abs() - q.half.y).abs() / s));
+            if dl.z > 0.0 && h.x.abs() <= q.half.x && h.y.abs() <= q.half.y {
+                // t in world units: the local z advances dl.z a unit of t.
+                depths.push(-xl.z / dl.z);
+            }
         }
+    }
+    depths.sort_by(f64::total_cmp);
+    if let [a, b, ..] = depths[..] {
+        m = m.min((b - a) / b);
     }
     m
 }
