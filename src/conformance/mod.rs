@@ -10,9 +10,12 @@
 //! - within [`BAND`] rad of a distant light's cone edge, of the one-sided horizon of a rect or
 //!   disk, or of a cylinder's axis direction;
 //! - within [`CONE_BAND`]·θcone of a ShapingAPI cone edge, hard or soft (see its docs);
+//! - for a mesh light's emission, directions within `BAND` rad of edge-on to every front that
+//!   could decide it (DESIGN.md §7 M3);
 //! - for radiance, a shape's silhouette: the hit point or the closest approach within `BAND` of
 //!   the boundary (as a fraction of the shape's size), grazing rays, and ray origins within
-//!   `BAND` of the surface;
+//!   `BAND` of the surface; for a masked dome (§8 P2) the same of each portal's rectangle, and
+//!   near ties in depth between two portals crossed (`band::portal_margin`);
 //! - for intensity, also directions that see a rect or disk nearly edge-on or a cylinder
 //!   nearly end-on (the projected area is a vanishing cosine): see [`intensity_margin`];
 //! - for irradiance, receivers that see only a sliver of the light (at the receiver's horizon,
