@@ -47,7 +47,8 @@ fn mesh_light(c: &mut Criterion) {
         })
     });
     // The same rays on a GPU evaluator, where there is one (the kernel traverses the BVH on
-    // the device: GpuPath::RadianceOnDevice); Mesa's lavapipe proves it runs, not its speed.
+    // the device: GpuPath::HostIntensity or RadianceOnDevice); Mesa's lavapipe proves it runs,
+    // not its speed.
     match Evaluator::gpu() {
         Ok(g) => {
             let dev = g

@@ -28,8 +28,23 @@ fn emission(light: Record, e: vec3<f32>) -> vec3<f32> {
             return surface_emission(light, e) * rect_mean(light);
         }
         case KIND_MESH: {
-            // GpuPath::RadianceOnDevice: a mesh light's emission (and so its intensity) is the
-            // CPU reference's, added on the host.
+            // DESIGN.md §7 M3 (cpu::mesh::emission): L(e) where some front faces e, strictly
+            // n·e > 0 (either side when double-sided, n·e ≠ 0). Without FLAG_MESH_FRONTS
+            // (GpuPath::RadianceOnDevice) the emission is the CPU reference's, added on the
+            // host; intensity always is.
+            if !has_flag(light, FLAG_MESH_FRONTS) {
+                return vec3<f32>(0.0);
+            }
+            let at = light.tex.w;
+            let count = bitcast<u32>(mesh_atlas[at]);
+            let double_sided = has_flag(light, FLAG_DOUBLE_SIDED);
+            for (var k = 0u; k < count; k++) {
+                let q = at + 1u + 3u * k;
+                let c = dot(vec3<f32>(mesh_atlas[q], mesh_atlas[q + 1u], mesh_atlas[q + 2u]), e);
+                if c > 0.0 || (double_sided && c != 0.0) {
+                    return base * shaping(light, e);
+                }
+            }
             return vec3<f32>(0.0);
         }
         case KIND_CYLINDER: {

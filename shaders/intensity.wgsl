@@ -26,6 +26,8 @@ fn projected_area(light: Record, e: vec3<f32>) -> f32 {
         case KIND_CYLINDER: {
             a = 4.0 * light.size.x * light.size.y * length(v.yz);
         }
+        // Distant and dome lights: 0 (at infinity). Mesh lights: 0, their intensity is the
+        // host's (GpuPath::HostIntensity), though their emission is the kernel's.
         default: {}
     }
     return a * light.irr.y;

@@ -8,6 +8,7 @@
 // #import shared/record.wgsl
 // #import shared/shapes.wgsl
 // #import mesh/ray.wgsl
+// #import portal.wgsl
 // #import emission.wgsl
 
 fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
@@ -15,6 +16,15 @@ fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
         case KIND_DOME: {
             // A dome's emission is indexed by the direction toward the environment (DESIGN.md
             // §3), which is w itself.
+            if has_flag(light, FLAG_PORTALS) {
+                // Masked (§8 P2): through the nearest portal crossed toward its +Z, else 0
+                // (cpu::portal::radiance).
+                let m = crossing(light.tex.w, x, w);
+                if m.w == 0.0 {
+                    return vec3<f32>(0.0);
+                }
+                return emission(light, w) * m.xyz;
+            }
             return emission(light, w);
         }
         case KIND_DISTANT: {

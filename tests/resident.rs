@@ -515,21 +515,29 @@ fn counts_over_the_binding_limit_are_refused_with_the_most_one_call_takes() {
     assert_eq!(got, host);
 }
 
-/// A dome masked by its portals (DESIGN.md §8 P2 mask mode) is every query's CPU reference on a
-/// GPU evaluator (`GpuPath::Host`), so the GPU-resident queries refuse it by name; in hint mode
-/// the same dome runs on the device.
+/// A dome masked by its portals (DESIGN.md §8 P2 mask mode) has its emission and radiance on
+/// the device (`GpuPath::HostIrradiance`): the GPU-resident `encode_emission` and
+/// `encode_radiance` give the host path's values, and `encode_irradiance` refuses it by name;
+/// in hint mode the same dome runs on the device as without portals.
 #[test]
-fn masked_domes_are_refused_by_name_and_hint_mode_runs_on_the_device() {
+fn masked_domes_run_emission_and_radiance_on_the_device_and_refuse_irradiance_by_name() {
     let Some(r) = renderer() else { return };
     let dome = Light::dome().with_path("/World/Sky").with_portal(
         luxeval::Portal::new(2.0, 1.0)
             .with_path("/World/Window")
+            .with_intensity(3.0)
             .with_transform(glam::DMat4::from_translation(glam::DVec3::new(
                 0.0, 0.0, 3.0,
             ))),
     );
     let n = 16;
-    let dirs = r.buffer(&vec![[0.0, 0.0, 1.0]; n], wgpu::BufferUsages::STORAGE);
+    let up = vec![[0.0, 0.0, 1.0]; n];
+    // Half the points under the window (lit through it), half beside it (dark).
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|i| [if i % 2 == 0 { 0.1 } else { 5.0 }, 0.2, 0.0])
+        .collect();
+    let dirs = r.buffer(&up, wgpu::BufferUsages::STORAGE);
+    let pts = r.buffer(&points, wgpu::BufferUsages::STORAGE);
     let out = r.output(n);
     for mode in [luxeval::PortalMode::Hint, luxeval::PortalMode::Mask] {
         let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone())
@@ -537,11 +545,32 @@ fn masked_domes_are_refused_by_name_and_hint_mode_runs_on_the_device() {
             .with_portal_mode(mode);
         let scene = eval.prepare(std::slice::from_ref(&dome)).unwrap();
         let mut enc = r.encoder();
-        let got = scene.encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum);
-        match (mode, got) {
-            (luxeval::PortalMode::Hint, Ok(_)) => {
-                assert_eq!(r.finish(enc, &out, n), vec![[1.0; 3]; n]);
-            }
+        scene
+            .encode_emission(&mut enc, &dirs, &out, n as u32, Accumulate::Sum)
+            .unwrap();
+        assert_eq!(r.finish(enc, &out, n), vec![[1.0; 3]; n], "{mode:?}");
+        let mut enc = r.encoder();
+        scene
+            .encode_radiance(&mut enc, &pts, &dirs, &out, n as u32, Accumulate::Sum)
+            .unwrap();
+        let got = r.finish(enc, &out, n);
+        assert_eq!(
+            got,
+            scene.radiance(&points, &up, Accumulate::Sum).unwrap(),
+            "{mode:?}"
+        );
+        let want: Vec<[f32; 3]> = (0..n)
+            .map(|i| match (mode, i % 2) {
+                (luxeval::PortalMode::Mask, 0) => [3.0; 3],
+                (luxeval::PortalMode::Mask, _) => [0.0; 3],
+                _ => [1.0; 3],
+            })
+            .collect();
+        assert_eq!(got, want, "{mode:?}");
+        let mut enc = r.encoder();
+        let irr = scene.encode_irradiance(&mut enc, &pts, &dirs, &out, n as u32, Accumulate::Sum);
+        match (mode, irr) {
+            (luxeval::PortalMode::Hint, Ok(_)) => {}
             (luxeval::PortalMode::Mask, Err(e @ LuxError::NotOnDevice { .. })) => {
                 let text = e.to_string();
                 assert!(

@@ -109,4 +109,17 @@ fn check_says_a_mesh_light_is_not_compared() {
         text.contains("/NeonRing: not compared: it is a mesh light") && text.contains("radiance"),
         "{text}"
     );
+    // Emission and radiance run on the device (GpuPath::HostIntensity): both rows compared.
+    for q in ["emission", "radiance"] {
+        assert!(
+            text.lines()
+                .any(|l| l.contains(" Mesh ") && l.contains(q) && l.trim_end().ends_with("ok")),
+            "{q}: {text}"
+        );
+    }
+    assert!(
+        !text
+            .lines()
+            .any(|l| l.contains(" Mesh ") && l.contains("intensity"))
+    );
 }

@@ -150,3 +150,56 @@ fn every_scene_command_takes_portal_mode() {
     );
     assert!(!out.exists());
 }
+
+/// `check` on the window room in mask mode compares the masked dome's emission and radiance
+/// (on the device since the portal kernel, shaders/portal.wgsl) and lists it as not compared for
+/// nothing: its irradiance is the host's (nothing to compare), as for a textured dome.
+#[test]
+fn check_compares_a_masked_domes_radiance() {
+    if crate::common::gpu().is_none() {
+        return;
+    }
+    let o = luxeval(&[
+        "check",
+        &asset("window_room.usda"),
+        "--portal-mode",
+        "mask",
+        "--samples",
+        "400",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    let row = |q: &str| {
+        rows.iter()
+            .find(|r| r["light"] == "/World/Sky" && r["query"] == q)
+            .unwrap_or_else(|| panic!("no {q} row: {v}"))
+    };
+    let radiance = row("radiance");
+    assert!(radiance["samples"].as_u64().unwrap() > 0, "{radiance}");
+    assert!(
+        radiance["nonzero"].as_u64().unwrap() > 0,
+        "nothing lit: {radiance}"
+    );
+    assert_eq!(radiance["pass"], true, "{radiance}");
+    assert!(row("emission")["samples"].as_u64().unwrap() > 0);
+    // Irradiance is the host's (GpuPath::HostIrradiance): no row, or one of no samples.
+    assert!(
+        rows.iter()
+            .all(|r| r["query"] != "irradiance" || r["samples"] == 0),
+        "{v}"
+    );
+    assert!(
+        v["host_only"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|h| h[0] != "/World/Sky"),
+        "{v}"
+    );
+    eprintln!(
+        "window room, mask mode: radiance {} samples, {} excluded, {} lit, worst {}",
+        radiance["samples"], radiance["excluded"], radiance["nonzero"], radiance["max_rel_error"]
+    );
+}

@@ -45,6 +45,8 @@ struct Record {
     // Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0); in the
     // sample and pdf kernels' copy a textured dome's z is its sampling table's offset (0: none;
     // gpu::sample::SampleLights).
+    // A masked dome (FLAG_PORTALS): w is its portals' offset in the mesh atlas. A mesh light:
+    // (nodes' offset, node count, triangles' offset, fronts' offset) in the mesh atlas.
     tex: vec4<u32>,
     kind: u32,
     flags: u32,
@@ -91,7 +93,8 @@ struct Params {
 @group(0) @binding(5) var<storage, read> ies_atlas: array<f32>;
 // Every dome and rect texture of the scene (shared/texture.wgsl reads it; layout in src/gpu/texture_atlas.rs).
 @group(0) @binding(6) var<storage, read> tex_atlas: array<f32>;
-// Every mesh light's BVH and triangles (mesh/ray.wgsl reads it; layout in src/gpu/mesh_atlas.rs).
+// Every mesh light's BVH, triangles and fronts, and every masked dome's portals (mesh/ray.wgsl,
+// emission.wgsl and portal.wgsl read it; layout in src/gpu/mesh_atlas.rs).
 @group(0) @binding(7) var<storage, read> mesh_atlas: array<f32>;
 
 fn sample_index(gid: vec3<u32>) -> u32 {

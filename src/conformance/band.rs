@@ -68,6 +68,38 @@ pub fn mesh_edge_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, w: D
     m
 }
 
+/// How far the ray `x + tω`, t > 0, is from changing which portal of a masked dome it passes
+/// through (DESIGN.md §8 P2), as a rect light's silhouette is measured (the fraction of the
+/// portal's larger half extent): the crossing point's distance to each portal's edges, the
+/// ray's origin's distance to each portal's plane, and the grazing angle, minimised over every
+/// portal whose plane the ray meets (a crossing toward −Z or outside the rectangle may turn into
+/// one that counts under f32 rounding); and the relative gap in depth between the nearest
+/// crossing that counts and the next (where two portals cut through each other the nearer may
+/// change, and with it the multiplier).
+pub fn portal_margin(portals: &[crate::prepare::PreparedPortal], x: DVec3, w: DVec3) -> f64 {
+    let mut m = f64::INFINITY;
+    let mut depths = Vec::new();
+    for q in portals {
+        let xl = q.to_local * (x - q.origin);
+        let dl = q.to_local * w;
+        let s = q.half.x.max(q.half.y);
+        m = m.min(xl.z.abs() / s).min(dl.normalize().z.abs());
+        if dl.z != 0.0 && -xl.z / dl.z > 0.0 {
+            let h = xl - xl.z / dl.z * dl;
+            m = m.min(((h.x.abs() - q.half.x).abs() / s).min((h.y.abs() - q.half.y).abs() / s));
+            if dl.z > 0.0 && h.x.abs() <= q.half.x && h.y.abs() <= q.half.y {
+                // t in world units: the local z advances dl.z a unit of t.
+                depths.push(-xl.z / dl.z);
+            }
+        }
+    }
+    depths.sort_by(f64::total_cmp);
+    if let [a, b, ..] = depths[..] {
+        m = m.min((b - a) / b);
+    }
+    m
+}
+
 /// Distance of an emission direction from the light's discontinuities, in radians.
 pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
     let p = &r.p;
@@ -92,8 +124,22 @@ pub fn emission_margin(r: &Reference, e: DVec3) -> f64 {
             }
         }
         LightType::Sphere { .. } => {}
-        // Evaluated on the host on every backend (GpuPath::Host): nothing to band.
-        LightType::Mesh { .. } => {}
+        // DESIGN.md §7 M3: L(e) where some front faces e. Where one faces it by more than BAND
+        // rad the f32 test agrees; else the nearest front to edge-on decides.
+        LightType::Mesh { double_sided, .. } => {
+            if let crate::prepare::KindData::Mesh { fronts, .. } = &p.kind {
+                let facing = |n: &DVec3| {
+                    let c = n.dot(e);
+                    if double_sided { c.abs() } else { c }
+                };
+                if !fronts.iter().any(|n| facing(n).asin() > BAND) {
+                    let near = fronts
+                        .iter()
+                        .map(|n| n.dot(e).clamp(-1.0, 1.0).asin().abs());
+                    m = m.min(near.fold(f64::INFINITY, f64::min));
+                }
+            }
+        }
     }
     if let (Some(s), true) = (&p.light.shaping, p.light.kind.is_shapeable()) {
         // The cone edge, hard or soft: scaled so that the band is BAND where
@@ -219,6 +265,8 @@ pub fn radiance_margin(r: &Reference, x: DVec3, w: DVec3) -> f64 {
     let dl = p.to_local * w;
     let u = dl.normalize();
     let m_shape = match p.light.kind {
+        // A masked dome (§8 P2): the ray's crossings of its portals' edges and planes.
+        LightType::Dome if let Some(portals) = &p.portals => portal_margin(portals, x, w),
         LightType::Distant { .. } | LightType::Dome => f64::INFINITY,
         LightType::Mesh { ref geometry, .. } => mesh_edge_margin(&geometry.triangles, x, w),
         LightType::Sphere {

@@ -10,9 +10,12 @@
 //! - within [`BAND`] rad of a distant light's cone edge, of the one-sided horizon of a rect or
 //!   disk, or of a cylinder's axis direction;
 //! - within [`CONE_BAND`]·θcone of a ShapingAPI cone edge, hard or soft (see its docs);
+//! - for a mesh light's emission, directions within `BAND` rad of edge-on to every front that
+//!   could decide it (DESIGN.md §7 M3);
 //! - for radiance, a shape's silhouette: the hit point or the closest approach within `BAND` of
 //!   the boundary (as a fraction of the shape's size), grazing rays, and ray origins within
-//!   `BAND` of the surface;
+//!   `BAND` of the surface; for a masked dome (§8 P2) the same of each portal's rectangle, and
+//!   near ties in depth between two portals crossed (`band::portal_margin`);
 //! - for intensity, also directions that see a rect or disk nearly edge-on or a cylinder
 //!   nearly end-on (the projected area is a vanishing cosine): see [`intensity_margin`];
 //! - for irradiance, receivers that see only a sliver of the light (at the receiver's horizon,
@@ -92,8 +95,8 @@ pub struct CheckReport {
     pub excluded: usize,
     pub rows: Vec<QueryReport>,
     /// The lights some or all of whose queries the CPU reference answers on every device
-    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`: mesh lights), with what is not compared
-    /// and why.
+    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`, `GpuPath::HostIntensity`: mesh lights),
+    /// with what is not compared and why.
     pub host_only: Vec<(String, String)>,
 }
 
@@ -199,6 +202,13 @@ pub fn check_with(
                      on every device (its radiance is compared)"
                 ),
             )),
+            crate::prepare::GpuPath::HostIntensity(why) => host_only.push((
+                p.light.path.clone(),
+                format!(
+                    "{why}, whose intensity and irradiance the CPU reference answers on every \
+                     device (its emission and radiance are compared)"
+                ),
+            )),
             _ => {}
         }
         let scene = PreparedScene::from_prepared(eval.backend().clone(), vec![p.clone()])?;
@@ -210,8 +220,12 @@ pub fn check_with(
                 format!("cannot check on this device: {w}"),
             ));
         }
-        // Emission (not for a light whose emission and intensity the host computes).
-        let samples = if p.on_host() { 0 } else { counts.emission };
+        // Emission (not for a light whose emission the host computes).
+        let samples = if p.emission_on_host() {
+            0
+        } else {
+            counts.emission
+        };
         let dirs = emission_samples(r, samples, &mut rng);
         let got = scene.emission(&dirs, Accumulate::Sum)?;
         rows.push(compare(r, CheckedQuery::Emission, samples, |i| {
@@ -227,7 +241,12 @@ pub fn check_with(
         }));
         // Intensity, on the same directions: `L(ω)·A⊥(ω)`, whose discontinuities are the
         // emission's (the one-sided horizon zeroes both), plus the edge-on sliver.
-        let ni = counts.intensity.min(dirs.len());
+        // Not for a light whose intensity the host computes (mesh lights).
+        let ni = if p.on_host() {
+            0
+        } else {
+            counts.intensity.min(dirs.len())
+        };
         let got = scene.intensity(&dirs[..ni], Accumulate::Sum)?;
         rows.push(compare(r, CheckedQuery::Intensity, ni, |i| {
             let e = dvec(dirs[i]).normalize();

@@ -1,5 +1,5 @@
-//! A dome masked by its portals (DESIGN.md §8 P2, mask mode) on the CPU (f64). No WGSL twin: a
-//! masked dome is evaluated on the host on every device (`GpuPath::Host`).
+//! A dome masked by its portals (DESIGN.md §8 P2, mask mode) on the CPU (f64). Twin of
+//! `shaders/portal.wgsl` (`crossing`); irradiance has no kernel (`GpuPath::HostIrradiance`).
 //!
 //! - `radiance(x, ω)`: the dome's radiance along ω ⊙ the multiplier of the nearest portal the
 //!   ray `x + tω`, t > 0, passes through moving toward the portal's +Z (against the light it
@@ -175,7 +175,10 @@ mod tests {
             .with_diffuse(0.7)
             .with_portal(portal);
         let p = mask(&dome);
-        assert_eq!(p.gpu_path, GpuPath::Host("it is masked by portals"));
+        assert_eq!(
+            p.gpu_path,
+            GpuPath::HostIrradiance("it is masked by portals")
+        );
         let corners = [(-1.0, -0.5), (1.0, -0.5), (1.0, 0.5), (-1.0, 0.5)]
             .map(|(a, b)| world.transform_point3(DVec3::new(a, b, 0.0)));
         let l = DVec3::new(2.0, 1.0, 0.5) * DVec3::new(6.0, 3.0, 1.5) * 0.7;
@@ -561,7 +564,9 @@ mod tests {
         assert_eq!(e, DVec3::ZERO);
     }
 
-    /// On a GPU evaluator a masked dome is the CPU reference's on every query (GpuPath::Host).
+    /// On a GPU evaluator a masked dome's emission and radiance are the device's (within f32
+    /// rounding of the reference: these rays pass far from the portals' edges) and its
+    /// irradiance and intensity the reference's (GpuPath::HostIrradiance).
     #[test]
     fn gpu_takes_masked_domes_from_the_reference() {
         let Some(gpu) = crate::query::test_gpu() else {
@@ -572,18 +577,27 @@ mod tests {
         let points = vec![[0.1f32, 0.0, 0.0]; 3];
         let cpu = Evaluator::cpu().with_portal_mode(PortalMode::Mask);
         let gpu = gpu.with_portal_mode(PortalMode::Mask);
+        let close = |a: Vec<[f32; 3]>, b: Vec<[f32; 3]>| {
+            assert_eq!(a.len(), b.len());
+            for (a, b) in a.iter().zip(&b) {
+                let (a, b) = (DVec3::from(a.map(f64::from)), DVec3::from(b.map(f64::from)));
+                assert!(
+                    (a - b).abs().max_element() <= 1e-4 * b.abs().max_element(),
+                    "{a} vs {b}"
+                );
+            }
+        };
         for acc in [Accumulate::Sum, Accumulate::PerLight] {
-            assert_eq!(
-                gpu.radiance(&l, &points, &dirs, acc).unwrap(),
-                cpu.radiance(&l, &points, &dirs, acc).unwrap()
+            let got = gpu.radiance(&l, &points, &dirs, acc).unwrap();
+            assert!(got.iter().any(|v| v[0] > 0.0), "nothing lit: {got:?}");
+            close(got, cpu.radiance(&l, &points, &dirs, acc).unwrap());
+            close(
+                gpu.emission(&l, &dirs, acc).unwrap(),
+                cpu.emission(&l, &dirs, acc).unwrap(),
             );
             assert_eq!(
                 gpu.irradiance(&l, &points, &dirs, acc).unwrap(),
                 cpu.irradiance(&l, &points, &dirs, acc).unwrap()
-            );
-            assert_eq!(
-                gpu.emission(&l, &dirs, acc).unwrap(),
-                cpu.emission(&l, &dirs, acc).unwrap()
             );
             assert_eq!(
                 gpu.intensity(&l, &dirs, acc).unwrap(),

@@ -1,41 +1,72 @@
-//! Every mesh light's BVH and triangles in one f32 array per scene, for the radiance kernel's
-//! first-hit traversal (shaders/mesh/ray.wgsl; DESIGN.md §7 M3). Per mesh light, from its base
-//! offset:
+//! Every mesh light's BVH, triangles and front directions, and every masked dome's portals, in
+//! one f32 array per scene: what the kernels read of a light beyond its record. Per mesh light,
+//! from its base offset:
 //! - its nodes, 8 words each: the box's min xyz and max xyz, rounded outward to f32 (so the f32
 //!   traversal never skips a box the f64 one enters), then `first` and `count` as u32 bits
 //!   (prepare::mesh_bvh's layout: a leaf holds `count > 0` triangles from `first`; an inner
 //!   node's left child is the next node, its right child `first`);
 //! - then its triangles in the leaves' order, 10 words each: `p0`, `p1 − p0`, `p2 − p0` (the
 //!   edges subtracted in f64, then rounded), and the triangle's index in face and fan order as
-//!   u32 bits (ties keep the lower, as the CPU reference does).
+//!   u32 bits (ties keep the lower, as the CPU reference does);
+//! - where its emission is the device's (`GpuPath::HostIntensity`), its distinct front
+//!   directions (`KindData::Mesh::fronts`, DESIGN.md §7 M3 emission): their count as u32 bits,
+//!   then 3 words each, in prepare's order (largest area first).
 //!
-//! The record's `tex` holds (nodes' offset, node count, triangles' offset, 0).
+//! The record's `tex` holds (nodes' offset, node count, triangles' offset, fronts' offset) and
+//! `FLAG_MESH_FRONTS` says the fronts are there.
+//!
+//! Per masked dome (`Prepared::portals`, DESIGN.md §8 P2; read by shaders/portal.wgsl): the
+//! portal count as u32 bits, then [`PORTAL_WORDS`] words a portal, in the `portals`
+//! relationship's order (ties go to the earlier): origin xyz, unit normal xyz, the world → local
+//! map's rows (3 × 3), half width and height, multiplier rgb. The record's `tex.w` holds the
+//! block's offset and `FLAG_PORTALS` says it is there (a textured dome keeps `tex.xyz`).
 
-use crate::prepare::{GpuPath, KindData, Prepared};
+use crate::prepare::{KindData, Prepared};
 
-/// Words per node and per triangle.
+/// Words per node, per triangle and per portal.
 pub const NODE_WORDS: u32 = 8;
 pub const TRIANGLE_WORDS: u32 = 10;
+pub const PORTAL_WORDS: u32 = 20;
 
-/// The constants shaders/mesh/ray.wgsl reads from the WGSL prelude.
-pub fn wgsl_constants() -> [(&'static str, u32); 3] {
+/// The constants shaders/mesh/ray.wgsl and shaders/portal.wgsl read from the WGSL prelude.
+pub fn wgsl_constants() -> [(&'static str, u32); 4] {
     [
         ("MESH_NODE_WORDS", NODE_WORDS),
         ("MESH_TRIANGLE_WORDS", TRIANGLE_WORDS),
         ("MESH_STACK", crate::prepare::MESH_STACK as u32),
+        ("PORTAL_WORDS", PORTAL_WORDS),
     ]
 }
 
-/// The scene's mesh atlas and, per light, its `tex` words where the kernel traverses it.
+/// The scene's mesh atlas and, per light, its `tex` words where the kernels read the atlas for
+/// it: a mesh light's four (the fronts' offset 0 where its emission is the host's), a masked
+/// dome's `[0, 0, 0, portals' offset]`.
 pub fn scene_atlas(lights: &[Prepared]) -> (Vec<f32>, Vec<Option<[u32; 4]>>) {
     let mut data: Vec<f32> = Vec::new();
     let offsets = lights
         .iter()
         .map(|p| {
-            let KindData::Mesh { bvh, .. } = &p.kind else {
+            if let Some(portals) = &p.portals {
+                if p.radiance_on_host() {
+                    return None;
+                }
+                let at = data.len() as u32;
+                data.push(f32::from_bits(portals.len() as u32));
+                for q in portals {
+                    data.extend(q.origin.to_array().map(|c| c as f32));
+                    data.extend(q.normal.to_array().map(|c| c as f32));
+                    for i in 0..3 {
+                        data.extend(q.to_local.row(i).to_array().map(|c| c as f32));
+                    }
+                    data.extend(q.half.to_array().map(|c| c as f32));
+                    data.extend(q.multiplier.to_array().map(|c| c as f32));
+                }
+                return Some([0, 0, 0, at]);
+            }
+            let KindData::Mesh { bvh, fronts, .. } = &p.kind else {
                 return None;
             };
-            if !matches!(p.gpu_path, GpuPath::RadianceOnDevice(_)) {
+            if p.radiance_on_host() {
                 return None;
             }
             let nodes = data.len() as u32;
@@ -56,7 +87,15 @@ pub fn scene_atlas(lights: &[Prepared]) -> (Vec<f32>, Vec<Option<[u32; 4]>>) {
                 }
                 data.push(f32::from_bits(i));
             }
-            Some([nodes, bvh.nodes.len() as u32, triangles, 0])
+            let mut front_words = 0;
+            if !p.emission_on_host() {
+                front_words = data.len() as u32;
+                data.push(f32::from_bits(fronts.len() as u32));
+                for n in fronts.iter() {
+                    data.extend(n.to_array().map(|c| c as f32));
+                }
+            }
+            Some([nodes, bvh.nodes.len() as u32, triangles, front_words])
         })
         .collect();
     (data, offsets)
@@ -77,6 +116,114 @@ fn up(v: f64) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::{Light, MeshGeometry, MeshTopology, Portal};
+    use crate::prepare::{GpuPath, MESH_FRONTS_ON_DEVICE, PortalMode, Prepared, TemperatureMode};
+    use glam::{DMat4, DVec3};
+
+    /// A fan of `k` triangles about the origin, each tilted differently: `k` distinct fronts.
+    fn fan(k: usize) -> Light {
+        let mut points = vec![[0.0, 0.0, 0.0]];
+        for i in 0..=k {
+            let t = 3.0 * i as f64 / k as f64;
+            points.push([t.cos(), t.sin(), 0.1 * (i % 7) as f64]);
+        }
+        let counts = vec![3; k];
+        let indices: Vec<i32> = (0..k as i32).flat_map(|i| [0, i + 1, i + 2]).collect();
+        let geometry = MeshGeometry::triangulate(
+            &MeshTopology {
+                points: &points,
+                face_vertex_counts: &counts,
+                face_vertex_indices: &indices,
+                hole_indices: &[],
+                left_handed: false,
+            },
+            DMat4::IDENTITY,
+        )
+        .unwrap();
+        Light::mesh(geometry)
+    }
+
+    fn prep(l: &Light) -> Prepared {
+        Prepared::new(l, TemperatureMode::Spec).unwrap()
+    }
+
+    /// A mesh facing at most MESH_FRONTS_ON_DEVICE directions has its fronts in the atlas after
+    /// its triangles (`tex.w`: the count, then xyz each); one facing more has none, and its
+    /// emission is the host's (the one decision, GpuPath).
+    #[test]
+    fn fronts_follow_the_triangles_up_to_the_cap() {
+        let small = prep(&fan(10));
+        assert_eq!(small.gpu_path, GpuPath::HostIntensity("it is a mesh light"));
+        let big = prep(&fan(MESH_FRONTS_ON_DEVICE + 1));
+        assert!(matches!(big.gpu_path, GpuPath::RadianceOnDevice(_)));
+        assert!(big.emission_on_host() && !big.radiance_on_host());
+        let (data, words) = scene_atlas(&[small.clone(), big]);
+        let w = words[0].unwrap();
+        let KindData::Mesh { fronts, bvh, .. } = &small.kind else {
+            unreachable!()
+        };
+        assert_eq!(fronts.len(), 10);
+        assert_eq!(w[3], w[2] + TRIANGLE_WORDS * bvh.order.len() as u32);
+        assert_eq!(data[w[3] as usize].to_bits(), 10);
+        for (k, n) in fronts.iter().enumerate() {
+            let at = w[3] as usize + 1 + 3 * k;
+            assert_eq!(&data[at..at + 3], &n.to_array().map(|c| c as f32));
+        }
+        assert_eq!(words[1].unwrap()[3], 0);
+    }
+
+    /// A dome masked by more portals than the kernel tests (lavapipe's loop budget) stays on the
+    /// host on every query, and nothing of it goes to the atlas.
+    #[test]
+    fn a_dome_masked_by_too_many_portals_stays_on_the_host() {
+        let dome = (0..=crate::prepare::PORTALS_ON_DEVICE).fold(Light::dome(), |l, i| {
+            l.with_portal(
+                Portal::new(0.5, 0.5)
+                    .with_transform(DMat4::from_translation(DVec3::new(i as f64, 0.0, 3.0))),
+            )
+        });
+        let mut p = prep(&dome);
+        p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
+            .unwrap();
+        assert!(matches!(p.gpu_path, GpuPath::Host(_)) && p.radiance_on_host());
+        let (data, words) = scene_atlas(&[p]);
+        assert!(data.is_empty() && words == [None]);
+    }
+
+    /// A masked dome's portals: count, then PORTAL_WORDS each, in order; `tex.w` their offset.
+    #[test]
+    fn portals_are_packed_in_order() {
+        let dome = Light::dome()
+            .with_portal(
+                Portal::new(2.0, 1.0)
+                    .with_transform(DMat4::from_translation(DVec3::new(0.0, 0.0, 3.0)))
+                    .with_intensity(2.0),
+            )
+            .with_portal(
+                Portal::new(1.0, 4.0).with_transform(DMat4::from_scale(DVec3::splat(2.0))),
+            );
+        let mut p = prep(&dome);
+        p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
+            .unwrap();
+        assert_eq!(
+            p.gpu_path,
+            GpuPath::HostIrradiance("it is masked by portals")
+        );
+        let (data, words) = scene_atlas(&[prep(&fan(3)), p]);
+        let at = words[1].unwrap()[3] as usize;
+        assert!(at > 0);
+        assert_eq!(data[at].to_bits(), 2);
+        let first = &data[at + 1..at + 1 + PORTAL_WORDS as usize];
+        assert_eq!(&first[..6], &[0.0, 0.0, 3.0, 0.0, 0.0, 1.0]);
+        assert_eq!(&first[15..], &[1.0, 0.5, 2.0, 2.0, 2.0]);
+        let second = &data[at + 1 + PORTAL_WORDS as usize..];
+        assert_eq!(second.len(), PORTAL_WORDS as usize);
+        // World → local of a uniform scale 2: rows of 0.5·I; half extents in local units.
+        assert_eq!(
+            &second[6..17],
+            &[0.5, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 0.5, 2.0]
+        );
+    }
 
     #[test]
     fn boxes_round_outward() {

@@ -55,6 +55,12 @@ pub const FLAG_HOST_IRRADIANCE: u32 = 4096;
 pub const FLAG_SHEARED_RECT: u32 = 8192;
 /// A mesh light whose triangles emit from both sides (`doubleSided`, DESIGN.md §7 M2).
 pub const FLAG_DOUBLE_SIDED: u32 = 16384;
+/// A mesh light whose front directions are in the mesh atlas at `tex.w`: its emission is the
+/// device's (`GpuPath::HostIntensity`, `super::mesh_atlas`).
+pub const FLAG_MESH_FRONTS: u32 = 32768;
+/// A dome masked by portals, which are in the mesh atlas at `tex.w` (DESIGN.md §8 P2 mask
+/// mode; `super::mesh_atlas`, shaders/portal.wgsl).
+pub const FLAG_PORTALS: u32 = 65536;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -83,6 +89,8 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_HOST_IRRADIANCE", FLAG_HOST_IRRADIANCE),
     ("FLAG_SHEARED_RECT", FLAG_SHEARED_RECT),
     ("FLAG_DOUBLE_SIDED", FLAG_DOUBLE_SIDED),
+    ("FLAG_MESH_FRONTS", FLAG_MESH_FRONTS),
+    ("FLAG_PORTALS", FLAG_PORTALS),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
     ("SELECT_POWER", SELECT_POWER),
     ("SELECT_BOUND", SELECT_BOUND),
@@ -112,7 +120,9 @@ pub struct Record {
     pub tex_inv: [[f32; 4]; 3],
     /// Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0); in the
     /// sample and pdf kernels' copy a textured dome's `tex[2]` is its sampling table's offset
-    /// (0: none; `gpu::sample::SampleLights`).
+    /// (0: none; `gpu::sample::SampleLights`). A masked dome (FLAG_PORTALS): `tex[3]` is its
+    /// portals' offset in the mesh atlas. A mesh light: its words in the mesh atlas
+    /// (`gpu::mesh_atlas`).
     pub tex: [u32; 4],
     pub kind: u32,
     pub flags: u32,
@@ -191,12 +201,13 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 
 /// Rounds a prepared light's f64 constants to its GPU record; `ies_base` is where its IES
 /// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture
-/// starts in the scene's texture atlas (`gpu::texture_atlas`).
+/// starts in the scene's texture atlas (`gpu::texture_atlas`), `atlas` its `tex` words in the
+/// scene's mesh atlas (`gpu::mesh_atlas`: a mesh light's, a masked dome's).
 pub fn pack(
     p: &Prepared,
     ies_base: Option<u32>,
     tex_offset: Option<u32>,
-    mesh: Option<[u32; 4]>,
+    atlas: Option<[u32; 4]>,
 ) -> Record {
     if p.radiance_on_host() {
         return host_record();
@@ -313,14 +324,25 @@ pub fn pack(
                 [(length / 2.0) as f32, radius as f32, 0.0, 0.0],
             )
         }
-        LightType::Dome => (KIND_DOME, [0.0; 4]),
+        LightType::Dome => {
+            // A masked dome (GpuPath::HostIrradiance): its portals' offset in the mesh atlas.
+            if let (Some(_), Some(words)) = (&p.portals, atlas) {
+                r.flags |= FLAG_PORTALS;
+                r.tex[3] = words[3];
+            }
+            (KIND_DOME, [0.0; 4])
+        }
         LightType::Mesh { double_sided, .. } => {
             if double_sided {
                 r.flags |= FLAG_DOUBLE_SIDED;
             }
-            // GpuPath::RadianceOnDevice: the kernels traverse its BVH for radiance; emission,
-            // intensity and irradiance are the host's (they give 0 for KIND_MESH).
-            r.tex = mesh.unwrap_or([0; 4]);
+            // The kernels traverse its BVH for radiance and, where its emission is the device's
+            // (GpuPath::HostIntensity), test its fronts; intensity and irradiance are the host's
+            // (they give 0 for KIND_MESH), and emission too under GpuPath::RadianceOnDevice.
+            r.tex = atlas.unwrap_or([0; 4]);
+            if !p.emission_on_host() {
+                r.flags |= FLAG_MESH_FRONTS;
+            }
             (KIND_MESH, [0.0; 4])
         }
     };
@@ -330,7 +352,7 @@ pub fn pack(
 }
 
 /// The record of a light every query takes from the CPU reference (`GpuPath::Host`: mesh
-/// lights): a `treatAsPoint` sphere of zero radiance at the origin, with an identity frame, so
+/// lights the device cannot hold, domes masked by too many portals): a `treatAsPoint` sphere of zero radiance at the origin, with an identity frame, so
 /// that every kernel gives exactly 0 for it and the sampling kernels' light choice never picks
 /// it (its luminance weight is 0); the host adds the reference's values.
 fn host_record() -> Record {

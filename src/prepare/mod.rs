@@ -9,6 +9,7 @@ pub mod alias;
 pub mod assets;
 pub mod blackbody;
 pub mod env_table;
+pub mod gpu_path;
 pub mod ies;
 pub mod ies_kinks;
 pub mod mesh_bvh;
@@ -27,6 +28,9 @@ use crate::model::{Light, LightType, Shaping, Texture, UpAxis};
 use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
+pub use gpu_path::{
+    GpuPath, MESH_DEVICE_BYTES, MESH_FRONTS_ON_DEVICE, MESH_STACK, PORTALS_ON_DEVICE,
+};
 pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
 
@@ -103,8 +107,8 @@ pub struct Prepared {
     pub ies: Option<PreparedIes>,
     /// What only this kind of light carries.
     pub kind: KindData,
-    /// Where the GPU path takes this light's irradiance from, decided once here (see
-    /// [`GpuPath`]).
+    /// Which of this light's queries the GPU path takes from the device and which from the CPU
+    /// reference, decided once here (see [`GpuPath`]).
     pub gpu_path: GpuPath,
     /// The files on disk its assets were read from (IES profile, TILT file, texture, or the
     /// package holding them), so that no output is written over one of them.
@@ -113,7 +117,8 @@ pub struct Prepared {
     /// [`zero_size`]).
     pub warning: Option<String>,
     /// A dome masked by its portals (DESIGN.md §8 P2, [`PortalMode::Mask`]): the portals light
-    /// reaches a point through (possibly none that pass light: then the dome lights nothing).
+    /// reaches a point through (possibly none that pass light: then the dome lights nothing). On
+    /// the device they are in the mesh atlas (`gpu::mesh_atlas`, shaders/portal.wgsl).
     /// `None`: not masked (hint mode, another type, a dome naming no visible portal).
     pub portals: Option<Vec<PreparedPortal>>,
 }
@@ -151,48 +156,6 @@ pub enum KindData {
         bound_radius: f64,
     },
 }
-
-/// Where the GPU path takes a light's values from: the one decision, made per light when it is
-/// prepared, that the record (`FLAG_HOST_IRRADIANCE`, or a record that emits nothing), the
-/// host's sums in `query::PreparedScene`, the GPU-resident refusals and the conformance check
-/// all read.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum GpuPath {
-    /// Every query on the device.
-    Device,
-    /// Every query on the device but irradiance, which is the CPU reference's until the f32
-    /// quadrature can match it; the reason is a phrase ("it is IES-shaped"):
-    /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as
-    ///   the reference's line integrals do, and misses lit features narrower than its nodes
-    ///   (measured: up to 100 % on receivers that see a thin lit band of a striped profile).
-    /// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
-    ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a
-    ///   dome's irradiance depends on the normal only, so the reference evaluates it once per
-    ///   distinct normal (one for a whole falloff map).
-    /// - Textured rects: the exact integral of the filtered texture over the surface, split at
-    ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
-    ///   (src/cpu/irradiance/rect_texture.rs).
-    HostIrradiance(&'static str),
-    /// Radiance on the device (the first hit through the mesh's BVH, shaders/mesh/ray.wgsl);
-    /// emission, intensity and irradiance from the CPU reference: mesh lights (DESIGN.md §7).
-    /// Their emission tests every distinct front direction, their intensity and irradiance
-    /// need the exact visible pieces (cpu::mesh::visible): none has a kernel yet.
-    RadianceOnDevice(&'static str),
-    /// Every query from the CPU reference: mesh lights the device cannot hold or traverse (a
-    /// hierarchy deeper than the kernel's stack, more data than [`MESH_DEVICE_BYTES`], a
-    /// singular transform), and domes masked by portals (§8 P2 mask mode), until a kernel
-    /// tests portal crossings. The record the kernels see emits nothing.
-    Host(&'static str),
-}
-
-/// The most bytes of BVH nodes and triangles one mesh light may take on the device (32 bytes a
-/// node, 40 a triangle: about 800,000 triangles); a larger mesh is evaluated on the host
-/// ([`GpuPath::Host`]), so that a scene's meshes fit WebGPU's default storage binding limit
-/// (128 MiB) with room for others.
-pub const MESH_DEVICE_BYTES: u64 = 48 << 20;
-
-/// The deepest BVH the radiance kernel traverses: its stack holds this many nodes.
-pub const MESH_STACK: usize = 64;
 
 impl Prepared {
     /// A distant light's θmax (half its angular diameter, radians); 0 for other types.
@@ -248,9 +211,19 @@ impl Prepared {
         !matches!(self.gpu_path, GpuPath::Device)
     }
 
-    /// Whether the GPU path takes this light's emission and intensity from the CPU reference
-    /// ([`Prepared::gpu_path`]): some query besides irradiance is the host's.
+    /// Whether the GPU path takes this light's intensity from the CPU reference
+    /// ([`Prepared::gpu_path`]): some query besides irradiance is the host's (a light whose
+    /// emission is the host's has its intensity there too). Sampling reads it: a scene holding
+    /// such a light is sampled on the CPU reference.
     pub fn on_host(&self) -> bool {
+        matches!(
+            self.gpu_path,
+            GpuPath::HostIntensity(_) | GpuPath::RadianceOnDevice(_) | GpuPath::Host(_)
+        )
+    }
+
+    /// Whether the GPU path takes this light's emission from the CPU reference.
+    pub fn emission_on_host(&self) -> bool {
         matches!(
             self.gpu_path,
             GpuPath::RadianceOnDevice(_) | GpuPath::Host(_)
@@ -263,16 +236,21 @@ impl Prepared {
     }
 
     /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
-    /// portals is masked, and every query of it on a GPU evaluator is the CPU reference's
-    /// (there is no portal kernel). Hint mode changes nothing.
+    /// portals is masked; on a GPU evaluator its emission and radiance are the device's (the
+    /// radiance kernel tests the portal crossings) and its irradiance the CPU reference's
+    /// ([`GpuPath::HostIrradiance`]). Hint mode changes nothing.
     pub fn apply_portal_mode(
         &mut self,
         mode: PortalMode,
         temperature: TemperatureMode,
     ) -> Result<()> {
         self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
-        if self.portals.is_some() {
-            self.gpu_path = GpuPath::Host("it is masked by portals");
+        if let Some(portals) = &self.portals {
+            self.gpu_path = if portals.len() > PORTALS_ON_DEVICE {
+                GpuPath::Host("it is masked by more portals than the radiance kernel tests")
+            } else {
+                GpuPath::HostIrradiance("it is masked by portals")
+            };
         }
         Ok(())
     }
@@ -415,7 +393,7 @@ impl Prepared {
                 KindData::Shape
             }
         };
-        let gpu_path = if let KindData::Mesh { bvh, .. } = &kind {
+        let gpu_path = if let KindData::Mesh { bvh, fronts, .. } = &kind {
             let bytes = 32 * bvh.nodes.len() as u64 + 40 * bvh.order.len() as u64;
             if bvh.depth() > MESH_STACK {
                 GpuPath::Host("it is a mesh light whose BVH is deeper than the kernel's stack")
@@ -423,8 +401,12 @@ impl Prepared {
                 GpuPath::Host("it is a mesh light too large for the device")
             } else if !to_local.is_finite() {
                 GpuPath::Host("it is a mesh light with a singular transform")
+            } else if fronts.len() > MESH_FRONTS_ON_DEVICE {
+                GpuPath::RadianceOnDevice(
+                    "it is a mesh light facing more directions than the emission kernel tests",
+                )
             } else {
-                GpuPath::RadianceOnDevice("it is a mesh light")
+                GpuPath::HostIntensity("it is a mesh light")
             }
         } else if ies.is_some() {
             GpuPath::HostIrradiance("it is IES-shaped")

@@ -170,6 +170,7 @@ impl PreparedScene {
     ) -> Result<()> {
         if let Some((p, reason)) = self.lights.iter().find_map(|p| match p.gpu_path {
             GpuPath::HostIrradiance(reason)
+            | GpuPath::HostIntensity(reason)
             | GpuPath::RadianceOnDevice(reason)
             | GpuPath::Host(reason) => Some((p, reason)),
             GpuPath::Device => None,
@@ -338,16 +339,23 @@ impl PreparedScene {
         )
     }
 
-    /// Refuses a GPU-resident query of a scene holding a light every query of which the host
-    /// computes (`GpuPath::Host`: mesh lights): the kernels give 0 for it, which this path
-    /// would return as if it were the answer.
+    /// Refuses a GPU-resident query of a scene holding a light whose `kernel` query the host
+    /// computes (`GpuPath::Host`: every query; `RadianceOnDevice`: all but radiance;
+    /// `HostIntensity`: intensity, of mesh lights): the kernels give 0 for it, which this path
+    /// would return as if it were the answer. A masked dome's emission and radiance are the
+    /// device's (`GpuPath::HostIrradiance`), so they pass.
     fn check_all_on_device(&self, kernel: Kernel) -> Result<()> {
         let refused = |p: &Prepared| match kernel {
             Kernel::Radiance => p.radiance_on_host(),
+            Kernel::Emission => p.emission_on_host(),
             _ => p.on_host(),
         };
         match self.lights.iter().find_map(|p| match p.gpu_path {
-            GpuPath::Host(reason) | GpuPath::RadianceOnDevice(reason) if refused(p) => {
+            GpuPath::Host(reason)
+            | GpuPath::RadianceOnDevice(reason)
+            | GpuPath::HostIntensity(reason)
+                if refused(p) =>
+            {
                 Some((p, reason))
             }
             _ => None,

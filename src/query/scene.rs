@@ -174,7 +174,7 @@ impl PreparedScene {
         let mut out = self.run(Kernel::Emission, dirs, None, per_light, || {
             cpu::emission_batch(&self.lights, dirs, per_light)
         })?;
-        self.add_host(per_light, &mut out, Prepared::on_host, |l| {
+        self.add_host(per_light, &mut out, Prepared::emission_on_host, |l| {
             cpu::emission_batch(l, dirs, true)
         });
         Ok(out)

@@ -1,0 +1,68 @@
+//! The one per-light decision of which queries a GPU evaluator takes from the device and which
+//! from the CPU reference (DESIGN.md §1: made once in `prepare`, read by both sides), and the
+//! limits it applies.
+
+/// Where the GPU path takes a light's values from: the one decision, made per light when it is
+/// prepared, that the record (`FLAG_HOST_IRRADIANCE`, `FLAG_MESH_FRONTS`, or a record that emits
+/// nothing), the mesh atlas, the host's sums in `query::PreparedScene`, the GPU-resident
+/// refusals and the conformance check all read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GpuPath {
+    /// Every query on the device.
+    Device,
+    /// Every query on the device but irradiance, which is the CPU reference's until the f32
+    /// quadrature can match it; the reason is a phrase ("it is IES-shaped"):
+    /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as
+    ///   the reference's line integrals do, and misses lit features narrower than its nodes
+    ///   (measured: up to 100 % on receivers that see a thin lit band of a striped profile).
+    /// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
+    ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a
+    ///   dome's irradiance depends on the normal only, so the reference evaluates it once per
+    ///   distinct normal (one for a whole falloff map).
+    /// - Textured rects: the exact integral of the filtered texture over the surface, split at
+    ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
+    ///   (src/cpu/irradiance/rect_texture.rs).
+    /// - Domes masked by portals (§8 P2 mask mode): emission is the dome's own and radiance
+    ///   tests the portal crossings on the device (shaders/portal.wgsl, the portals in the mesh
+    ///   atlas); irradiance needs the portals' visible pieces (cpu::portal::irradiance), which
+    ///   have no kernel. A dome's intensity is 0 on both paths.
+    HostIrradiance(&'static str),
+    /// Emission and radiance on the device (the mesh's distinct front directions and its BVH in
+    /// the mesh atlas: shaders/emission.wgsl, shaders/mesh/ray.wgsl); intensity and irradiance
+    /// from the CPU reference: mesh lights (DESIGN.md §7) with at most
+    /// [`MESH_FRONTS_ON_DEVICE`] front directions. Their intensity and irradiance need the exact
+    /// visible pieces (cpu::mesh::visible), which have no kernel.
+    HostIntensity(&'static str),
+    /// Radiance on the device; emission, intensity and irradiance from the CPU reference: mesh
+    /// lights with more than [`MESH_FRONTS_ON_DEVICE`] front directions (the emission kernel
+    /// tests each in turn).
+    RadianceOnDevice(&'static str),
+    /// Every query from the CPU reference: mesh lights the device cannot hold or traverse (a
+    /// hierarchy deeper than the kernel's stack, more data than [`MESH_DEVICE_BYTES`], a
+    /// singular transform), and domes masked by more than [`PORTALS_ON_DEVICE`] portals. The
+    /// record the kernels see emits nothing.
+    Host(&'static str),
+}
+
+/// The most distinct front directions of a mesh light whose emission the kernel tests
+/// ([`GpuPath::HostIntensity`]); a mesh with more takes its emission from the host
+/// ([`GpuPath::RadianceOnDevice`]). The kernel loops once per direction: 4096 keeps one mesh
+/// well inside lavapipe's 65,535 loop iterations per invocation (with room for a dozen such
+/// meshes in one dispatch) and bounds the cost of a direction that no front faces (every front
+/// is read) at about the cost of a BVH traversal; flat, boxy and low-polygon lights have a
+/// handful, a smooth closed mesh about as many as triangles (those past 4096 stay on the host).
+pub const MESH_FRONTS_ON_DEVICE: usize = 4096;
+
+/// The most portals of a masked dome whose crossings the radiance kernel tests (one loop
+/// iteration each, for lavapipe's budget as [`MESH_FRONTS_ON_DEVICE`]); a dome masked by more is
+/// evaluated on the host ([`GpuPath::Host`]).
+pub const PORTALS_ON_DEVICE: usize = 4096;
+
+/// The most bytes of BVH nodes and triangles one mesh light may take on the device (32 bytes a
+/// node, 40 a triangle: about 800,000 triangles); a larger mesh is evaluated on the host
+/// ([`GpuPath::Host`]), so that a scene's meshes fit WebGPU's default storage binding limit
+/// (128 MiB) with room for others.
+pub const MESH_DEVICE_BYTES: u64 = 48 << 20;
+
+/// The deepest BVH the radiance kernel traverses: its stack holds this many nodes.
+pub const MESH_STACK: usize = 64;

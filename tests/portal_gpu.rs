@@ -1,0 +1,324 @@
+//! A dome masked by portals (DESIGN.md §8 P2 mask mode) on a GPU evaluator: emission and
+//! radiance on the device (shaders/portal.wgsl), irradiance and intensity from the CPU
+//! reference (`GpuPath::HostIrradiance`). Radiance is compared with the reference within 1e-4
+//! relative away from the portals' edges and planes (a band of 1e-4 of the portal's size, the
+//! one `luxeval check` excludes, computed here from the portals' transforms); the excluded count
+//! is printed. Hint mode is bitwise the dome without portals.
+
+use glam::{DMat3, DMat4, DQuat, DVec3};
+use luxeval::testkit::Rng;
+use luxeval::{Accumulate, Asset, Evaluator, Light, Portal, PortalMode, Texture, TextureFormat};
+
+/// Half-width of the excluded band, as `conformance::BAND`.
+const BAND: f64 = 1e-4;
+
+fn rel(a: [f32; 3], b: [f32; 3]) -> f64 {
+    let (a, b) = (
+        DVec3::from_array(a.map(f64::from)),
+        DVec3::from_array(b.map(f64::from)),
+    );
+    let d = (a - b).abs().max_element();
+    if d == 0.0 {
+        0.0
+    } else {
+        d / a.abs().max_element().max(b.abs().max_element())
+    }
+}
+
+/// Portals of several kinds: overlapping at different depths (a skylight above a larger,
+/// deeper-in-the-view one), one turned the other way (its +Z faces down), one rotated and
+/// non-uniformly scaled, multipliers ≠ 1 (intensity, exposure, colour).
+fn portals() -> Vec<(Portal, DMat4, f64, f64)> {
+    let rot = DMat4::from_quat(DQuat::from_rotation_x(0.4) * DQuat::from_rotation_z(0.7));
+    let specs = [
+        // A window in the wall x = 3, turned about Y by −90°: its +Z faces world −X, so it
+        // passes light toward +X, to points beyond the wall.
+        (
+            DMat4::from_rotation_translation(
+                DQuat::from_rotation_y(-std::f64::consts::FRAC_PI_2),
+                DVec3::new(3.0, 0.0, 0.5),
+            ),
+            2.0,
+            1.5,
+            (1.0, 0.0, DVec3::new(0.9, 0.8, 0.7)),
+        ),
+        // A skylight at z = 4 and a larger one above it at z = 6 (overlapping as seen from
+        // below: the nearer counts).
+        (
+            DMat4::from_translation(DVec3::new(0.0, 0.5, 4.0)),
+            2.0,
+            2.0,
+            (2.0, 0.0, DVec3::ONE),
+        ),
+        (
+            DMat4::from_translation(DVec3::new(0.3, 0.0, 6.0)),
+            5.0,
+            4.0,
+            (1.0, -1.0, DVec3::new(0.5, 1.0, 0.25)),
+        ),
+        // Turned the other way: +Z faces down, so only rays moving down cross it toward +Z.
+        (
+            DMat4::from_rotation_translation(
+                DQuat::from_rotation_x(std::f64::consts::PI),
+                DVec3::new(-1.0, -1.0, -3.0),
+            ),
+            3.0,
+            2.0,
+            (0.5, 1.0, DVec3::ONE),
+        ),
+        // Rotated and non-uniformly scaled (and sheared by the rotation after the scale).
+        (
+            DMat4::from_translation(DVec3::new(-2.5, 1.0, 1.0))
+                * rot
+                * DMat4::from_scale(DVec3::new(1.5, 0.6, 2.0)),
+            1.5,
+            2.0,
+            (3.0, 0.0, DVec3::new(1.0, 0.7, 0.2)),
+        ),
+    ];
+    specs
+        .into_iter()
+        .enumerate()
+        .map(|(i, (world, w, h, (intensity, exposure, color)))| {
+            let p = Portal::new(w, h)
+                .with_path(format!("/P{i}"))
+                .with_transform(world)
+                .with_intensity(intensity)
+                .with_exposure(exposure)
+                .with_color(color);
+            (p, world, w, h)
+        })
+        .collect()
+}
+
+/// How far the ray x + tω is from changing the portal it passes through (as
+/// `conformance::band::portal_margin`, written out again here): the crossing point's distance
+/// to each portal's edges and the origin's distance to each plane (fractions of the portal's
+/// larger half extent, in its local units), and the grazing angle.
+fn margin(ps: &[(Portal, DMat4, f64, f64)], x: DVec3, w: DVec3) -> f64 {
+    let mut m = f64::INFINITY;
+    for (_, world, wd, ht) in ps {
+        let inv = DMat3::from_mat4(*world).inverse();
+        let xl = inv * (x - world.w_axis.truncate());
+        let dl = inv * w;
+        let (hw, hh) = (wd / 2.0, ht / 2.0);
+        let s = hw.max(hh);
+        m = m.min(xl.z.abs() / s).min(dl.normalize().z.abs());
+        if dl.z != 0.0 && -xl.z / dl.z > 0.0 {
+            let h = xl - xl.z / dl.z * dl;
+            m = m.min(((h.x.abs() - hw).abs() / s).min((h.y.abs() - hh).abs() / s));
+        }
+    }
+    m
+}
+
+fn textured(l: Light) -> Light {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/textures/testImage.png"
+    );
+    l.with_texture(Texture::new(Asset::file(file)).with_format(TextureFormat::LatLong))
+}
+
+fn masked(l: Light, ps: &[(Portal, DMat4, f64, f64)]) -> Light {
+    ps.iter().fold(l, |l, (p, ..)| l.with_portal(p.clone()))
+}
+
+/// Points inside the room and outside it (on both sides of every portal), rays aimed at the
+/// portals (and past their edges) and in uniform directions.
+fn rays(ps: &[(Portal, DMat4, f64, f64)], n: usize, seed: u64) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let mut rng = Rng::new(seed);
+    let (mut pts, mut dirs) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        let x = DVec3::new(
+            rng.range(-4.0, 4.0),
+            rng.range(-4.0, 4.0),
+            rng.range(-5.0, 7.0),
+        );
+        let w = if i % 3 == 0 {
+            rng.unit()
+        } else {
+            let (_, world, wd, ht) = &ps[i % ps.len()];
+            let local = DVec3::new(rng.range(-0.6, 0.6) * wd, rng.range(-0.6, 0.6) * ht, 0.0);
+            (world.transform_point3(local) - x).normalize()
+        };
+        pts.push(x.as_vec3().to_array());
+        dirs.push(w.as_vec3().to_array());
+    }
+    (pts, dirs)
+}
+
+/// GPU radiance of masked domes, untextured and textured, within 1e-4 of the reference away
+/// from the portals' edges and planes; emission is the dome's own on both; irradiance and
+/// intensity are the reference's exactly.
+#[test]
+fn masked_dome_radiance_runs_on_the_device_within_tolerance() {
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let ps = portals();
+    let domes = [
+        masked(
+            Light::dome()
+                .with_intensity(1.5)
+                .with_color(DVec3::new(1.0, 0.6, 0.3))
+                .with_path("/Sky"),
+            &ps,
+        ),
+        masked(textured(Light::dome().with_path("/Map")), &ps),
+    ];
+    let cpu = Evaluator::cpu().with_portal_mode(PortalMode::Mask);
+    let gpu = gpu.with_portal_mode(PortalMode::Mask);
+    let n = 6000;
+    let (pts, dirs) = rays(&ps, n, 11);
+    for dome in &domes {
+        let l = std::slice::from_ref(dome);
+        let c = cpu.prepare(l).unwrap();
+        let g = gpu.prepare(l).unwrap();
+        let (rc, rg) = (
+            c.radiance(&pts, &dirs, Accumulate::Sum).unwrap(),
+            g.radiance(&pts, &dirs, Accumulate::Sum).unwrap(),
+        );
+        let (mut excluded, mut lit, mut worst) = (0, 0, 0.0f64);
+        for i in 0..n {
+            let x = DVec3::from_array(pts[i].map(f64::from));
+            let w = DVec3::from_array(dirs[i].map(f64::from));
+            if margin(&ps, x, w) < BAND {
+                excluded += 1;
+                continue;
+            }
+            if rc[i] != [0.0; 3] {
+                lit += 1;
+            }
+            let e = rel(rc[i], rg[i]);
+            assert!(
+                e <= 1e-4,
+                "{}: ray {i} from {x} along {w}: cpu {:?} gpu {:?} ({e:e})",
+                dome.path,
+                rc[i],
+                rg[i]
+            );
+            worst = worst.max(e);
+        }
+        eprintln!(
+            "{}: {n} rays, {excluded} within {BAND:e} of a portal edge or plane (excluded), \
+             {lit} lit, worst relative error {worst:e}",
+            dome.path
+        );
+        assert!(lit > n / 10, "{lit} lit of {n}");
+        assert!(excluded < n / 50, "{excluded} excluded");
+        // Emission is the dome's own (within f32 rounding of the texture lookup: the dome
+        // check compares it); irradiance and intensity are the reference's rows.
+        let e_dirs = &dirs[..256];
+        for (a, b) in c
+            .emission(e_dirs, Accumulate::Sum)
+            .unwrap()
+            .iter()
+            .zip(g.emission(e_dirs, Accumulate::Sum).unwrap())
+        {
+            assert!(rel(*a, b) <= 1e-4, "emission {a:?} vs {b:?}");
+        }
+        assert_eq!(
+            c.irradiance(&pts[..64], &dirs[..64], Accumulate::PerLight)
+                .unwrap(),
+            g.irradiance(&pts[..64], &dirs[..64], Accumulate::PerLight)
+                .unwrap()
+        );
+        assert_eq!(
+            c.intensity(e_dirs, Accumulate::Sum).unwrap(),
+            g.intensity(e_dirs, Accumulate::Sum).unwrap()
+        );
+    }
+}
+
+/// Each multiplier applies where its portal is the nearest crossed toward +Z: straight up from
+/// under the skylights, the lower one's (2); from between them, the upper one's (0.5·colour);
+/// straight down onto the turned portal from above, its own (0.5·2); up through it (toward its
+/// −Z, ignored) and past every other portal, none.
+#[test]
+fn the_nearest_portal_crossed_toward_its_front_counts_on_the_device() {
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let ps = portals();
+    let dome = masked(Light::dome().with_path("/Sky"), &ps);
+    let g = gpu
+        .with_portal_mode(PortalMode::Mask)
+        .prepare(std::slice::from_ref(&dome))
+        .unwrap();
+    let pts = [
+        [0.0f32, 0.5, 0.0],
+        [0.3, 0.0, 5.0],
+        [-1.0, -1.0, -1.0],
+        [-2.4, -1.9, -5.0],
+    ];
+    let dirs = [
+        [0.0f32, 0.0, 1.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+        [0.0, 0.0, 1.0],
+    ];
+    let got = g.radiance(&pts, &dirs, Accumulate::Sum).unwrap();
+    assert_eq!(got[0], [2.0; 3]);
+    assert_eq!(got[1], [0.25, 0.5, 0.125]);
+    assert_eq!(got[2], [1.0; 3]);
+    assert_eq!(got[3], [0.0; 3]);
+    let c = Evaluator::cpu()
+        .with_portal_mode(PortalMode::Mask)
+        .prepare(std::slice::from_ref(&dome))
+        .unwrap();
+    assert_eq!(got, c.radiance(&pts, &dirs, Accumulate::Sum).unwrap());
+}
+
+/// A dome whose every portal passes no light (zero width) lights nothing in mask mode, on the
+/// device as on the reference; a dome naming no portal is unchanged; hint mode is bitwise the
+/// dome without portals on every query.
+#[test]
+fn invisible_portals_and_hint_mode_on_the_device() {
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let ps = portals();
+    let (pts, dirs) = rays(&ps, 512, 3);
+    let plain = Light::dome().with_intensity(1.5).with_path("/Sky");
+    // Masked by portals that pass nothing: every ray 0 on both paths.
+    let shut = plain
+        .clone()
+        .with_portal(Portal::new(0.0, 1.0).with_path("/Shut"));
+    let s = std::slice::from_ref(&shut);
+    let g = gpu
+        .clone()
+        .with_portal_mode(PortalMode::Mask)
+        .prepare(s)
+        .unwrap();
+    let c = Evaluator::cpu()
+        .with_portal_mode(PortalMode::Mask)
+        .prepare(s)
+        .unwrap();
+    let rg = g.radiance(&pts, &dirs, Accumulate::Sum).unwrap();
+    assert!(rg.iter().all(|v| *v == [0.0; 3]));
+    assert_eq!(rg, c.radiance(&pts, &dirs, Accumulate::Sum).unwrap());
+    // Hint mode, and mask mode without portals: bitwise the plain dome on the device.
+    let reference = gpu.prepare(std::slice::from_ref(&plain)).unwrap();
+    let hinted = masked(plain.clone(), &ps);
+    for (mode, l) in [(PortalMode::Hint, &hinted), (PortalMode::Mask, &plain)] {
+        let g = gpu
+            .clone()
+            .with_portal_mode(mode)
+            .prepare(std::slice::from_ref(l))
+            .unwrap();
+        let acc = Accumulate::PerLight;
+        assert_eq!(
+            g.radiance(&pts, &dirs, acc).unwrap(),
+            reference.radiance(&pts, &dirs, acc).unwrap()
+        );
+        assert_eq!(
+            g.emission(&dirs, acc).unwrap(),
+            reference.emission(&dirs, acc).unwrap()
+        );
+        assert_eq!(
+            g.irradiance(&pts, &dirs, acc).unwrap(),
+            reference.irradiance(&pts, &dirs, acc).unwrap()
+        );
+    }
+}
