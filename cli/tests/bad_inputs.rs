@@ -301,7 +301,7 @@ fn hardlink_dirs(d: &Path) {
 fn many_dirs(d: &Path) {
     let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (100, 3), }";
     let mut h = header.to_string();
-    while (10 + h.len() + 1) % 64 != 0 {
+    while !(10 + h.len() + 1).is_multiple_of(64) {
         h.push(' ');
     }
     h.push('\n');

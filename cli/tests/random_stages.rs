@@ -210,7 +210,7 @@ fn check_passes_on_a_randomised_mesh_stage() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let mut rng = Rng::new(0x22_5EED);
+    let mut rng = Rng::new(0x0022_5EED);
     let lights = random_mesh_lights(&mut rng, 1); // 5 classes × 7 transforms
     let names: Vec<String> = (0..lights.len()).map(|i| format!("Mesh{i}")).collect();
     let prims: Vec<String> = lights
@@ -261,7 +261,7 @@ fn check_passes_on_randomised_portal_stages() {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
-    let mut rng = Rng::new(0x8_5EED);
+    let mut rng = Rng::new(0x0008_5EED);
     let texture = repo_file("tests/data/textures/testImage.png");
     for k in 0..4 {
         let dome = random_portal_dome(&mut rng, k);

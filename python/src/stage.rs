@@ -457,6 +457,7 @@ impl Stage {
     /// Raises ``InputError`` for a wrong shape or dtype, a non-finite or zero row, an unknown
     /// light, or a light attribute luxeval cannot evaluate (naming the file, prim, attribute).
     #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint"))]
+    #[allow(clippy::too_many_arguments)]
     fn emission<'py>(
         &self,
         py: Python<'py>,
@@ -486,6 +487,7 @@ impl Stage {
     /// ``dirs``: (N, 3), any real dtype. Returns float32 (N, 3), or (L, N, 3) with
     /// ``per_light=True``. Options and errors as ``emission``.
     #[pyo3(signature = (dirs, *, per_light = false, lights = None, device = "auto", temperature_mode = "spec", texture_filter = "bilinear", portal_mode = "hint"))]
+    #[allow(clippy::too_many_arguments)]
     fn intensity<'py>(
         &self,
         py: Python<'py>,

@@ -13,7 +13,8 @@ pub enum Scale {
 /// A "nice" step (1, 2 or 5 times a power of ten) for about `n` divisions of a span of `span`;
 /// 1 for a span that is not a positive finite number.
 pub fn nice_step(span: f64, n: f64) -> f64 {
-    if !(span > 0.0) || !span.is_finite() {
+    // NaN fails is_finite.
+    if !span.is_finite() || span <= 0.0 {
         return 1.0;
     }
     let raw = span / n;
@@ -40,7 +41,7 @@ const MAX_TICKS: usize = 700;
 /// is ticked at its two ends; never more than [`MAX_TICKS`] values.
 pub fn ticks(range: (f64, f64), scale: Scale) -> Vec<f64> {
     let (lo, hi) = range;
-    if !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
+    if !lo.is_finite() || !hi.is_finite() || hi <= lo {
         return vec![];
     }
     match scale {
@@ -62,7 +63,9 @@ pub fn ticks(range: (f64, f64), scale: Scale) -> Vec<f64> {
             let step = nice_step(hi - lo, 5.0);
             let (first, last) = ((lo / step).ceil(), (hi / step).floor());
             // The step of a subnormal span rounds to 0 or loses its digits: the ends instead.
-            if !step.is_normal() || !(last - first < MAX_TICKS as f64) || !(first <= last) {
+            // A NaN end (an infinite quotient's) makes the span NaN.
+            let span = last - first;
+            if !step.is_normal() || span.is_nan() || span >= MAX_TICKS as f64 || first > last {
                 return vec![lo, hi];
             }
             (first as i64..=last as i64)
