@@ -8,8 +8,8 @@
 //! one `luxeval bench` times): non-convex, so rays and receivers meet self-occlusion.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use glam::{DMat4, DVec3};
-use luxeval::testkit::{Rng, torus};
+use glam::DMat4;
+use luxeval::testkit::{Rng, torus, torus_rays};
 use luxeval::{Accumulate, Evaluator, Light};
 
 fn mesh_light(c: &mut Criterion) {
@@ -26,18 +26,7 @@ fn mesh_light(c: &mut Criterion) {
     let mut rng = Rng::new(3);
     let n = 1_000_000;
     // Rays from a shell around the torus toward points near it: most hit.
-    let points: Vec<[f32; 3]> = (0..n)
-        .map(|_| (rng.unit() * rng.range(3.0, 6.0)).as_vec3().to_array())
-        .collect();
-    let dirs: Vec<[f32; 3]> = points
-        .iter()
-        .map(|p| {
-            let target = rng.unit() * 2.0;
-            (target - DVec3::from_array(p.map(f64::from)))
-                .as_vec3()
-                .to_array()
-        })
-        .collect();
+    let (points, dirs) = torus_rays(n, &mut rng);
     group.throughput(Throughput::Elements(n as u64));
     group.bench_function("radiance 1M rays", |b| {
         b.iter(|| {

@@ -94,7 +94,7 @@ pub use query::{
 };
 #[cfg(feature = "usd")]
 pub use query::{lights_json, portal_multiplier};
-pub use synthetic::{Rng, synthetic_lights, synthetic_mesh_light};
+pub use synthetic::{Rng, synthetic_lights, synthetic_mesh_light, torus_rays};
 #[cfg(feature = "usd")]
 pub use usd::{
     LightList, LinkCollection, RefusedInput, Stage, StageInfo, StageLight, TimeRule, UsdStage,

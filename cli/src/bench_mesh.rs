@@ -10,8 +10,7 @@
 
 use std::time::Instant;
 
-use glam::DVec3;
-use luxeval::{Accumulate, Evaluator, Rng, synthetic_mesh_light};
+use luxeval::{Accumulate, Evaluator, Rng, synthetic_mesh_light, torus_rays};
 
 use crate::exit::CliResult;
 
@@ -71,18 +70,7 @@ pub fn run(
             per_second: 1.0 / prepare,
         });
         let scene = eval.prepare(lights)?;
-        let points: Vec<[f32; 3]> = (0..*n)
-            .map(|_| (rng.unit() * rng.range(3.0, 6.0)).as_vec3().to_array())
-            .collect();
-        let dirs: Vec<[f32; 3]> = points
-            .iter()
-            .map(|p| {
-                let target = rng.unit() * 2.0;
-                (target - DVec3::from_array(p.map(f64::from)))
-                    .as_vec3()
-                    .to_array()
-            })
-            .collect();
+        let (points, dirs) = torus_rays(*n, &mut rng);
         let t = median_of(repeat, || {
             scene.radiance(&points, &dirs, Accumulate::Sum).map(drop)
         })?;

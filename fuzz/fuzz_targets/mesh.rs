@@ -5,43 +5,16 @@
 //! mesh light goes through: the triangle count checked against its limit, fan triangulation,
 //! validation and preparation (the BVH), then every query at a few points.
 //! Invariants beyond "no panic, no hang, bounded memory": a light that prepares gives finite,
-//! non-negative emission, radiance, irradiance and intensity, and finite sample densities.
+//! non-negative emission, radiance, irradiance and intensity.
 #![no_main]
 
+#[path = "bytes.rs"]
+mod bytes;
+
+use bytes::Bytes;
 use glam::{DMat4, DVec3};
 use luxeval::testkit::Rng;
 use luxeval::{Light, LightType, MeshGeometry, MeshTopology, Reference, Shaping, TemperatureMode};
-
-/// Reads the fuzz bytes front to back; past the end every read is 0.
-struct Bytes<'a>(&'a [u8]);
-
-impl Bytes<'_> {
-    fn u8(&mut self) -> u8 {
-        match self.0.split_first() {
-            Some((&b, rest)) => {
-                self.0 = rest;
-                b
-            }
-            None => 0,
-        }
-    }
-    fn i16(&mut self) -> i16 {
-        i16::from_le_bytes([self.u8(), self.u8()])
-    }
-    /// Small coordinates most of the time (so that meshes have area), any f32 bit pattern
-    /// after a 0xFF marker.
-    fn coord(&mut self) -> f64 {
-        match self.u8() {
-            0xFF => f64::from(f32::from_le_bytes([
-                self.u8(),
-                self.u8(),
-                self.u8(),
-                self.u8(),
-            ])),
-            b => (f64::from(b as i8)) / 16.0,
-        }
-    }
-}
 
 const POINTS: [[f64; 3]; 4] = [
     [0.0, 0.0, 0.0],
@@ -61,7 +34,7 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     let mut b = Bytes(data);
     let n_points = (b.u8() % 48) as usize;
     let points: Vec<[f64; 3]> = (0..n_points)
-        .map(|_| [b.coord(), b.coord(), b.coord()])
+        .map(|_| [b.value(), b.value(), b.value()])
         .collect();
     let n_faces = (b.u8() % 32) as usize;
     // Counts: mostly 3-6, any small signed value after a marker.
@@ -97,7 +70,7 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
             1.0, 0.3, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.7, 0.0, 1.0, 0.0, 1.0, 2.0, 3.0, 1.0,
         ]),
         4 => DMat4::from_scale(DVec3::splat(1e-9)),
-        _ => DMat4::from_rotation_y(b.coord()),
+        _ => DMat4::from_rotation_y(b.value()),
     };
     if MeshGeometry::fan_triangles(&topology).is_err() {
         return;
@@ -114,10 +87,10 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     }
     if flags & 0x40 != 0 {
         light = light.with_shaping(Shaping {
-            focus: b.coord(),
+            focus: b.value(),
             focus_tint: DVec3::new(0.5, 0.7, 1.0),
-            cone_angle: b.coord() * 30.0,
-            cone_softness: b.coord(),
+            cone_angle: b.value() * 30.0,
+            cone_softness: b.value(),
             ies: None,
         });
     }

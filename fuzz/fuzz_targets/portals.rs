@@ -9,35 +9,13 @@
 //! that names no portal, which is unchanged).
 #![no_main]
 
+#[path = "bytes.rs"]
+mod bytes;
+
+use bytes::Bytes;
 use glam::{DMat4, DVec3};
 use luxeval::testkit::Rng;
 use luxeval::{Light, Portal, PortalMode, Reference, TemperatureMode};
-
-struct Bytes<'a>(&'a [u8]);
-
-impl Bytes<'_> {
-    fn u8(&mut self) -> u8 {
-        match self.0.split_first() {
-            Some((&b, rest)) => {
-                self.0 = rest;
-                b
-            }
-            None => 0,
-        }
-    }
-    /// Small values most of the time, any f32 bit pattern after a 0xFF marker.
-    fn value(&mut self) -> f64 {
-        match self.u8() {
-            0xFF => f64::from(f32::from_le_bytes([
-                self.u8(),
-                self.u8(),
-                self.u8(),
-                self.u8(),
-            ])),
-            b => f64::from(b as i8) / 16.0,
-        }
-    }
-}
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     let mut b = Bytes(data);

@@ -76,6 +76,25 @@ pub fn synthetic_mesh_light(triangles: usize) -> Light {
         .with_path(format!("/bench/torus_{}", 2 * around * across))
 }
 
+/// `n` rays from a shell 3–6 units from the origin toward random points within 2 units of it:
+/// most meet the benchmark [`torus`] (ring radius 2), some pass through its hole or miss.
+/// (points, directions), as the queries take them.
+pub fn torus_rays(n: usize, rng: &mut super::Rng) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|_| (rng.unit() * rng.range(3.0, 6.0)).as_vec3().to_array())
+        .collect();
+    let dirs = points
+        .iter()
+        .map(|p| {
+            let target = rng.unit() * 2.0;
+            (target - glam::DVec3::from_array(p.map(f64::from)))
+                .as_vec3()
+                .to_array()
+        })
+        .collect();
+    (points, dirs)
+}
+
 /// The shape classes of [`random_mesh_light`].
 #[cfg(any(test, feature = "testkit"))]
 pub const MESH_CLASSES: [&str; 5] = ["box", "torus", "l-prism", "open-patch", "double-sided"];

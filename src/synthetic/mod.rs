@@ -13,9 +13,9 @@ pub(crate) mod samples;
 pub use lights::synthetic_lights;
 #[cfg(any(test, feature = "testkit"))]
 pub use lights::{TRANSFORMS, random_light, random_lights, transform};
-pub use mesh::synthetic_mesh_light;
 #[cfg(any(test, feature = "testkit"))]
 pub use mesh::{MESH_CLASSES, MeshSource, random_mesh_light, random_mesh_lights, torus};
+pub use mesh::{synthetic_mesh_light, torus_rays};
 #[cfg(any(test, feature = "testkit"))]
 pub use portals::random_portal_dome;
 pub use rng::Rng;

@@ -14,7 +14,7 @@ pub mod sample;
 pub use crate::synthetic::{
     MESH_CLASSES, MeshSource, Rng, TRANSFORMS, emission_samples, irradiance_samples,
     radiance_samples, random_light, random_lights, random_mesh_light, random_mesh_lights,
-    random_portal_dome, synthetic_lights, synthetic_mesh_light, torus, transform,
+    random_portal_dome, synthetic_lights, synthetic_mesh_light, torus, torus_rays, transform,
 };
 pub use kernel_rule::kernel_rule_irradiance;
 
