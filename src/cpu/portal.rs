@@ -17,7 +17,8 @@ use glam::DVec3;
 
 use super::emission::emission;
 use super::irradiance::closed::polygon_irradiance;
-use super::mesh::visible::{Surface, integrate_piece};
+use super::irradiance::dome;
+use super::mesh::visible::Surface;
 use crate::model::MeshTriangle;
 use crate::prepare::{Prepared, PreparedPortal};
 
@@ -73,9 +74,41 @@ fn seen_from(portals: &[PreparedPortal], x: DVec3) -> (Vec<MeshTriangle>, Vec<us
     (triangles, owner)
 }
 
-/// irradiance at x for receiver normal n of a masked dome, before `diffuse`: exact for an
-/// untextured dome, to relative tolerance `rel` for a textured one (see the module docs).
-pub fn irradiance(p: &Prepared, portals: &[PreparedPortal], x: DVec3, n: DVec3, rel: f64) -> DVec3 {
+/// The half-spaces `k·ω ≥ 0` (unit world `k`) whose intersection is the convex planar polygon
+/// `q` (vectors from x to its vertices, in order) seen from x: one per edge, the plane through x
+/// and the edge, `σ (q_i × q_{i+1})` with σ the sign of `(Σ q_i × q_{i+1})·q_0` (twice the
+/// polygon's vector area dotted with a vertex: positive when the vertices run
+/// counter-clockwise about the normal pointing away from x, when every `q_i × q_{i+1}` points
+/// inward). `None` for a polygon of no solid angle (a sliver seen edge-on, which the visibility
+/// split can leave): its edge planes would not bound it. An edge whose endpoints coincide is
+/// left out (its neighbours meet there).
+fn edge_planes(q: &[DVec3]) -> Option<Vec<DVec3>> {
+    let k = q.len();
+    if k < 3 {
+        return None;
+    }
+    let area2: DVec3 = (0..k).map(|i| q[i].cross(q[(i + 1) % k])).sum();
+    let scale = q.iter().map(|v| v.length()).fold(0.0, f64::max);
+    let volume = area2.dot(q[0]);
+    if !(volume.abs() > 1e-12 * scale * scale * scale) {
+        return None;
+    }
+    let sigma = volume.signum();
+    let mut out = Vec::with_capacity(k);
+    for i in 0..k {
+        let (a, b) = (q[i], q[(i + 1) % k]);
+        let c = a.cross(b);
+        let l = c.length();
+        if l > 1e-12 * a.length() * b.length() {
+            out.push(c * (sigma / l));
+        }
+    }
+    Some(out)
+}
+
+/// irradiance at x for receiver normal n of a masked dome, before `diffuse`: exact for every
+/// dome (see the module docs).
+pub fn irradiance(p: &Prepared, portals: &[PreparedPortal], x: DVec3, n: DVec3) -> DVec3 {
     let (triangles, owner) = seen_from(portals, x);
     if triangles.is_empty() {
         return DVec3::ZERO;
@@ -85,20 +118,33 @@ pub fn irradiance(p: &Prepared, portals: &[PreparedPortal], x: DVec3, n: DVec3, 
         triangles: &triangles,
         double_sided: true,
     };
-    let textured = p.dome_texture().is_some();
+    let tables = match p.dome_texture() {
+        Some(_) => match dome::tables(p) {
+            Some(t) => Some(t),
+            // As the unmasked dome: a texture with no tables (a bad cross) has no value.
+            None => return DVec3::NAN,
+        },
+        None => None,
+    };
     let mut sum = DVec3::ZERO;
     // Portals wholly below the receiver's horizon neither pass light it receives nor hide any.
     for piece in surface.emitting_above(x, n) {
         let m = portals[owner[piece.triangle as usize]].multiplier;
-        if textured {
-            let e = integrate_piece(&piece.verts, n, rel, &mut |w: DVec3| emission(p, w));
-            sum += m * e;
-        } else {
-            sum += m * polygon_irradiance(&piece.verts, n);
-        }
+        sum += m * match &tables {
+            // The filtered texture's exact integral over the piece's spherical polygon clipped
+            // at the horizon (DESIGN.md §8 P2, §6 "what 'exact' means").
+            Some(t) => match edge_planes(&piece.verts) {
+                Some(planes) => t.irradiance_within(n, &planes),
+                None => DVec3::ZERO,
+            },
+            None => DVec3::splat(polygon_irradiance(&piece.verts, n)),
+        };
     }
-    if textured { sum } else { p.base * sum }
+    p.base * sum
 }
+
+#[cfg(test)]
+mod exact_tests;
 
 #[cfg(test)]
 mod tests {

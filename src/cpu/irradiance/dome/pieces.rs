@@ -209,6 +209,39 @@ impl Geometry {
         }
     }
 
+    /// The sheet point (x, y) of dome direction `d` (the inverse of [`Geometry::dir_jac`]'s
+    /// direction, §6 D2–D5); for the cross, within `face`'s block, `None` when `d` is not in
+    /// front of that face. Used only to place outer break points.
+    pub fn sheet_point(&self, face: u32, d: DVec3) -> Option<(f64, f64)> {
+        match self.format {
+            DomeFormat::LatLong => {
+                let x = self.w * (0.5 - d.x.atan2(d.z) / TAU);
+                let y = self.h * (d.x.hypot(d.z)).atan2(d.y) / PI;
+                Some((x, y))
+            }
+            DomeFormat::MirroredBall | DomeFormat::Angular => {
+                let st = if self.format == DomeFormat::MirroredBall {
+                    texture::mirrored_ball_st(d)
+                } else {
+                    texture::angular_st(d)
+                };
+                Some((st.x * self.w, st.y * self.h))
+            }
+            DomeFormat::Cross => {
+                let (f, r, u, blk) = texture::cross_basis(face);
+                let fd = f.dot(d);
+                if !(fd > 0.0) {
+                    return None;
+                }
+                let (a, b) = (r.dot(d) / fd, u.dot(d) / fd);
+                Some((
+                    blk.x * self.n + 0.5 * self.n * (a + 1.0),
+                    blk.y * self.n + 0.5 * self.n * (1.0 - b),
+                ))
+            }
+        }
+    }
+
     /// Inside, on, or outside a disk format's rim (always inside for latlong and cross).
     pub fn domain(&self, p: &Piece) -> Domain {
         if !self.is_disk() {
@@ -315,16 +348,37 @@ pub fn tensor<const K: usize>(
     })
 }
 
-/// `∫∫ f(d, tex, J) dx dy` over the piece ∩ domain ∩ {m·d > 0} (no clip when `horizon` is
-/// `None`), exactly in the sense of the module docs. `n` is the inner rule's order, `tol` the
-/// absolute tolerance of the adaptive outer integral.
+/// One clipping half-space `m·d > 0` of dome space (a receiver's horizon, or the plane through
+/// x and an edge of a portal piece mapped to dome space), with its great circle drawn on the
+/// image for the disk formats ([`HorizonCurve`]; `None` for latlong and cross, whose crossings are
+/// found in closed form).
+#[derive(Clone, Copy)]
+pub struct Clip<'a> {
+    pub m: DVec3,
+    pub curve: Option<&'a HorizonCurve>,
+    /// Disk formats only: the circle passes through the rim's direction −Z (`m_z ≈ 0`), so it
+    /// is the diameter `m_x a + m_y b = 0` of the image (the disks keep the azimuth,
+    /// `d ∝ (a, b, ·)`): its crossings are solved in closed form (its curve would jump across
+    /// the image at −Z, and sampling the edges would step outside the disk).
+    pub line: bool,
+}
+
+/// `∫∫ f(d, tex, J) dx dy` over the piece ∩ domain ∩ {m·d > 0 for every clip} (no clip: the
+/// whole piece), exactly in the sense of the module docs. `n` is the inner rule's order, `tol`
+/// the absolute tolerance of the adaptive outer integral.
+///
+/// With several clips (a convex spherical polygon, DESIGN.md §8 P2 mask mode) the lit part of an
+/// inner line is the part where every clip is positive: the line is cut at every clip's roots
+/// and each sub-interval kept when all clips are positive at its middle. Where two clip circles
+/// cross inside the piece (a vertex of the polygon) the endpoint of the lit part switches from
+/// one root to the other, a kink of the outer integrand, so the outer integral is also split at
+/// the x of those crossings. With one clip this is the horizon-only computation, unchanged.
 #[allow(clippy::too_many_arguments)]
 pub fn exact<const K: usize>(
     g: &Geometry,
     img: &Image,
     p: &Piece,
-    horizon: Option<DVec3>,
-    curve: Option<&HorizonCurve>,
+    clips: &[Clip],
     n: usize,
     tol: f64,
     f: &mut impl FnMut(DVec3, DVec3, f64) -> [f64; K],
@@ -332,25 +386,66 @@ pub fn exact<const K: usize>(
     let (x0, x1, y0, y1) = (p.ax.x0, p.ax.x1, p.ay.x0, p.ay.x1);
     let boundary = g.domain(p) == Domain::Boundary;
     let disk = g.is_disk();
-    let h = |x: f64, y: f64| horizon.map_or(1.0, |m| m.dot(g.dir_jac(p.face, x, y).0));
+    // `!(m·d <= 0)` as the one-clip code had it (a NaN counts as lit there).
+    let dark = |x: f64, y: f64| {
+        if clips.is_empty() {
+            return false;
+        }
+        let d = g.dir_jac(p.face, x, y).0;
+        clips.iter().any(|c| c.m.dot(d) <= 0.0)
+    };
     let mut breaks = vec![x0, x1];
     let to_x = |a: f64| 0.5 * g.w * (a + 1.0);
-    match (horizon, curve) {
-        (Some(_), Some(c)) => {
-            // Disk formats: where the horizon crosses the top/bottom edges, and where it turns.
-            let mut pts = Vec::new();
+    for c in clips {
+        if c.line {
             for ye in [y0, y1] {
-                c.crossings(1, 1.0 - 2.0 * ye / g.h, &mut pts);
+                if c.m.x != 0.0 {
+                    breaks.push(to_x(-c.m.y * (1.0 - 2.0 * ye / g.h) / c.m.x));
+                }
             }
-            breaks.extend(pts.iter().map(|p| to_x(p.x)));
-            breaks.extend(c.a_extrema().map(to_x));
+            continue;
         }
-        (Some(_), None) => {
-            for ye in [y0, y1] {
-                sign_change_roots(&mut |x| h(x, ye), x0, x1, 16, &mut breaks);
+        match c.curve {
+            Some(curve) => {
+                // Disk formats: where the circle crosses the top/bottom edges, and where it turns.
+                let mut pts = Vec::new();
+                for ye in [y0, y1] {
+                    curve.crossings(1, 1.0 - 2.0 * ye / g.h, &mut pts);
+                }
+                breaks.extend(pts.iter().map(|p| to_x(p.x)));
+                breaks.extend(curve.a_extrema().map(to_x));
+            }
+            None => {
+                for ye in [y0, y1] {
+                    let m = c.m;
+                    sign_change_roots(
+                        &mut |x| m.dot(g.dir_jac(p.face, x, ye).0),
+                        x0,
+                        x1,
+                        16,
+                        &mut breaks,
+                    );
+                }
             }
         }
-        _ => {}
+    }
+    // Where two clip circles cross inside the piece (both crossing points ±(mᵢ × mⱼ)).
+    for (i, a) in clips.iter().enumerate() {
+        for b in &clips[i + 1..] {
+            let v = a.m.cross(b.m);
+            let l = v.length();
+            if !(l > 0.0) {
+                continue;
+            }
+            for d in [v / l, -v / l] {
+                if let Some((x, y)) = g.sheet_point(p.face, d) {
+                    let slack = 1e-9 * (y1 - y0);
+                    if x > x0 && x < x1 && y >= y0 - slack && y <= y1 + slack {
+                        breaks.push(x);
+                    }
+                }
+            }
+        }
     }
     if boundary {
         // Where the rim crosses the piece's top and bottom edges, and the disk's left/right ends.
@@ -386,26 +481,40 @@ pub fn exact<const K: usize>(
         }
         roots.clear();
         roots.push(ylo);
-        match (horizon, curve) {
-            (Some(_), Some(c)) => {
-                let start = roots.len();
-                let mut pts = Vec::new();
-                c.crossings(0, 2.0 * x / g.w - 1.0, &mut pts);
-                roots.extend(
-                    pts.iter()
-                        .map(|p| 0.5 * g.h * (1.0 - p.y))
-                        .filter(|&y| y > ylo && y < yhi),
-                );
-                roots[start..].sort_by(f64::total_cmp);
+        for c in clips {
+            if c.line {
+                if c.m.y != 0.0 {
+                    let b = -c.m.x * (2.0 * x / g.w - 1.0) / c.m.y;
+                    let y = 0.5 * g.h * (1.0 - b);
+                    if y > ylo && y < yhi {
+                        roots.push(y);
+                    }
+                }
+                continue;
             }
-            (Some(m), None) => inner_roots(g, p.face, m, x, ylo, yhi, &mut roots, disk),
-            _ => {}
+            match c.curve {
+                Some(curve) => {
+                    let start = roots.len();
+                    let mut pts = Vec::new();
+                    curve.crossings(0, 2.0 * x / g.w - 1.0, &mut pts);
+                    roots.extend(
+                        pts.iter()
+                            .map(|p| 0.5 * g.h * (1.0 - p.y))
+                            .filter(|&y| y > ylo && y < yhi),
+                    );
+                    roots[start..].sort_by(f64::total_cmp);
+                }
+                None => inner_roots(g, p.face, c.m, x, ylo, yhi, &mut roots, disk),
+            }
+        }
+        if clips.len() > 1 {
+            roots[1..].sort_by(f64::total_cmp);
         }
         roots.push(yhi);
         let mut sum = [0.0; K];
         for k in 0..roots.len() - 1 {
             let (a, b) = (roots[k], roots[k + 1]);
-            if b <= a || h(x, 0.5 * (a + b)) <= 0.0 {
+            if b <= a || dark(x, 0.5 * (a + b)) {
                 continue;
             }
             let v = if ball {

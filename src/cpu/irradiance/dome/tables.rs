@@ -5,7 +5,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::horizon::HorizonCurve;
-use super::pieces::{Domain, exact};
+use super::pieces::{Clip, Domain, exact};
 use super::quadrature::gl;
 use super::{DomeIrradiance, REL_TOL, add};
 use crate::prepare::texture::DomeFormat;
@@ -32,26 +32,33 @@ pub(super) struct Tables {
     rows: Vec<[[f64; 2]; 2]>,
 }
 
-/// Where a cap lies with respect to the lit hemisphere `m̂·d > 0`.
+/// Where a cap lies with respect to the lit region, the intersection of the half-spaces
+/// `m̂ᵢ·d > 0`.
 #[derive(PartialEq)]
 enum Side {
+    /// Inside every half-space.
     Lit,
+    /// Outside one of them.
     Dark,
     Crossed,
 }
 
-fn side(mhat: DVec3, centre: DVec3, radius: f64) -> Side {
+fn side(mhats: &[DVec3], centre: DVec3, radius: f64) -> Side {
     if radius >= 0.5 * std::f64::consts::PI {
         return Side::Crossed;
     }
-    let (s, r) = (mhat.dot(centre), radius.sin() + 1e-12);
-    if s > r {
-        Side::Lit
-    } else if s < -r {
-        Side::Dark
-    } else {
-        Side::Crossed
+    let r = radius.sin() + 1e-12;
+    let mut lit = true;
+    for mhat in mhats {
+        let s = mhat.dot(centre);
+        if s < -r {
+            return Side::Dark;
+        }
+        if !(s > r) {
+            lit = false;
+        }
     }
+    if lit { Side::Lit } else { Side::Crossed }
 }
 
 /// `tex ⊗ v`, channel-major: a moment's RGB × xyz entries.
@@ -227,11 +234,49 @@ impl DomeIrradiance {
     /// (module docs). Multiply by the dome's `intensity · 2^exposure · color ⊙ temperature` and
     /// `diffuse` outside.
     pub fn irradiance(&self, n: DVec3) -> DVec3 {
+        self.irradiance_within(n, &[])
+    }
+
+    /// `∫ L(ω) max(0, n·ω) dω` over the directions ω with `k·ω ≥ 0` for every `k` in `planes`
+    /// (world vectors), exactly as [`DomeIrradiance::irradiance`] (which is the case of no
+    /// plane): a convex spherical polygon clipped at the horizon, e.g. a portal piece seen from
+    /// a receiver (DESIGN.md §8 P2 mask mode, `cpu/portal.rs`). Each world half-space is the
+    /// dome-space half-space `(A_effᵀ k)·d ≥ 0` (`k·ω ∝ k·A_eff d`, §6 D1), the horizon
+    /// included. A tile or piece is added wholesale (`m · V`) when its cap is inside all of
+    /// them, skipped when it is outside any one, and integrated exactly ([`exact`]) otherwise.
+    pub fn irradiance_within(&self, n: DVec3, planes: &[DVec3]) -> DVec3 {
         let t = self.tables();
         let m = self.frame.horizon(n);
-        let mhat = m.normalize();
-        let curve = matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
-            .then(|| HorizonCurve::new(self.format, m));
+        let ms: Vec<DVec3> = std::iter::once(m)
+            .chain(planes.iter().map(|k| self.frame.horizon(*k)))
+            .collect();
+        let hats: Vec<DVec3> = ms.iter().map(|v| v.normalize()).collect();
+        let disk = matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular);
+        // On a disk image a great circle through the rim's direction −Z (to within 1e-7 rad) is
+        // drawn as a diameter: then the clip is that straight line through the image's centre
+        // ([`Clip::line`]), and what this leaves out is within a cap of radius 1e-7 about −Z
+        // (< 4e-14 sr).
+        // A portal edge parallel to the dome's Z axis gives such a circle; its [`HorizonCurve`]
+        // would jump across the image there. Not applied to the unmasked dome (no plane), which
+        // stays as it was.
+        let lines: Vec<bool> = hats
+            .iter()
+            .map(|h| disk && !planes.is_empty() && !(h.z.abs() > 1e-7))
+            .collect();
+        let curves: Vec<Option<HorizonCurve>> = ms
+            .iter()
+            .zip(&lines)
+            .map(|(v, line)| (disk && !line).then(|| HorizonCurve::new(self.format, *v)))
+            .collect();
+        let clips: Vec<Clip> = ms
+            .iter()
+            .zip(curves.iter().zip(&lines))
+            .map(|(m, (c, line))| Clip {
+                m: *m,
+                curve: c.as_ref(),
+                line: *line,
+            })
+            .collect();
         let dot = |v: &[f64; 9]| {
             DVec3::new(
                 m.dot(DVec3::new(v[0], v[1], v[2])),
@@ -241,21 +286,21 @@ impl DomeIrradiance {
         };
         let mut e = DVec3::ZERO;
         for tile in &t.tiles {
-            match side(mhat, tile.centre, tile.radius) {
+            match side(&hats, tile.centre, tile.radius) {
                 Side::Lit => e += dot(&tile.v),
                 Side::Dark => {}
                 Side::Crossed if t.single && tile.radius.is_finite() => {
-                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, curve.as_ref());
+                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, &clips);
                 }
                 Side::Crossed => {
                     for j in tile.iy.0..tile.iy.1 {
                         for i in tile.ix.0..tile.ix.1 {
                             let p = self.piece(tile.grid, i, j);
-                            match self.geom.cap(&p).map(|(c, r)| side(mhat, c, r)) {
+                            match self.geom.cap(&p).map(|(c, r)| side(&hats, c, r)) {
                                 _ if self.geom.domain(&p) == Domain::Outside => {}
                                 Some(Side::Lit) => e += dot(&self.moment(t, tile.grid, i, j)),
                                 Some(Side::Dark) => {}
-                                _ => e += self.crossed(tile.grid, i, j, m, curve.as_ref()),
+                                _ => e += self.crossed(tile.grid, i, j, m, &clips),
                             }
                         }
                     }
@@ -265,23 +310,16 @@ impl DomeIrradiance {
         e
     }
 
-    /// One piece's share of `E`, clipped exactly at the horizon.
-    fn crossed(
-        &self,
-        grid: usize,
-        i: usize,
-        j: usize,
-        m: DVec3,
-        curve: Option<&HorizonCurve>,
-    ) -> DVec3 {
+    /// One piece's share of `E`, clipped exactly at the horizon and the other clips (the first
+    /// clip is the horizon `m`).
+    fn crossed(&self, grid: usize, i: usize, j: usize, m: DVec3, clips: &[Clip]) -> DVec3 {
         let p = self.piece(grid, i, j);
         let delta = self.geom.cap(&p).map_or(0.5, |c| c.1.min(0.5));
         let v = exact(
             &self.geom,
             &self.img,
             &p,
-            Some(m),
-            curve,
+            clips,
             self.order(delta) + 2,
             REL_TOL * self.scale(&p) * m.length(),
             &mut |d, tex, jac| {
