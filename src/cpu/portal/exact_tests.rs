@@ -360,3 +360,86 @@ fn two_overlapping_portals_agree_with_a_brute_force() {
         worst.0, worst.1
     );
 }
+
+/// Per-receiver cost of a masked textured dome's irradiance (not a test of values; run with
+/// `cargo test --release --no-default-features --lib portal_timing -- --ignored --nocapture`):
+/// the exact integral against the adaptive cubature it replaced (`integrate_piece` of the
+/// dome's radiance over each visible piece, as `portal::irradiance` did before, at the
+/// reference's 1e-9 and at 1e-6), on the two-portal room of the tests in `portal.rs` with
+/// 1024 × 512 latlong maps. The tables are built before timing.
+#[test]
+#[ignore]
+fn portal_timing() {
+    use std::time::Instant;
+
+    use crate::cpu::mesh::visible::{Surface, integrate_piece};
+    use crate::model::{Asset, Texture, TextureFormat};
+
+    let room = |tex: Texture| {
+        let window = Portal::new(3.0, 2.0)
+            .with_path("/Window")
+            .with_transform(DMat4::from_rotation_translation(
+                DQuat::from_rotation_y(0.5),
+                DVec3::new(0.5, 0.0, 2.5),
+            ));
+        let skylight = Portal::new(2.0, 2.0)
+            .with_path("/Skylight")
+            .with_transform(DMat4::from_translation(DVec3::new(0.0, 0.5, 4.0)));
+        Light::dome()
+            .with_texture(tex)
+            .with_portal(window)
+            .with_portal(skylight)
+    };
+    let mut rng = Rng::new(5);
+    let receivers: Vec<(DVec3, DVec3)> = (0..16)
+        .map(|_| {
+            let x = DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, rng.f64());
+            let n = DVec3::new(rng.f64() - 0.5, rng.f64() - 0.5, 1.0).normalize();
+            (x, n)
+        })
+        .collect();
+    for name in ["testImage.png", "studio_dwab.exr"] {
+        let file = format!(
+            "{}/tests/data/textures/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let tex = Texture::new(Asset::file(file)).with_format(TextureFormat::LatLong);
+        let mut p = Prepared::new(&room(tex), TemperatureMode::Spec).unwrap();
+        p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
+            .unwrap();
+        let ports = p.portals.clone().unwrap();
+        let t0 = Instant::now();
+        let _ = crate::cpu::irradiance::dome::tables(&p).unwrap().irradiance(DVec3::Z);
+        eprintln!("{name}: tables {:.0} ms", t0.elapsed().as_secs_f64() * 1e3);
+        let t0 = Instant::now();
+        let exact: Vec<DVec3> = receivers
+            .iter()
+            .map(|&(x, n)| super::irradiance(&p, &ports, x, n))
+            .collect();
+        let per = t0.elapsed().as_secs_f64() * 1e3 / receivers.len() as f64;
+        eprintln!("{name}: exact {per:.2} ms a receiver");
+        for rel_tol in [1e-9, 1e-6] {
+            let t0 = Instant::now();
+            let mut worst: f64 = 0.0;
+            for (&(x, n), want) in receivers.iter().zip(&exact) {
+                let (triangles, owner) = super::seen_from(&ports, x);
+                let surface = Surface {
+                    triangles: &triangles,
+                    double_sided: true,
+                };
+                let mut sum = DVec3::ZERO;
+                for piece in surface.emitting_above(x, n) {
+                    let m = ports[owner[piece.triangle as usize]].multiplier;
+                    sum += m * integrate_piece(&piece.verts, n, rel_tol, &mut |w: DVec3| {
+                        emission(&p, w)
+                    });
+                }
+                worst = worst.max(rel(sum, *want));
+            }
+            let per = t0.elapsed().as_secs_f64() * 1e3 / receivers.len() as f64;
+            eprintln!(
+                "{name}: adaptive to {rel_tol:e}: {per:.2} ms a receiver, {worst:.1e} from exact"
+            );
+        }
+    }
+}
