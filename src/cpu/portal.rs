@@ -11,10 +11,10 @@
 //!   polygons. An untextured dome is uniform, so each piece is `L ⊙ multiplier` times Lambert's
 //!   formula clipped at the horizon ([`polygon_irradiance`]): exact. A textured dome's is exact
 //!   too, in the sense of §6 "what 'exact' means" as P2 asks: a convex polygon seen from x is
-//!   the intersection of the half-spaces `k·ω ≥ 0` through x and its edges ([`edge_planes`]),
-//!   and the dome's exact texel integral, which clips the filtered texture's polynomial pieces
-//!   at the horizon, clips them at those half-spaces as well
-//!   ([`DomeIrradiance::irradiance_within`](super::irradiance::dome::DomeIrradiance::irradiance_within)):
+//!   the intersection of the half-spaces `k·ω ≥ 0` through x and its edges, and the dome's
+//!   exact texel integral, which clips the filtered texture's polynomial pieces at the horizon,
+//!   clips them at those half-spaces as well
+//!   ([`DomeIrradiance::irradiance_over_polygon`](super::irradiance::dome::DomeIrradiance::irradiance_over_polygon)):
 //!   pieces inside all of them add their precomputed moment, pieces outside one are skipped,
 //!   the rest are integrated between the clip circles' crossings. No query tolerance enters.
 //!   Proofs: `exact_tests.rs` (a closed box of portals gives the unmasked dome, a constant
@@ -81,38 +81,6 @@ fn seen_from(portals: &[PreparedPortal], x: DVec3) -> (Vec<MeshTriangle>, Vec<us
     (triangles, owner)
 }
 
-/// The half-spaces `k·ω ≥ 0` (unit world `k`) whose intersection is the convex planar polygon
-/// `q` (vectors from x to its vertices, in order) seen from x: one per edge, the plane through x
-/// and the edge, `σ (q_i × q_{i+1})` with σ the sign of `(Σ q_i × q_{i+1})·q_0` (twice the
-/// polygon's vector area dotted with a vertex: positive when the vertices run
-/// counter-clockwise about the normal pointing away from x, when every `q_i × q_{i+1}` points
-/// inward). `None` for a polygon of no solid angle (a sliver seen edge-on, which the visibility
-/// split can leave): its edge planes would not bound it. An edge whose endpoints coincide is
-/// left out (its neighbours meet there).
-fn edge_planes(q: &[DVec3]) -> Option<Vec<DVec3>> {
-    let k = q.len();
-    if k < 3 {
-        return None;
-    }
-    let area2: DVec3 = (0..k).map(|i| q[i].cross(q[(i + 1) % k])).sum();
-    let scale = q.iter().map(|v| v.length()).fold(0.0, f64::max);
-    let volume = area2.dot(q[0]);
-    if !(volume.abs() > 1e-12 * scale * scale * scale) {
-        return None;
-    }
-    let sigma = volume.signum();
-    let mut out = Vec::with_capacity(k);
-    for i in 0..k {
-        let (a, b) = (q[i], q[(i + 1) % k]);
-        let c = a.cross(b);
-        let l = c.length();
-        if l > 1e-12 * a.length() * b.length() {
-            out.push(c * (sigma / l));
-        }
-    }
-    Some(out)
-}
-
 /// irradiance at x for receiver normal n of a masked dome, before `diffuse`: exact for every
 /// dome (see the module docs).
 pub fn irradiance(p: &Prepared, portals: &[PreparedPortal], x: DVec3, n: DVec3) -> DVec3 {
@@ -140,10 +108,7 @@ pub fn irradiance(p: &Prepared, portals: &[PreparedPortal], x: DVec3, n: DVec3) 
         sum += m * match &tables {
             // The filtered texture's exact integral over the piece's spherical polygon clipped
             // at the horizon (DESIGN.md §8 P2, §6 "what 'exact' means").
-            Some(t) => match edge_planes(&piece.verts) {
-                Some(planes) => t.irradiance_within(n, &planes),
-                None => DVec3::ZERO,
-            },
+            Some(t) => t.irradiance_over_polygon(n, &piece.verts),
             None => DVec3::splat(polygon_irradiance(&piece.verts, n)),
         };
     }

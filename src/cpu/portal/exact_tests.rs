@@ -376,12 +376,12 @@ fn portal_timing() {
     use crate::model::{Asset, Texture, TextureFormat};
 
     let room = |tex: Texture| {
-        let window = Portal::new(3.0, 2.0)
-            .with_path("/Window")
-            .with_transform(DMat4::from_rotation_translation(
+        let window = Portal::new(3.0, 2.0).with_path("/Window").with_transform(
+            DMat4::from_rotation_translation(
                 DQuat::from_rotation_y(0.5),
                 DVec3::new(0.5, 0.0, 2.5),
-            ));
+            ),
+        );
         let skylight = Portal::new(2.0, 2.0)
             .with_path("/Skylight")
             .with_transform(DMat4::from_translation(DVec3::new(0.0, 0.5, 4.0)));
@@ -399,17 +399,16 @@ fn portal_timing() {
         })
         .collect();
     for name in ["testImage.png", "studio_dwab.exr"] {
-        let file = format!(
-            "{}/tests/data/textures/{name}",
-            env!("CARGO_MANIFEST_DIR")
-        );
+        let file = format!("{}/tests/data/textures/{name}", env!("CARGO_MANIFEST_DIR"));
         let tex = Texture::new(Asset::file(file)).with_format(TextureFormat::LatLong);
         let mut p = Prepared::new(&room(tex), TemperatureMode::Spec).unwrap();
         p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
             .unwrap();
         let ports = p.portals.clone().unwrap();
         let t0 = Instant::now();
-        let _ = crate::cpu::irradiance::dome::tables(&p).unwrap().irradiance(DVec3::Z);
+        let _ = crate::cpu::irradiance::dome::tables(&p)
+            .unwrap()
+            .irradiance(DVec3::Z);
         eprintln!("{name}: tables {:.0} ms", t0.elapsed().as_secs_f64() * 1e3);
         let t0 = Instant::now();
         let exact: Vec<DVec3> = receivers

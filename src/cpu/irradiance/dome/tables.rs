@@ -1,11 +1,13 @@
 //! The tile tables of a textured dome (each piece's moment, grouped in tiles under bounding
-//! caps, built once) and the walk over them that gives a receiver's `E(n)`.
+//! caps, built once) and the walk over them that gives a receiver's `E(n)`, or its part inside a
+//! convex intersection of half-spaces (a masked dome's portal piece, DESIGN.md §8 P2).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::clip::{Clip, exact};
 use super::horizon::HorizonCurve;
-use super::pieces::{Clip, Domain, exact};
+use super::pieces::Domain;
 use super::quadrature::gl;
 use super::{DomeIrradiance, REL_TOL, add};
 use crate::prepare::texture::DomeFormat;
@@ -310,6 +312,16 @@ impl DomeIrradiance {
         e
     }
 
+    /// `∫ L(ω) max(0, n·ω) dω` over the directions of the convex planar polygon `q` (vectors
+    /// from the receiver to its vertices, in order): [`DomeIrradiance::irradiance_within`] of
+    /// its [`edge_planes`]; 0 for a polygon of no solid angle.
+    pub fn irradiance_over_polygon(&self, n: DVec3, q: &[DVec3]) -> DVec3 {
+        match edge_planes(q) {
+            Some(planes) => self.irradiance_within(n, &planes),
+            None => DVec3::ZERO,
+        }
+    }
+
     /// One piece's share of `E`, clipped exactly at the horizon and the other clips (the first
     /// clip is the horizon `m`).
     fn crossed(&self, grid: usize, i: usize, j: usize, m: DVec3, clips: &[Clip]) -> DVec3 {
@@ -329,4 +341,36 @@ impl DomeIrradiance {
         );
         DVec3::from_array(v)
     }
+}
+
+/// The half-spaces `k·ω ≥ 0` (unit world `k`) whose intersection is the convex planar polygon
+/// `q` (vectors from x to its vertices, in order) seen from x: one per edge, the plane through x
+/// and the edge, `σ (q_i × q_{i+1})` with σ the sign of `(Σ q_i × q_{i+1})·q_0` (twice the
+/// polygon's vector area dotted with a vertex: positive when the vertices run
+/// counter-clockwise about the normal pointing away from x, when every `q_i × q_{i+1}` points
+/// inward). `None` for a polygon of no solid angle (a sliver seen edge-on, which the visibility
+/// split can leave): its edge planes would not bound it. An edge whose endpoints coincide is
+/// left out (its neighbours meet there).
+pub fn edge_planes(q: &[DVec3]) -> Option<Vec<DVec3>> {
+    let k = q.len();
+    if k < 3 {
+        return None;
+    }
+    let area2: DVec3 = (0..k).map(|i| q[i].cross(q[(i + 1) % k])).sum();
+    let scale = q.iter().map(|v| v.length()).fold(0.0, f64::max);
+    let volume = area2.dot(q[0]);
+    if !(volume.abs() > 1e-12 * scale * scale * scale) {
+        return None;
+    }
+    let sigma = volume.signum();
+    let mut out = Vec::with_capacity(k);
+    for i in 0..k {
+        let (a, b) = (q[i], q[(i + 1) % k]);
+        let c = a.cross(b);
+        let l = c.length();
+        if l > 1e-12 * a.length() * b.length() {
+            out.push(c * (sigma / l));
+        }
+    }
+    Some(out)
 }
