@@ -23,6 +23,9 @@ struct Tile {
     /// Cap centre and angular radius; radius = ∞ forces a descent.
     centre: DVec3,
     radius: f64,
+    /// `sin(radius)`, kept: a receiver's walk tests every tile (for a masked dome, once per
+    /// portal piece), and the sine was most of that walk's cost.
+    sin_radius: f64,
 }
 
 pub(super) struct Tables {
@@ -45,11 +48,11 @@ enum Side {
     Crossed,
 }
 
-fn side(mhats: &[DVec3], centre: DVec3, radius: f64) -> Side {
+fn side(mhats: &[DVec3], centre: DVec3, radius: f64, sin_radius: f64) -> Side {
     if radius >= 0.5 * std::f64::consts::PI {
         return Side::Crossed;
     }
-    let r = radius.sin() + 1e-12;
+    let r = sin_radius + 1e-12;
     let mut lit = true;
     for mhat in mhats {
         let s = mhat.dot(centre);
@@ -229,6 +232,7 @@ impl DomeIrradiance {
             v,
             centre,
             radius,
+            sin_radius: radius.sin(),
         })
     }
 
@@ -288,7 +292,7 @@ impl DomeIrradiance {
         };
         let mut e = DVec3::ZERO;
         for tile in &t.tiles {
-            match side(&hats, tile.centre, tile.radius) {
+            match side(&hats, tile.centre, tile.radius, tile.sin_radius) {
                 Side::Lit => e += dot(&tile.v),
                 Side::Dark => {}
                 Side::Crossed if t.single && tile.radius.is_finite() => {
@@ -298,7 +302,7 @@ impl DomeIrradiance {
                     for j in tile.iy.0..tile.iy.1 {
                         for i in tile.ix.0..tile.ix.1 {
                             let p = self.piece(tile.grid, i, j);
-                            match self.geom.cap(&p).map(|(c, r)| side(&hats, c, r)) {
+                            match self.geom.cap(&p).map(|(c, r)| side(&hats, c, r, r.sin())) {
                                 _ if self.geom.domain(&p) == Domain::Outside => {}
                                 Some(Side::Lit) => e += dot(&self.moment(t, tile.grid, i, j)),
                                 Some(Side::Dark) => {}
