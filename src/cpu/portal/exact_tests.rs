@@ -3,10 +3,11 @@
 //! filters, the identity and a non-conformal dome frame:
 //!
 //! 1. six portals closing a box around x pass the whole dome: the masked value equals the
-//!    unmasked exact dome irradiance (its own tests: tests/dome_irradiance.rs) to ≤ 1e-9;
+//!    unmasked exact dome irradiance (its own tests: tests/dome_irradiance.rs) to ≤ 1e-9
+//!    (measured ≤ 7.4e-14);
 //! 2. a constant texture through a tilted portal partly below the horizon is `L ×` Lambert's
 //!    formula for the portal clipped at the horizon (`closed::polygon_irradiance`, tested on its
-//!    own) to ≤ 1e-9;
+//!    own) to ≤ 1e-9 (measured ≤ 2.1e-14);
 //! 3. a random texture through two overlapping portals (the farther partly below the horizon)
 //!    agrees with a brute force written here: tensor Gauss–Legendre on a grid of sub-squares of
 //!    each portal's plane (`L(ω) max(0, n·ω) cos θ_portal / r²` with the lookup of
@@ -135,12 +136,27 @@ fn closed_box(c: DVec3, h: f64) -> Vec<Portal> {
 #[test]
 fn a_closed_box_of_portals_passes_the_whole_dome() {
     let portals = closed_box(DVec3::new(0.1, 0.0, -0.2), 1.0);
+    // Tilted normals; and one ⊥ Z, whose horizon passes through the disk formats' rim
+    // direction −Z (the box's edges along Z do too).
     let receivers = [
         (DVec3::new(0.2, -0.3, 0.1), DVec3::new(0.3, -0.5, 0.8)),
         (DVec3::new(-0.5, 0.6, -0.7), DVec3::new(-0.7, 0.2, -0.1)),
+        (DVec3::new(0.3, 0.2, 0.4), DVec3::new(0.6, 0.8, 0.0)),
     ];
+    // And other sizes (odd ones, a finer latlong and cross) under the skewed frame.
+    let mut all = configs();
+    for (format, w, h) in [
+        (DomeFormat::LatLong, 16, 8),
+        (DomeFormat::MirroredBall, 17, 17),
+        (DomeFormat::Angular, 9, 9),
+        (DomeFormat::Cross, 12, 16),
+    ] {
+        for filter in [Filter::Bilinear, Filter::Nearest] {
+            all.push((format, w, h, filter, skew()));
+        }
+    }
     let mut worst: f64 = 0.0;
-    for (k, (format, w, h, filter, frame)) in configs().into_iter().enumerate() {
+    for (k, (format, w, h, filter, frame)) in all.into_iter().enumerate() {
         let img = random_image(w, h, 11 + k as u64);
         let (masked, plain) = domes(&img, format, filter, frame, &portals);
         for (x, n) in receivers {
