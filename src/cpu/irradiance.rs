@@ -68,7 +68,7 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
         LightType::Mesh { .. } => super::mesh::irradiance(p, x, n, rule.piece_tolerance()),
         // A dome masked by its portals (DESIGN.md §8 P2 mask mode), see cpu/portal.rs.
         LightType::Dome if let Some(portals) = &p.portals => {
-            super::portal::irradiance(p, portals, x, n, rule.piece_tolerance())
+            super::portal::irradiance(p, portals, x, n)
         }
         // A textured dome's irradiance is the exact integral of its filtered texture (DESIGN.md
         // §6 "Dome and texture irradiance: what 'exact' means"), see dome.rs.

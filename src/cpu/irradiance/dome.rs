@@ -7,7 +7,13 @@
 //! (`n·ω = m·d / |A_eff d|` times the Jacobian `|det A| / |A_eff d|³`). It is linear in `m`, so a
 //! piece of the texture wholly above the horizon contributes `m · V` with the precomputable
 //! moment `V = ∫ L d w dd` (RGB × xyz). Only pieces the horizon great circle `m·d = 0` crosses
-//! need per-receiver work ([`pieces::exact`]).
+//! need per-receiver work ([`clip::exact`]).
+//!
+//! The same holds inside any convex intersection of half-spaces `kᵢ·ω ≥ 0` (DESIGN.md §8 P2 mask
+//! mode: a portal piece seen from x is one, an edge each, `cpu/portal.rs`): each is the dome-space
+//! half-space `(A_effᵀ kᵢ)·d ≥ 0`, a piece inside all of them and the horizon adds `m · V`, one
+//! outside any is skipped, and [`clip::exact`] clips the rest at every boundary circle
+//! ([`DomeIrradiance::irradiance_within`]; the unmasked `E(n)` is its case of no `kᵢ`).
 //!
 //! Tables (built lazily on the first query, in parallel): pieces grouped in tiles of T × T
 //! (T = 1 up to 2²⁰ pieces), each with its summed moment and a bounding cap. A receiver adds
@@ -22,6 +28,7 @@
 //! grow like `(1 + κ)^k`), and the adaptive routine for disk-rim pieces and pieces with
 //! `δ(1 + κ) > 0.5`. Crossed pieces: adaptive outer integral to 1e-12 of the piece's scale.
 
+pub mod clip;
 pub mod horizon;
 pub mod pieces;
 pub mod quadrature;
@@ -36,7 +43,8 @@ use rayon::prelude::*;
 use crate::prepare::texture::Filter;
 use crate::prepare::texture::Image;
 use crate::prepare::texture::{DomeFormat, DomeFrame, FormatError};
-use pieces::{Domain, Geometry, Piece, PieceGrid, exact, tensor};
+use clip::exact;
+use pieces::{Domain, Geometry, Piece, PieceGrid, tensor};
 use quadrature::gl;
 use tables::Tables;
 
@@ -191,8 +199,7 @@ impl DomeIrradiance {
                 &self.geom,
                 &self.img,
                 p,
-                None,
-                None,
+                &[],
                 self.order(0.5),
                 REL_TOL * self.scale(p),
                 f,

@@ -79,7 +79,9 @@ use crate::model::MeshTriangle;
 use clip::{Line, Pieces, Poly, Scratch, Side, Small};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
+#[cfg(test)]
 use std::cmp::Ordering;
+#[cfg(test)]
 use std::collections::BinaryHeap;
 
 /// Which sides emit.
@@ -827,6 +829,7 @@ fn lambert(q: &[DVec3], n: DVec3, buf: &mut Vec<DVec3>) -> f64 {
 /// One cell of [`integrate_piece`]: a spherical triangle (unit vertices), its four children's
 /// rule values, their sum (the cell's value) and its difference from the cell's own rule value
 /// (the cell's error estimate).
+#[cfg(test)]
 struct Cell {
     tri: [DVec3; 3],
     children: [DVec3; 4],
@@ -834,17 +837,21 @@ struct Cell {
     err: f64,
 }
 
+#[cfg(test)]
 impl PartialEq for Cell {
     fn eq(&self, o: &Self) -> bool {
         self.err.total_cmp(&o.err) == Ordering::Equal
     }
 }
+#[cfg(test)]
 impl Eq for Cell {}
+#[cfg(test)]
 impl PartialOrd for Cell {
     fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
         Some(self.cmp(o))
     }
 }
+#[cfg(test)]
 impl Ord for Cell {
     fn cmp(&self, o: &Self) -> Ordering {
         self.err.total_cmp(&o.err)
@@ -852,6 +859,7 @@ impl Ord for Cell {
 }
 
 /// The four children of a spherical triangle: its edges' midpoints pushed out to the sphere.
+#[cfg(test)]
 fn split_cell(t: &[DVec3; 3]) -> [[DVec3; 3]; 4] {
     let m = |a: DVec3, b: DVec3| (a + b).normalize();
     let (ab, bc, ca) = (m(t[0], t[1]), m(t[1], t[2]), m(t[2], t[0]));
@@ -860,6 +868,7 @@ fn split_cell(t: &[DVec3; 3]) -> [[DVec3; 3]; 4] {
 
 /// Radon's degree-5 seven-point rule on a triangle (Stroud 1971, T2:5-1): barycentric points
 /// and weights (summing to 1).
+#[cfg(test)]
 fn radon7() -> [([f64; 3], f64); 7] {
     let s = 15f64.sqrt();
     let (a1, b1, w1) = (
@@ -896,6 +905,10 @@ fn radon7() -> [([f64; 3], f64); 7] {
 /// triangle. Cells are split in four at their edges' midpoints pushed out to the sphere
 /// (geodesic subdivision: the four children tile the parent exactly), largest error first,
 /// the error of a cell being its rule value against its children's sum.
+///
+/// Test-only: the tests of shaped meshes use it as an independent integral (a masked textured
+/// dome, which used it, is now integrated exactly, `cpu/portal.rs`).
+#[cfg(test)]
 pub(crate) fn integrate_piece(
     verts: &[DVec3],
     n: DVec3,

@@ -9,30 +9,19 @@
 //! latlong `sin θ · (2π/W)(π/H)`; mirroredBall `4 · (2/W)(2/H)` (the mirror ball is equal-area);
 //! angular `π sin(πr)/r · (2/W)(2/H)`; cross `(2/N)² / |F + aR + bU|³` (gnomonic).
 //!
-//! Integration over a piece: outer variable x, inner y. For each outer node the lit part of the
-//! inner line is found exactly — latlong: the line is a meridian, which meets the horizon great
-//! circle once, at `θ = α ± π/2` with `α = atan2(m_x sin φ + m_z cos φ, m_y)`; cross: the horizon
-//! is a straight line in the face's gnomonic (a, b); disks: sign changes on 8 sub-intervals refined
-//! by regula falsi — and integrated with an n-point Gauss–Legendre rule. The outer integral is split
-//! at the x where the horizon (or the disk rim) crosses the piece's top or bottom edge, so each
-//! outer part is smooth, and integrated adaptively. The mirror ball's `√(1 − r²)` is removed by
-//! integrating its inner lines in τ with `b = √(1 − a²)·sin τ`; for the disks the outer parts use
-//! `x = x₀ + L(3u² − 2u³)`, which turns the `√` behaviour at the rim's ends and at the horizon's
-//! turning points into a polynomial in u.
+//! The integral over a piece, clipped at a receiver's horizon or at several half-spaces, is
+//! [`super::clip::exact`].
 
 use glam::{DVec2, DVec3};
 
-use super::horizon::HorizonCurve;
-use super::quadrature::{adaptive, gl, sign_change_roots};
+use super::quadrature::gl;
 use crate::cpu::texture;
 use crate::prepare::texture::Image;
 use crate::prepare::texture::{AxisPiece, Filter, axis_pieces};
 use crate::prepare::texture::{DomeFormat, ball_dir};
 
-const PI: f64 = std::f64::consts::PI;
+pub(super) const PI: f64 = std::f64::consts::PI;
 pub(super) const TAU: f64 = std::f64::consts::TAU;
-/// Most outer sub-intervals per smooth part of a piece (bounds the work of near-singular cases).
-const MAX_INTERVALS: usize = 64;
 
 /// The sheet → dome-direction map of one format.
 #[derive(Clone, Copy, Debug)]
@@ -105,7 +94,7 @@ impl Geometry {
         }
     }
 
-    fn is_disk(&self) -> bool {
+    pub(super) fn is_disk(&self) -> bool {
         matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
     }
 
@@ -205,6 +194,39 @@ impl Geometry {
                 let v = f + a * r + b * u;
                 let l = v.length();
                 (v / l, 4.0 / (self.n * self.n * l * l * l))
+            }
+        }
+    }
+
+    /// The sheet point (x, y) of dome direction `d` (the inverse of [`Geometry::dir_jac`]'s
+    /// direction, §6 D2–D5); for the cross, within `face`'s block, `None` when `d` is not in
+    /// front of that face. Used only to place outer break points.
+    pub fn sheet_point(&self, face: u32, d: DVec3) -> Option<(f64, f64)> {
+        match self.format {
+            DomeFormat::LatLong => {
+                let x = self.w * (0.5 - d.x.atan2(d.z) / TAU);
+                let y = self.h * (d.x.hypot(d.z)).atan2(d.y) / PI;
+                Some((x, y))
+            }
+            DomeFormat::MirroredBall | DomeFormat::Angular => {
+                let st = if self.format == DomeFormat::MirroredBall {
+                    texture::mirrored_ball_st(d)
+                } else {
+                    texture::angular_st(d)
+                };
+                Some((st.x * self.w, st.y * self.h))
+            }
+            DomeFormat::Cross => {
+                let (f, r, u, blk) = texture::cross_basis(face);
+                let fd = f.dot(d);
+                if !(fd > 0.0) {
+                    return None;
+                }
+                let (a, b) = (r.dot(d) / fd, u.dot(d) / fd);
+                Some((
+                    blk.x * self.n + 0.5 * self.n * (a + 1.0),
+                    blk.y * self.n + 0.5 * self.n * (1.0 - b),
+                ))
             }
         }
     }
@@ -313,207 +335,4 @@ pub fn tensor<const K: usize>(
             f(d, texture_at(img, p, x, y), j)
         })
     })
-}
-
-/// `∫∫ f(d, tex, J) dx dy` over the piece ∩ domain ∩ {m·d > 0} (no clip when `horizon` is
-/// `None`), exactly in the sense of the module docs. `n` is the inner rule's order, `tol` the
-/// absolute tolerance of the adaptive outer integral.
-#[allow(clippy::too_many_arguments)]
-pub fn exact<const K: usize>(
-    g: &Geometry,
-    img: &Image,
-    p: &Piece,
-    horizon: Option<DVec3>,
-    curve: Option<&HorizonCurve>,
-    n: usize,
-    tol: f64,
-    f: &mut impl FnMut(DVec3, DVec3, f64) -> [f64; K],
-) -> [f64; K] {
-    let (x0, x1, y0, y1) = (p.ax.x0, p.ax.x1, p.ay.x0, p.ay.x1);
-    let boundary = g.domain(p) == Domain::Boundary;
-    let disk = g.is_disk();
-    let h = |x: f64, y: f64| horizon.map_or(1.0, |m| m.dot(g.dir_jac(p.face, x, y).0));
-    let mut breaks = vec![x0, x1];
-    let to_x = |a: f64| 0.5 * g.w * (a + 1.0);
-    match (horizon, curve) {
-        (Some(_), Some(c)) => {
-            // Disk formats: where the horizon crosses the top/bottom edges, and where it turns.
-            let mut pts = Vec::new();
-            for ye in [y0, y1] {
-                c.crossings(1, 1.0 - 2.0 * ye / g.h, &mut pts);
-            }
-            breaks.extend(pts.iter().map(|p| to_x(p.x)));
-            breaks.extend(c.a_extrema().map(to_x));
-        }
-        (Some(_), None) => {
-            for ye in [y0, y1] {
-                sign_change_roots(&mut |x| h(x, ye), x0, x1, 16, &mut breaks);
-            }
-        }
-        _ => {}
-    }
-    if boundary {
-        // Where the rim crosses the piece's top and bottom edges, and the disk's left/right ends.
-        for ye in [y0, y1] {
-            let b = 1.0 - 2.0 * ye / g.h;
-            if b.abs() < 1.0 {
-                let a = (1.0 - b * b).sqrt();
-                breaks.extend([-a, a].map(|a| 0.5 * g.w * (a + 1.0)));
-            }
-        }
-        breaks.extend([0.0, g.w]);
-    }
-    breaks.retain(|&x| (x0..=x1).contains(&x));
-    breaks.sort_by(f64::total_cmp);
-    breaks.dedup_by(|a, b| (*a - *b).abs() <= 1e-14 * g.w);
-    let ball = g.format == DomeFormat::MirroredBall;
-    let mut roots = Vec::with_capacity(8);
-    let mut inner = |x: f64| -> [f64; K] {
-        // The inner line's part inside the disk.
-        let (mut ylo, mut yhi) = (y0, y1);
-        if boundary {
-            let a = 2.0 * x / g.w - 1.0;
-            if a.abs() >= 1.0 {
-                return [0.0; K];
-            }
-            let bmax = (1.0 - a * a).sqrt();
-            let (ylo_d, yhi_d) = (0.5 * g.h * (1.0 - bmax), 0.5 * g.h * (1.0 + bmax));
-            ylo = ylo.max(ylo_d);
-            yhi = yhi.min(yhi_d);
-            if ylo >= yhi {
-                return [0.0; K];
-            }
-        }
-        roots.clear();
-        roots.push(ylo);
-        match (horizon, curve) {
-            (Some(_), Some(c)) => {
-                let start = roots.len();
-                let mut pts = Vec::new();
-                c.crossings(0, 2.0 * x / g.w - 1.0, &mut pts);
-                roots.extend(
-                    pts.iter()
-                        .map(|p| 0.5 * g.h * (1.0 - p.y))
-                        .filter(|&y| y > ylo && y < yhi),
-                );
-                roots[start..].sort_by(f64::total_cmp);
-            }
-            (Some(m), None) => inner_roots(g, p.face, m, x, ylo, yhi, &mut roots, disk),
-            _ => {}
-        }
-        roots.push(yhi);
-        let mut sum = [0.0; K];
-        for k in 0..roots.len() - 1 {
-            let (a, b) = (roots[k], roots[k + 1]);
-            if b <= a || h(x, 0.5 * (a + b)) <= 0.0 {
-                continue;
-            }
-            let v = if ball {
-                // b = B sin τ with B = √(1 − a²): the ball's √(1 − r²) = B cos τ is smooth in τ.
-                let bmax = (1.0 - (2.0 * x / g.w - 1.0).powi(2)).max(0.0).sqrt();
-                let tau = |y: f64| ((1.0 - 2.0 * y / g.h) / bmax).clamp(-1.0, 1.0).asin();
-                gl(n, tau(b), tau(a), |t| {
-                    let (st, ct) = t.sin_cos();
-                    let y = 0.5 * g.h * (1.0 - bmax * st);
-                    let (d, j) = g.dir_jac(p.face, x, y);
-                    f(d, texture_at(img, p, x, y), j).map(|c| c * 0.5 * g.h * bmax * ct)
-                })
-            } else {
-                gl(n, a, b, |y| {
-                    let (d, j) = g.dir_jac(p.face, x, y);
-                    f(d, texture_at(img, p, x, y), j)
-                })
-            };
-            for c in 0..K {
-                sum[c] += v[c];
-            }
-        }
-        sum
-    };
-    let mut total = [0.0; K];
-    for w in breaks.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        if b <= a {
-            continue;
-        }
-        let (v, _) = adaptive(n, 0.0, 1.0, tol, MAX_INTERVALS, &mut |u| {
-            let (x, dx) = substitute(a, b, u, disk, disk);
-            inner(x).map(|c| c * dx)
-        });
-        for c in 0..K {
-            total[c] += v[c];
-        }
-    }
-    total
-}
-
-/// `u ∈ [0, 1]` → `y ∈ [a, b]` and `dy/du`: linear, or the smoothstep `a + L(3u² − 2u³)` at the
-/// ends flagged singular (it turns `√(end − y)` behaviour into a polynomial in u).
-#[inline]
-fn substitute(a: f64, b: f64, u: f64, lo: bool, hi: bool) -> (f64, f64) {
-    let l = b - a;
-    match (lo, hi) {
-        (false, false) => (a + l * u, l),
-        (true, true) => (a + l * u * u * (3.0 - 2.0 * u), 6.0 * l * u * (1.0 - u)),
-        (true, false) => (a + l * u * u, 2.0 * l * u),
-        (false, true) => (a + l * (2.0 * u - u * u), 2.0 * l * (1.0 - u)),
-    }
-}
-
-/// Roots of `m·d(x, ·)` strictly inside `(ylo, yhi)`, appended in increasing order.
-#[allow(clippy::too_many_arguments)]
-fn inner_roots(
-    g: &Geometry,
-    face: u32,
-    m: DVec3,
-    x: f64,
-    ylo: f64,
-    yhi: f64,
-    out: &mut Vec<f64>,
-    disk: bool,
-) {
-    let start = out.len();
-    match g.format {
-        DomeFormat::LatLong => {
-            // m·d = m_y cos θ + c sin θ = R cos(θ − α), zero at θ = α ± π/2 (mod π).
-            let phi = PI - 2.0 * PI * x / g.w;
-            let c = m.x * phi.sin() + m.z * phi.cos();
-            if c == 0.0 && m.y == 0.0 {
-                return;
-            }
-            let alpha = c.atan2(m.y);
-            for th in [alpha - 0.5 * PI, alpha + 0.5 * PI, alpha + 1.5 * PI] {
-                let y = th * g.h / PI;
-                if y > ylo && y < yhi {
-                    out.push(y);
-                }
-            }
-        }
-        DomeFormat::Cross => {
-            // m·(F + aR + bU) = 0 is a line in the face's (a, b).
-            let (f, r, u, blk) = texture::cross_basis(face);
-            let a = 2.0 * (x - blk.x * g.n) / g.n - 1.0;
-            let mu = m.dot(u);
-            if mu != 0.0 {
-                let b = -(m.dot(f) + a * m.dot(r)) / mu;
-                let y = blk.y * g.n + 0.5 * g.n * (1.0 - b);
-                if y > ylo && y < yhi {
-                    out.push(y);
-                }
-            }
-        }
-        _ => {
-            debug_assert!(disk);
-            let mut found = Vec::with_capacity(4);
-            sign_change_roots(
-                &mut |y| m.dot(g.dir_jac(face, x, y).0),
-                ylo,
-                yhi,
-                8,
-                &mut found,
-            );
-            out.extend(found.into_iter().filter(|&y| y > ylo && y < yhi));
-        }
-    }
-    out[start..].sort_by(f64::total_cmp);
 }

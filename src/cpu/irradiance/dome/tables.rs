@@ -1,11 +1,13 @@
 //! The tile tables of a textured dome (each piece's moment, grouped in tiles under bounding
-//! caps, built once) and the walk over them that gives a receiver's `E(n)`.
+//! caps, built once) and the walk over them that gives a receiver's `E(n)`, or its part inside a
+//! convex intersection of half-spaces (a masked dome's portal piece, DESIGN.md §8 P2).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::clip::{Clip, exact};
 use super::horizon::HorizonCurve;
-use super::pieces::{Domain, exact};
+use super::pieces::Domain;
 use super::quadrature::gl;
 use super::{DomeIrradiance, REL_TOL, add};
 use crate::prepare::texture::DomeFormat;
@@ -21,6 +23,9 @@ struct Tile {
     /// Cap centre and angular radius; radius = ∞ forces a descent.
     centre: DVec3,
     radius: f64,
+    /// `sin(radius)`, kept: a receiver's walk tests every tile (for a masked dome, once per
+    /// portal piece), and the sine was most of that walk's cost.
+    sin_radius: f64,
 }
 
 pub(super) struct Tables {
@@ -32,26 +37,33 @@ pub(super) struct Tables {
     rows: Vec<[[f64; 2]; 2]>,
 }
 
-/// Where a cap lies with respect to the lit hemisphere `m̂·d > 0`.
+/// Where a cap lies with respect to the lit region, the intersection of the half-spaces
+/// `m̂ᵢ·d > 0`.
 #[derive(PartialEq)]
 enum Side {
+    /// Inside every half-space.
     Lit,
+    /// Outside one of them.
     Dark,
     Crossed,
 }
 
-fn side(mhat: DVec3, centre: DVec3, radius: f64) -> Side {
+fn side(mhats: &[DVec3], centre: DVec3, radius: f64, sin_radius: f64) -> Side {
     if radius >= 0.5 * std::f64::consts::PI {
         return Side::Crossed;
     }
-    let (s, r) = (mhat.dot(centre), radius.sin() + 1e-12);
-    if s > r {
-        Side::Lit
-    } else if s < -r {
-        Side::Dark
-    } else {
-        Side::Crossed
+    let r = sin_radius + 1e-12;
+    let mut lit = true;
+    for mhat in mhats {
+        let s = mhat.dot(centre);
+        if s < -r {
+            return Side::Dark;
+        }
+        if !(s > r) {
+            lit = false;
+        }
     }
+    if lit { Side::Lit } else { Side::Crossed }
 }
 
 /// `tex ⊗ v`, channel-major: a moment's RGB × xyz entries.
@@ -220,6 +232,7 @@ impl DomeIrradiance {
             v,
             centre,
             radius,
+            sin_radius: radius.sin(),
         })
     }
 
@@ -227,11 +240,49 @@ impl DomeIrradiance {
     /// (module docs). Multiply by the dome's `intensity · 2^exposure · color ⊙ temperature` and
     /// `diffuse` outside.
     pub fn irradiance(&self, n: DVec3) -> DVec3 {
+        self.irradiance_within(n, &[])
+    }
+
+    /// `∫ L(ω) max(0, n·ω) dω` over the directions ω with `k·ω ≥ 0` for every `k` in `planes`
+    /// (world vectors), exactly as [`DomeIrradiance::irradiance`] (which is the case of no
+    /// plane): a convex spherical polygon clipped at the horizon, e.g. a portal piece seen from
+    /// a receiver (DESIGN.md §8 P2 mask mode, `cpu/portal.rs`). Each world half-space is the
+    /// dome-space half-space `(A_effᵀ k)·d ≥ 0` (`k·ω ∝ k·A_eff d`, §6 D1), the horizon
+    /// included. A tile or piece is added wholesale (`m · V`) when its cap is inside all of
+    /// them, skipped when it is outside any one, and integrated exactly ([`exact`]) otherwise.
+    pub fn irradiance_within(&self, n: DVec3, planes: &[DVec3]) -> DVec3 {
         let t = self.tables();
         let m = self.frame.horizon(n);
-        let mhat = m.normalize();
-        let curve = matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular)
-            .then(|| HorizonCurve::new(self.format, m));
+        let ms: Vec<DVec3> = std::iter::once(m)
+            .chain(planes.iter().map(|k| self.frame.horizon(*k)))
+            .collect();
+        let hats: Vec<DVec3> = ms.iter().map(|v| v.normalize()).collect();
+        let disk = matches!(self.format, DomeFormat::MirroredBall | DomeFormat::Angular);
+        // On a disk image a great circle through the rim's direction −Z (to within 1e-7 rad) is
+        // drawn as a diameter: then the clip is that straight line through the image's centre
+        // ([`Clip::line`]), and what this leaves out is within a cap of radius 1e-7 about −Z
+        // (< 4e-14 sr).
+        // A portal edge parallel to the dome's Z axis gives such a circle; its [`HorizonCurve`]
+        // would jump across the image there. Not applied to the unmasked dome (no plane), which
+        // stays as it was.
+        let lines: Vec<bool> = hats
+            .iter()
+            .map(|h| disk && !planes.is_empty() && !(h.z.abs() > 1e-7))
+            .collect();
+        let curves: Vec<Option<HorizonCurve>> = ms
+            .iter()
+            .zip(&lines)
+            .map(|(v, line)| (disk && !line).then(|| HorizonCurve::new(self.format, *v)))
+            .collect();
+        let clips: Vec<Clip> = ms
+            .iter()
+            .zip(curves.iter().zip(&lines))
+            .map(|(m, (c, line))| Clip {
+                m: *m,
+                curve: c.as_ref(),
+                line: *line,
+            })
+            .collect();
         let dot = |v: &[f64; 9]| {
             DVec3::new(
                 m.dot(DVec3::new(v[0], v[1], v[2])),
@@ -241,21 +292,21 @@ impl DomeIrradiance {
         };
         let mut e = DVec3::ZERO;
         for tile in &t.tiles {
-            match side(mhat, tile.centre, tile.radius) {
+            match side(&hats, tile.centre, tile.radius, tile.sin_radius) {
                 Side::Lit => e += dot(&tile.v),
                 Side::Dark => {}
                 Side::Crossed if t.single && tile.radius.is_finite() => {
-                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, curve.as_ref());
+                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, &clips);
                 }
                 Side::Crossed => {
                     for j in tile.iy.0..tile.iy.1 {
                         for i in tile.ix.0..tile.ix.1 {
                             let p = self.piece(tile.grid, i, j);
-                            match self.geom.cap(&p).map(|(c, r)| side(mhat, c, r)) {
+                            match self.geom.cap(&p).map(|(c, r)| side(&hats, c, r, r.sin())) {
                                 _ if self.geom.domain(&p) == Domain::Outside => {}
                                 Some(Side::Lit) => e += dot(&self.moment(t, tile.grid, i, j)),
                                 Some(Side::Dark) => {}
-                                _ => e += self.crossed(tile.grid, i, j, m, curve.as_ref()),
+                                _ => e += self.crossed(tile.grid, i, j, m, &clips),
                             }
                         }
                     }
@@ -265,23 +316,26 @@ impl DomeIrradiance {
         e
     }
 
-    /// One piece's share of `E`, clipped exactly at the horizon.
-    fn crossed(
-        &self,
-        grid: usize,
-        i: usize,
-        j: usize,
-        m: DVec3,
-        curve: Option<&HorizonCurve>,
-    ) -> DVec3 {
+    /// `∫ L(ω) max(0, n·ω) dω` over the directions of the convex planar polygon `q` (vectors
+    /// from the receiver to its vertices, in order): [`DomeIrradiance::irradiance_within`] of
+    /// its [`edge_planes`]; 0 for a polygon of no solid angle.
+    pub fn irradiance_over_polygon(&self, n: DVec3, q: &[DVec3]) -> DVec3 {
+        match edge_planes(q) {
+            Some(planes) => self.irradiance_within(n, &planes),
+            None => DVec3::ZERO,
+        }
+    }
+
+    /// One piece's share of `E`, clipped exactly at the horizon and the other clips (the first
+    /// clip is the horizon `m`).
+    fn crossed(&self, grid: usize, i: usize, j: usize, m: DVec3, clips: &[Clip]) -> DVec3 {
         let p = self.piece(grid, i, j);
         let delta = self.geom.cap(&p).map_or(0.5, |c| c.1.min(0.5));
         let v = exact(
             &self.geom,
             &self.img,
             &p,
-            Some(m),
-            curve,
+            clips,
             self.order(delta) + 2,
             REL_TOL * self.scale(&p) * m.length(),
             &mut |d, tex, jac| {
@@ -291,4 +345,36 @@ impl DomeIrradiance {
         );
         DVec3::from_array(v)
     }
+}
+
+/// The half-spaces `k·ω ≥ 0` (unit world `k`) whose intersection is the convex planar polygon
+/// `q` (vectors from x to its vertices, in order) seen from x: one per edge, the plane through x
+/// and the edge, `σ (q_i × q_{i+1})` with σ the sign of `(Σ q_i × q_{i+1})·q_0` (twice the
+/// polygon's vector area dotted with a vertex: positive when the vertices run
+/// counter-clockwise about the normal pointing away from x, when every `q_i × q_{i+1}` points
+/// inward). `None` for a polygon of no solid angle (a sliver seen edge-on, which the visibility
+/// split can leave): its edge planes would not bound it. An edge whose endpoints coincide is
+/// left out (its neighbours meet there).
+pub fn edge_planes(q: &[DVec3]) -> Option<Vec<DVec3>> {
+    let k = q.len();
+    if k < 3 {
+        return None;
+    }
+    let area2: DVec3 = (0..k).map(|i| q[i].cross(q[(i + 1) % k])).sum();
+    let scale = q.iter().map(|v| v.length()).fold(0.0, f64::max);
+    let volume = area2.dot(q[0]);
+    if !(volume.abs() > 1e-12 * scale * scale * scale) {
+        return None;
+    }
+    let sigma = volume.signum();
+    let mut out = Vec::with_capacity(k);
+    for i in 0..k {
+        let (a, b) = (q[i], q[(i + 1) % k]);
+        let c = a.cross(b);
+        let l = c.length();
+        if l > 1e-12 * a.length() * b.length() {
+            out.push(c * (sigma / l));
+        }
+    }
+    Some(out)
 }
