@@ -32,7 +32,11 @@ fn receivers(light: &Light, n: usize, rng: &mut Rng) -> (Vec<[f32; 3]>, Vec<[f32
     let radius = verts.iter().map(|v| v.distance(centre)).fold(0.0, f64::max);
     (0..n)
         .map(|i| {
-            let r = if i % 5 == 0 { 0.05 } else { rng.range(0.1, 3.0) };
+            let r = if i % 5 == 0 {
+                0.05
+            } else {
+                rng.range(0.1, 3.0)
+            };
             let x = centre + rng.unit() * (r * radius);
             (x.as_vec3().to_array(), rng.unit().as_vec3().to_array())
         })
@@ -41,7 +45,13 @@ fn receivers(light: &Light, n: usize, rng: &mut Rng) -> (Vec<[f32; 3]>, Vec<[f32
 
 /// GPU irradiance of one light against the reference at `n` receivers: (compared, excluded,
 /// worst relative error); asserts each compared one within 1e-4.
-fn compare(gpu: &Evaluator, name: &str, light: &Light, n: usize, rng: &mut Rng) -> (usize, usize, f64) {
+fn compare(
+    gpu: &Evaluator,
+    name: &str,
+    light: &Light,
+    n: usize,
+    rng: &mut Rng,
+) -> (usize, usize, f64) {
     let lights = std::slice::from_ref(light);
     let dev = gpu.prepare(lights).unwrap();
     let reference = Reference::new(light, TemperatureMode::Spec).unwrap();
@@ -63,7 +73,11 @@ fn compare(gpu: &Evaluator, name: &str, light: &Light, n: usize, rng: &mut Rng) 
             g[i],
             irradiance_margin(&reference, x, nn),
             top(light, x, nn),
-            want.x / reference.irradiance(x, (DVec3::splat(0.5) - x).normalize()).x.max(1e-300)
+            want.x
+                / reference
+                    .irradiance(x, (DVec3::splat(0.5) - x).normalize())
+                    .x
+                    .max(1e-300)
         );
         worst = worst.max(err);
         compared += 1;
@@ -97,7 +111,10 @@ fn mesh_irradiance_runs_on_the_device_where_the_triangles_cannot_hide_one_anothe
             lights.push((format!("box {xf} {id}"), b));
         }
         let world = random_light(3, xf, &mut rng, 0).world;
-        lights.push((format!("quad {xf}"), Light::mesh(rect_quad(1.5, 0.8, world))));
+        lights.push((
+            format!("quad {xf}"),
+            Light::mesh(rect_quad(1.5, 0.8, world)),
+        ));
         lights.push((
             format!("double-sided quad {xf}"),
             double(Light::mesh(rect_quad(1.5, 0.8, world))),
@@ -191,7 +208,9 @@ fn mesh_irradiance_throughput() {
     let (pts, nrms) = receivers(&b, n, &mut rng);
     let dev = gpu.prepare(lights).unwrap();
     let cpu = Evaluator::cpu().prepare(lights).unwrap();
-    let _ = dev.irradiance(&pts[..1024], &nrms[..1024], Accumulate::Sum).unwrap();
+    let _ = dev
+        .irradiance(&pts[..1024], &nrms[..1024], Accumulate::Sum)
+        .unwrap();
     let t = std::time::Instant::now();
     let _ = dev.irradiance(&pts, &nrms, Accumulate::Sum).unwrap();
     let g = t.elapsed().as_secs_f64();

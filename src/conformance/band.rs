@@ -492,11 +492,10 @@ fn mesh_irradiance_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, n:
             continue;
         };
         let h = (x - t.p[0]).dot(nt);
-        let elev = t
-            .p
-            .iter()
-            .map(|q| (h / (x - *q).length()).clamp(-1.0, 1.0).asin().abs())
-            .fold(0.0, f64::max);
+        let elev =
+            t.p.iter()
+                .map(|q| (h / (x - *q).length()).clamp(-1.0, 1.0).asin().abs())
+                .fold(0.0, f64::max);
         edge_on = edge_on.max(elev);
     }
     scale(top, band).min(scale(edge_on, band))

@@ -82,7 +82,12 @@ mod tests {
     fn flat(which: usize, world: DMat4, rng: &mut Rng) -> Light {
         match which {
             0 => polygons(
-                &[[-1.0, -0.5, 0.0], [1.0, -0.5, 0.0], [1.0, 0.5, 0.0], [-1.0, 0.5, 0.0]],
+                &[
+                    [-1.0, -0.5, 0.0],
+                    [1.0, -0.5, 0.0],
+                    [1.0, 0.5, 0.0],
+                    [-1.0, 0.5, 0.0],
+                ],
                 &[4],
                 &[0, 1, 2, 3],
                 world,
@@ -137,14 +142,15 @@ mod tests {
         };
         let verts: Vec<DVec3> = m.triangles.iter().flat_map(|t| t.p).collect();
         let centre = verts.iter().sum::<DVec3>() / verts.len() as f64;
-        let extent = verts
-            .iter()
-            .map(|v| v.distance(centre))
-            .fold(0.0, f64::max);
+        let extent = verts.iter().map(|v| v.distance(centre)).fold(0.0, f64::max);
         let mut worst = 0.0f64;
         for k in 0..40 {
             // Some receivers well inside (a box's), the others out to 3 extents.
-            let r = if k % 5 == 0 { 0.05 } else { rng.range(0.1, 3.0) };
+            let r = if k % 5 == 0 {
+                0.05
+            } else {
+                rng.range(0.1, 3.0)
+            };
             let x = centre + rng.unit() * (r * extent);
             let n = rng.unit();
             let got = mesh_lambert(m.triangles, m.double_sided, x, n);
@@ -212,7 +218,11 @@ mod tests {
                 let n = geometry.triangles.len();
                 std::sync::Arc::make_mut(geometry).triangles.truncate(n - 2);
             }
-            assert_eq!(occlusion(&prep(&b)), MeshOcclusion::General, "open box {xf}");
+            assert_eq!(
+                occlusion(&prep(&b)),
+                MeshOcclusion::General,
+                "open box {xf}"
+            );
             let world = random_light(3, xf, &mut rng, 0).world;
             let overlapping = polygons(
                 &[
@@ -229,7 +239,11 @@ mod tests {
                 &[0, 1, 2, 3, 4, 5, 6, 7],
                 world,
             );
-            assert_eq!(occlusion(&prep(&overlapping)), MeshOcclusion::General, "{xf}");
+            assert_eq!(
+                occlusion(&prep(&overlapping)),
+                MeshOcclusion::General,
+                "{xf}"
+            );
             // The same face twice, once reversed: closed and flat.
             let doubled = polygons(
                 &[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
