@@ -225,3 +225,46 @@ fn mesh_irradiance_throughput() {
         n as f64 / c
     );
 }
+
+/// A flat grid of 4050 triangles (under the 4096 cap) seen low over the horizon, where every
+/// triangle takes the sliver form (the most loop iterations a triangle costs): the sum is the
+/// reference's, so lavapipe's 65,535-iteration budget was not cut short.
+#[test]
+fn a_mesh_at_the_triangle_cap_seen_low_is_summed_whole() {
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let k = 45;
+    let mut pts = Vec::new();
+    for i in 0..=k {
+        for j in 0..=k {
+            pts.push([i as f64 / k as f64, j as f64 / k as f64, 0.0]);
+        }
+    }
+    let v = |i: i32, j: i32| i * (k + 1) + j;
+    let quads: Vec<[i32; 4]> = (0..k)
+        .flat_map(|i| (0..k).map(move |j| [v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]))
+        .collect();
+    let faces: Vec<&[i32]> = quads.iter().map(|q| &q[..]).collect();
+    let light = Light::mesh(mesh(&pts, &faces, DMat4::IDENTITY));
+    let reference = Reference::new(&light, TemperatureMode::Spec).unwrap();
+    let dev = gpu.prepare(std::slice::from_ref(&light)).unwrap();
+    let pts = [[3.0f32, 0.5, 0.4], [0.5, -2.0, 0.3], [-1.5, 1.5, 0.6]];
+    let nrms = [[0.0f32, 0.0, -1.0], [0.0, 0.0, -1.0], [0.3, 0.0, -1.0]];
+    let g = dev.irradiance(&pts, &nrms, Accumulate::Sum).unwrap();
+    for i in 0..pts.len() {
+        let x = DVec3::from_array(pts[i].map(f64::from));
+        let n = DVec3::from_array(nrms[i].map(f64::from)).normalize();
+        let want = reference.irradiance(x, n);
+        let err = rel_error_above(want, g[i], 0.0);
+        eprintln!(
+            "grid of 4050 at {x}: CPU {:.6e}, GPU {:.6e}, {err:.1e}",
+            want.x, g[i][0]
+        );
+        assert!(
+            want.x > 0.0 && err <= 1e-4,
+            "{x}: CPU {want}, GPU {:?}",
+            g[i]
+        );
+    }
+}
