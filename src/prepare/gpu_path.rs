@@ -30,7 +30,8 @@ pub enum GpuPath {
     /// Emission and radiance on the device (the mesh's distinct front directions and its BVH in
     /// the mesh atlas: shaders/emission.wgsl, shaders/mesh/ray.wgsl); intensity and irradiance
     /// from the CPU reference: mesh lights (DESIGN.md §7) with at most
-    /// [`MESH_FRONTS_ON_DEVICE`] front directions. Their intensity and irradiance need the exact
+    /// [`MESH_FRONTS_ON_DEVICE`] front directions, but those of
+    /// [`HostIntensityOnly`](GpuPath::HostIntensityOnly). Their intensity and irradiance need the exact
     /// visible pieces (cpu::mesh::visible), which have no kernel.
     HostIntensity(&'static str),
     /// Emission, radiance and irradiance on the device, intensity from the CPU reference: the
