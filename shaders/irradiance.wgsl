@@ -7,7 +7,7 @@
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
 // On the host: lights flagged FLAG_HOST_IRRADIANCE (IES-shaped lights, textured domes and
-//   textured rects) give 0 here and the host adds the CPU reference's value
+//   textured rects, masked domes, mesh lights whose triangles may hide one another) give 0 here and the host adds the CPU reference's value
 //   (prepare::Prepared::irradiance_on_host gives the reasons): this f32 quadrature does not
 //   split at a profile's angle nodes as the reference's line integrals do, and misses lit
 //   features narrower than its nodes; a textured dome's exact integral splits at texel-centre
@@ -31,6 +31,7 @@
 // #import irradiance/closed.wgsl
 // #import irradiance/chart.wgsl
 // #import irradiance/outer.wgsl
+// #import mesh/lambert.wgsl
 
 fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let base = light.base.xyz;
@@ -101,6 +102,11 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
                 chart = cylinder_chart(light, x);
                 use_chart = true;
             }
+        }
+        case KIND_MESH: {
+            // Only meshes whose triangles cannot hide one another get here
+            // (GpuPath::HostIntensityOnly): Lambert's formula summed over the triangles.
+            e = base * mesh_lambert(light, x, n);
         }
         default: {}
     }

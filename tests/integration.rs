@@ -35,6 +35,7 @@ mod luxtest_check;
 mod math;
 mod mesh_conformance;
 mod mesh_emission_gpu;
+mod mesh_irradiance_gpu;
 mod mesh_lights;
 mod portal_gpu;
 mod rect_conformance;

@@ -133,3 +133,57 @@ fn gpu_matches_cpu_on_randomised_portal_scenes() {
     }
     assert!(report.pass(), "{:?}", report.rows.iter().find(|r| !r.pass));
 }
+
+/// Unshaped random boxes under every transform kind (closed convex, one-sided: their
+/// irradiance is the device's, `GpuPath::HostIntensityOnly`): `luxeval check` compares an
+/// irradiance row for each, within the tolerance, and lists only their intensity as the host's.
+#[test]
+fn gpu_irradiance_of_unshaped_boxes_is_compared() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(0x00B0_C5E5);
+    let mut lights = Vec::new();
+    for xf in luxeval::testkit::TRANSFORMS {
+        for _ in 0..3 {
+            let id = lights.len();
+            let mut b = luxeval::testkit::random_mesh_light("box", xf, &mut rng, id);
+            b.shaping = None;
+            lights.push(b);
+        }
+    }
+    let refs: Vec<Reference> = lights
+        .iter()
+        .map(|l| Reference::new(l, TemperatureMode::Spec).expect("valid mesh light"))
+        .collect();
+    let counts = check::Samples {
+        emission: 50,
+        intensity: 10,
+        radiance: 100,
+        irradiance: 200,
+    };
+    let report = check::check_with(&gpu, &refs, counts, 22).expect("GPU check runs");
+    print(&report);
+    let irradiance: Vec<&check::QueryReport> = report
+        .rows
+        .iter()
+        .filter(|r| r.query == check::CheckedQuery::Irradiance)
+        .collect();
+    assert_eq!(irradiance.len(), lights.len());
+    let compared: usize = irradiance.iter().map(|r| r.samples - r.excluded).sum();
+    let lit: usize = irradiance.iter().map(|r| r.nonzero).sum();
+    assert!(lit * 3 >= compared, "only {lit} of {compared} lit");
+    assert!(
+        compared * 10 >= 9 * 200 * lights.len() / 2,
+        "the band swallowed too many: {compared} compared"
+    );
+    for (light, why) in &report.host_only {
+        assert!(why.contains("whose intensity the CPU"), "{light}: {why}");
+    }
+    let failures: Vec<_> = report.rows.iter().filter(|r| !r.pass).collect();
+    assert!(
+        failures.is_empty(),
+        "{} light/query pairs over {}: {:?}",
+        failures.len(),
+        check::TOLERANCE,
+        failures.first()
+    );
+}

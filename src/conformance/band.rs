@@ -442,6 +442,65 @@ pub fn irradiance_outline(r: &Reference, x: DVec3) -> Vec<DVec3> {
     }
 }
 
+/// How much wider than a rect's the band of a mesh light's irradiance is (see
+/// [`mesh_irradiance_margin`]).
+pub const MESH_SLIVER_WIDER: f64 = 4.0;
+
+/// A mesh light's irradiance margin (its irradiance is the device's only where its triangles
+/// cannot hide one another: `GpuPath::HostIntensityOnly`, shaders/mesh/lambert.wgsl), as a
+/// rect's: the highest elevation above the receiver's horizon of its triangles' edges (a
+/// mesh wholly at the horizon is a sliver), and the largest over the triangles of x's
+/// elevation above a triangle's plane seen from its vertices (a flat mesh seen edge-on), each
+/// within
+/// the f32 band η of the geometry's rounding seen from x, widened by [`MESH_SLIVER_WIDER`]: the
+/// kernel has no quadrature to fall back on, and its f32 sums lose up to ~1e-3 relative where
+/// the whole mesh lies within ~0.015 rad of the horizon (a flat hexagon seen from 0.16 above
+/// its plane and 1.5 from its centre, measured on lavapipe).
+fn mesh_irradiance_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, n: DVec3) -> f64 {
+    let scale = |v: f64, band: f64| v.abs() / band * BAND;
+    let k = 16;
+    let mut points = Vec::with_capacity(triangles.len() * 3 * k);
+    for t in triangles {
+        for e in 0..3 {
+            let (a, b) = (t.p[e], t.p[(e + 1) % 3]);
+            points.extend((0..k).map(|j| a + (b - a) * (j as f64 / k as f64)));
+        }
+    }
+    if points.is_empty() {
+        return f64::INFINITY;
+    }
+    let (lo, hi) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let size = (hi - lo).length();
+    let nearest = points
+        .iter()
+        .map(|q| (*q - x).length())
+        .fold(f64::INFINITY, f64::min);
+    let eta = F32_ROUNDING * (x.length() + (0.5 * (lo + hi)).length() + size) / nearest;
+    let band = MESH_SLIVER_WIDER * IRRADIANCE_SLIVER_FACTOR * eta;
+    let top = points
+        .iter()
+        .map(|q| n.dot((*q - x).normalize()).clamp(-1.0, 1.0).asin())
+        .fold(f64::NEG_INFINITY, f64::max);
+    // Edge-on: x near the plane of every triangle (a flat mesh's); a box's face seen edge-on
+    // adds little to the sum of the others.
+    let mut edge_on = 0.0f64;
+    for t in triangles {
+        let Some(nt) = (t.p[1] - t.p[0]).cross(t.p[2] - t.p[0]).try_normalize() else {
+            continue;
+        };
+        let h = (x - t.p[0]).dot(nt);
+        let elev =
+            t.p.iter()
+                .map(|q| (h / (x - *q).length()).clamp(-1.0, 1.0).asin().abs())
+                .fold(0.0, f64::max);
+        edge_on = edge_on.max(elev);
+    }
+    scale(top, band).min(scale(edge_on, band))
+}
+
 /// Distance of an irradiance receiver from the places where f32 legitimately cannot resolve the
 /// answer to 1e-4 (dimensionless, compared with [`BAND`]).
 ///
@@ -488,6 +547,9 @@ pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
             m = m.min(scale((rho - radius) / radius, BAND));
         }
         _ => {}
+    }
+    if let LightType::Mesh { geometry, .. } = &p.light.kind {
+        return m.min(mesh_irradiance_margin(&geometry.triangles, x, n));
     }
     let outline = irradiance_outline(r, x);
     if outline.is_empty() {

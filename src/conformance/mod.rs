@@ -209,6 +209,13 @@ pub fn check_with(
                      device (its emission and radiance are compared)"
                 ),
             )),
+            crate::prepare::GpuPath::HostIntensityOnly(why) => host_only.push((
+                p.light.path.clone(),
+                format!(
+                    "{why}, whose intensity the CPU reference answers on every device (its \
+                     emission, radiance and irradiance are compared)"
+                ),
+            )),
             _ => {}
         }
         let scene = PreparedScene::from_prepared(eval.backend().clone(), vec![p.clone()])?;

@@ -337,13 +337,22 @@ pub fn pack(
                 r.flags |= FLAG_DOUBLE_SIDED;
             }
             // The kernels traverse its BVH for radiance and, where its emission is the device's
-            // (GpuPath::HostIntensity), test its fronts; intensity and irradiance are the host's
-            // (they give 0 for KIND_MESH), and emission too under GpuPath::RadianceOnDevice.
+            // (GpuPath::HostIntensity), test its fronts; intensity is the host's (the kernel
+            // gives 0 for KIND_MESH), and emission too under GpuPath::RadianceOnDevice.
+            // Irradiance is the host's too (FLAG_HOST_IRRADIANCE) but under
+            // GpuPath::HostIntensityOnly, where the kernel sums Lambert's formula over its
+            // size.x triangles (at most MESH_TRIANGLES_SUMMED: exact in f32) in the atlas.
             r.tex = atlas.unwrap_or([0; 4]);
             if !p.emission_on_host() {
                 r.flags |= FLAG_MESH_FRONTS;
             }
-            (KIND_MESH, [0.0; 4])
+            let summed = match &p.kind {
+                crate::prepare::KindData::Mesh { bvh, .. } if !p.irradiance_on_host() => {
+                    bvh.order.len() as f32
+                }
+                _ => 0.0,
+            };
+            (KIND_MESH, [summed, 0.0, 0.0, 0.0])
         }
     };
     r.kind = kind;

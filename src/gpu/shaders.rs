@@ -50,6 +50,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/shared/texture.wgsl"),
     ),
     ("mesh/ray.wgsl", include_str!("../../shaders/mesh/ray.wgsl")),
+    (
+        "mesh/lambert.wgsl",
+        include_str!("../../shaders/mesh/lambert.wgsl"),
+    ),
     ("portal.wgsl", include_str!("../../shaders/portal.wgsl")),
     ("emission.wgsl", include_str!("../../shaders/emission.wgsl")),
     ("radiance.wgsl", include_str!("../../shaders/radiance.wgsl")),

@@ -30,9 +30,18 @@ pub enum GpuPath {
     /// Emission and radiance on the device (the mesh's distinct front directions and its BVH in
     /// the mesh atlas: shaders/emission.wgsl, shaders/mesh/ray.wgsl); intensity and irradiance
     /// from the CPU reference: mesh lights (DESIGN.md §7) with at most
-    /// [`MESH_FRONTS_ON_DEVICE`] front directions. Their intensity and irradiance need the exact
+    /// [`MESH_FRONTS_ON_DEVICE`] front directions, but those of
+    /// [`HostIntensityOnly`](GpuPath::HostIntensityOnly). Their intensity and irradiance need the exact
     /// visible pieces (cpu::mesh::visible), which have no kernel.
     HostIntensity(&'static str),
+    /// Emission, radiance and irradiance on the device, intensity from the CPU reference: the
+    /// unshaped mesh lights of [`HostIntensity`](GpuPath::HostIntensity)'s kind whose triangles
+    /// cannot hide one another (`prepare::mesh_class`: planar meshes without overlap, one-sided
+    /// closed convex meshes) and that have at most [`MESH_TRIANGLES_SUMMED`] triangles. Their
+    /// exact irradiance is the sum over the triangles x sees an emitting side of of Lambert's
+    /// formula clipped at the horizon (shaders/mesh/lambert.wgsl, the triangles in the mesh
+    /// atlas); their intensity still needs the visible pieces.
+    HostIntensityOnly(&'static str),
     /// Radiance on the device; emission, intensity and irradiance from the CPU reference: mesh
     /// lights with more than [`MESH_FRONTS_ON_DEVICE`] front directions (the emission kernel
     /// tests each in turn).
@@ -52,6 +61,12 @@ pub enum GpuPath {
 /// is read) at about the cost of a BVH traversal; flat, boxy and low-polygon lights have a
 /// handful, a smooth closed mesh about as many as triangles (those past 4096 stay on the host).
 pub const MESH_FRONTS_ON_DEVICE: usize = 4096;
+
+/// The most triangles of a mesh light that prepare classifies ([`crate::prepare::mesh_class`])
+/// and whose irradiance the kernel sums ([`GpuPath::HostIntensityOnly`]): one triangle per loop
+/// iteration, for lavapipe's budget as [`MESH_FRONTS_ON_DEVICE`]; the classification's checks
+/// are quadratic in the worst case, which this bounds too.
+pub const MESH_TRIANGLES_SUMMED: usize = 4096;
 
 /// The most portals of a masked dome whose crossings the radiance kernel tests (one loop
 /// iteration each, for lavapipe's budget as [`MESH_FRONTS_ON_DEVICE`]); a dome masked by more is

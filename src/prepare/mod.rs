@@ -13,6 +13,7 @@ pub mod gpu_path;
 pub mod ies;
 pub mod ies_kinks;
 pub mod mesh_bvh;
+pub mod mesh_class;
 pub mod normalize;
 pub mod portal;
 pub mod profile;
@@ -29,8 +30,10 @@ use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
 pub use gpu_path::{
-    GpuPath, MESH_DEVICE_BYTES, MESH_FRONTS_ON_DEVICE, MESH_STACK, PORTALS_ON_DEVICE,
+    GpuPath, MESH_DEVICE_BYTES, MESH_FRONTS_ON_DEVICE, MESH_STACK, MESH_TRIANGLES_SUMMED,
+    PORTALS_ON_DEVICE,
 };
+pub use mesh_class::MeshOcclusion;
 pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
 
@@ -154,6 +157,10 @@ pub enum KindData {
         /// The farthest vertex's distance from the prim's origin ([`Prepared::bound_radius`]),
         /// computed once: the light choice reads it per receiver.
         bound_radius: f64,
+        /// Whether its triangles can hide one another ([`mesh_class`]): where they cannot,
+        /// its unshaped irradiance is the triangles' Lambert sum, on the CPU reference
+        /// (`cpu::mesh::lambert`) and on the device ([`GpuPath::HostIntensityOnly`]).
+        occlusion: MeshOcclusion,
     },
 }
 
@@ -208,7 +215,10 @@ impl Prepared {
     /// Whether the GPU path takes this light's irradiance from the CPU reference
     /// ([`Prepared::gpu_path`]).
     pub fn irradiance_on_host(&self) -> bool {
-        !matches!(self.gpu_path, GpuPath::Device)
+        !matches!(
+            self.gpu_path,
+            GpuPath::Device | GpuPath::HostIntensityOnly(_)
+        )
     }
 
     /// Whether the GPU path takes this light's intensity from the CPU reference
@@ -218,7 +228,10 @@ impl Prepared {
     pub fn on_host(&self) -> bool {
         matches!(
             self.gpu_path,
-            GpuPath::HostIntensity(_) | GpuPath::RadianceOnDevice(_) | GpuPath::Host(_)
+            GpuPath::HostIntensity(_)
+                | GpuPath::HostIntensityOnly(_)
+                | GpuPath::RadianceOnDevice(_)
+                | GpuPath::Host(_)
         )
     }
 
@@ -357,7 +370,16 @@ impl Prepared {
                     None => None,
                 },
             },
-            LightType::Mesh { ref geometry, .. } => KindData::Mesh {
+            LightType::Mesh {
+                ref geometry,
+                double_sided,
+                ..
+            } => KindData::Mesh {
+                occlusion: mesh_class::classify(
+                    &geometry.triangles,
+                    double_sided,
+                    MESH_TRIANGLES_SUMMED,
+                ),
                 bvh: std::sync::Arc::new(mesh_bvh::MeshBvh::build(&geometry.triangles)),
                 fronts: std::sync::Arc::new(distinct_fronts(&geometry.triangles)),
                 cumulative_area: std::sync::Arc::new(
@@ -393,7 +415,13 @@ impl Prepared {
                 KindData::Shape
             }
         };
-        let gpu_path = if let KindData::Mesh { bvh, fronts, .. } = &kind {
+        let gpu_path = if let KindData::Mesh {
+            bvh,
+            fronts,
+            occlusion,
+            ..
+        } = &kind
+        {
             let bytes = 32 * bvh.nodes.len() as u64 + 40 * bvh.order.len() as u64;
             if bvh.depth() > MESH_STACK {
                 GpuPath::Host("it is a mesh light whose BVH is deeper than the kernel's stack")
@@ -404,6 +432,10 @@ impl Prepared {
             } else if fronts.len() > MESH_FRONTS_ON_DEVICE {
                 GpuPath::RadianceOnDevice(
                     "it is a mesh light facing more directions than the emission kernel tests",
+                )
+            } else if occlusion.free() && shaping.is_none() {
+                GpuPath::HostIntensityOnly(
+                    "it is a mesh light (its triangles cannot hide one another: irradiance on the device)",
                 )
             } else {
                 GpuPath::HostIntensity("it is a mesh light")

@@ -173,7 +173,7 @@ impl PreparedScene {
             | GpuPath::HostIntensity(reason)
             | GpuPath::RadianceOnDevice(reason)
             | GpuPath::Host(reason) => Some((p, reason)),
-            GpuPath::Device => None,
+            GpuPath::Device | GpuPath::HostIntensityOnly(_) => None,
         }) {
             return Err(LuxError::NotOnDevice {
                 light: p.light.path.clone(),
@@ -341,7 +341,7 @@ impl PreparedScene {
 
     /// Refuses a GPU-resident query of a scene holding a light whose `kernel` query the host
     /// computes (`GpuPath::Host`: every query; `RadianceOnDevice`: all but radiance;
-    /// `HostIntensity`: intensity, of mesh lights): the kernels give 0 for it, which this path
+    /// `HostIntensity`, `HostIntensityOnly`: intensity, of mesh lights): the kernels give 0 for it, which this path
     /// would return as if it were the answer. A masked dome's emission and radiance are the
     /// device's (`GpuPath::HostIrradiance`), so they pass.
     fn check_all_on_device(&self, kernel: Kernel) -> Result<()> {
@@ -354,6 +354,7 @@ impl PreparedScene {
             GpuPath::Host(reason)
             | GpuPath::RadianceOnDevice(reason)
             | GpuPath::HostIntensity(reason)
+            | GpuPath::HostIntensityOnly(reason)
                 if refused(p) =>
             {
                 Some((p, reason))

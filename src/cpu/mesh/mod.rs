@@ -1,5 +1,7 @@
 //! Mesh lights (MeshLightAPI, DESIGN.md §7) on the CPU reference, in f64.
 //!
+//! - [`lambert`]: the irradiance of a mesh whose triangles cannot hide one another (prepare's
+//!   `MeshOcclusion`): Lambert's formula summed over the triangles, no visible-piece search.
 //! - [`ray`]: the first triangle a ray meets, through the prepared hierarchy (M3 `radiance`).
 //! - [`sample`]: directions drawn by area, with the density summed over every triangle crossed.
 //! - [`shaped`]: a shaped mesh light's irradiance over one visible piece, in polar coordinates
@@ -12,6 +14,7 @@
 //! `orientation` and a mirroring transform by the model), from both sides when `doubleSided`;
 //! every triangle occludes the mesh's own light from either side (M2, M3).
 
+pub(crate) mod lambert;
 pub(crate) mod ray;
 pub mod sample;
 pub(crate) mod shaped;
@@ -22,7 +25,7 @@ use glam::DVec3;
 use super::shaping::shaping;
 use crate::model::{LightType, MeshTriangle};
 use crate::prepare::mesh_bvh::MeshBvh;
-use crate::prepare::{KindData, Prepared};
+use crate::prepare::{KindData, MeshOcclusion, Prepared};
 
 /// What a prepared mesh light carries, read together: its model's triangles and sides and its
 /// prepared hierarchy, front directions and running area sum.
@@ -32,6 +35,7 @@ pub(crate) struct MeshParts<'a> {
     pub bvh: &'a MeshBvh,
     pub fronts: &'a [DVec3],
     pub cumulative_area: &'a [f64],
+    pub occlusion: MeshOcclusion,
 }
 
 /// A prepared mesh light's [`MeshParts`]; `None` for other lights.
@@ -47,9 +51,11 @@ pub(crate) fn parts(p: &Prepared) -> Option<MeshParts<'_>> {
                 bvh,
                 fronts,
                 cumulative_area,
+                occlusion,
                 ..
             },
         ) => Some(MeshParts {
+            occlusion: *occlusion,
             triangles: &geometry.triangles,
             double_sided: *double_sided,
             bvh,
@@ -105,7 +111,8 @@ pub fn projected_area(p: &Prepared, e: DVec3) -> f64 {
 
 /// M3 `irradiance(x, n)` before `diffuse`, to relative tolerance `rel` where shaped: unshaped, `L`
 /// times the cosine-weighted solid angle of the visible emitting pieces, each by Lambert's
-/// formula clipped at the horizon (exact); shaped, the shaping of the emission direction `−ω`
+/// formula clipped at the horizon (exact; where the triangles cannot hide one another, the
+/// same sum over whole triangles, [`lambert`]); shaped, the shaping of the emission direction `−ω`
 /// integrated over the same pieces.
 pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3, rel: f64) -> DVec3 {
     let Some(m) = parts(p) else {
@@ -116,6 +123,9 @@ pub fn irradiance(p: &Prepared, x: DVec3, n: DVec3, rel: f64) -> DVec3 {
         double_sided: m.double_sided,
     };
     if p.shaping.is_none() {
+        if m.occlusion.free() {
+            return p.base * lambert::mesh_lambert(m.triangles, m.double_sided, x, n);
+        }
         return p.base * surface.cosine_solid_angle(x, n);
     }
     let mut sum = DVec3::ZERO;

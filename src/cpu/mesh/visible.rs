@@ -127,7 +127,7 @@ const FACES: [[DVec3; 3]; 6] = [
 /// A plane through x whose distance to a triangle is below this fraction of the triangle's
 /// distance from x contains it for our purposes: the triangle is seen edge-on and subtends no
 /// solid angle (and hides none); dividing by its c would only amplify rounding.
-const EDGE_ON: f64 = 1e-12;
+pub(crate) const EDGE_ON: f64 = 1e-12;
 
 /// Chart lengths below this fraction of the chart's extent count as zero (see [`clip`]).
 const LENGTH_TOL: f64 = 1e-13;
