@@ -121,8 +121,7 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
             {
                 p.base * (k * rect_lambert(p, x, n, width / 2.0, height / 2.0))
             } else if let Some(rel) = rule.texture_tolerance()
-                && p.rect_texture().is_some()
-                && p.ies.is_none()
+                && rect_fast::applies(p)
             {
                 // The fast path of a textured rect at a loose tolerance (rect_fast.rs).
                 let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
