@@ -12,7 +12,8 @@
 //! - Everything else (shaped lights, disks, ellipsoids, cylinders, `treatAsLine`) is one
 //!   deterministic scheme: a plane [`chart`] of the directions x sees the light in, in which
 //!   `E = L·∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY` (S the RGB shaping factor of the emission
-//!   direction e = −ŵ: cone, softness, focus, tint, IES; a rect's texture, [`rect_texture`]), integrated over
+//!   direction e = −ŵ: cone, softness, focus, tint, IES; a rect's texture, [`rect_texture`];
+//!   from `--tolerance` 1e-4 on a textured rect takes [`rect_fast`]), integrated over
 //!   lines Y = const ([`line`]) across the pieces between [`critical`] Ys ([`outer`]), each
 //!   piece mapped to remove peaks and square-root ends ([`pieces`]).
 //!
