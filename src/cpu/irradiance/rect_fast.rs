@@ -23,7 +23,7 @@
 //!   et al. 1983, with the moment rule of a cell as the basic rule): every active cell carries
 //!   the sum of its children's rules as its value and `|Σ children − own rule|` as its error
 //!   estimate; the cell with the largest error is replaced by its children until the summed
-//!   error is below `rel/8` of the summed value in every channel. Cells continue below texel
+//!   error is below `rel/16` of the summed value in every channel. Cells continue below texel
 //!   pieces (quadrants of a piece), so the near-field peak is resolved by subdivision.
 //! - Where K is not smooth the moment rule is not used: a cell the receiver's horizon crosses
 //!   (K's kink `max(0, n·w)`, a line of the chart) or that a shaping kink may cross (cone edge,
@@ -44,7 +44,9 @@
 //! What this does not prove: the error estimate is a-posteriori (as the reference's
 //! Gauss–Kronrod estimates are), not an a-priori bound; the tests measure the result against
 //! the 1e-9 reference on random textures (sizes to 64 × 32 in the default run, 256 × 128 with
-//! `--ignored`), shaped and unshaped, near, grazing and far receivers. [`applies`] leaves IES
+//! `--ignored`), shaped and unshaped, near, grazing and far receivers. Known miss: the ignored
+//! 256 × 128 test fails at one receiver (nearest filter, cone with focus, sheared transform,
+//! horizon through the rect): 1.016e-4 at 1e-4, independent of the stopping fraction. [`applies`] leaves IES
 //! profiles and sharp cone edges to the exact path.
 
 use std::collections::BinaryHeap;
@@ -382,7 +384,10 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
     let mut forced = usize::from(first.key == f64::INFINITY);
     let mut heap = BinaryHeap::new();
     heap.push(first);
-    let q = rel / 8.0;
+    // The estimates are not bounds, so the sum stops well inside rel. Open: one case of the
+    // ignored 256 × 128 test (nearest, shaped, skewed, grazing receiver) is 1.02 × rel off at
+    // 1e-4 at rel/8 and 1.016 × rel at rel/16: a bias no cell's estimate sees, not the stop.
+    let q = rel / 16.0;
     for _ in 0..MAX_SPLITS {
         let tiny = 1e-14 * total.abs().max_element();
         let done = forced == 0
