@@ -45,8 +45,7 @@
 //! Gauss–Kronrod estimates are), not an a-priori bound; the tests measure the result against
 //! the 1e-9 reference on random textures (sizes to 64 × 32 in the default run, 256 × 128 with
 //! `--ignored`), near, grazing and far receivers. Shaped rects are left to the exact path
-//! ([`applies`]: a bias was measured there). [`applies`] leaves IES
-//! profiles and sharp cone edges to the exact path.
+//! ([`applies`]: a bias was measured there), IES profiles too.
 
 use std::collections::BinaryHeap;
 
