@@ -12,7 +12,8 @@
 //! - Everything else (shaped lights, disks, ellipsoids, cylinders, `treatAsLine`) is one
 //!   deterministic scheme: a plane [`chart`] of the directions x sees the light in, in which
 //!   `E = L·∫∫ S(−ŵ)·max(0, n·w)·J/|w|⁴ dX dY` (S the RGB shaping factor of the emission
-//!   direction e = −ŵ: cone, softness, focus, tint, IES; a rect's texture, [`rect_texture`]), integrated over
+//!   direction e = −ŵ: cone, softness, focus, tint, IES; a rect's texture, [`rect_texture`];
+//!   from `--tolerance` 1e-4 on a textured rect takes [`rect_fast`]), integrated over
 //!   lines Y = const ([`line`]) across the pieces between [`critical`] Ys ([`outer`]), each
 //!   piece mapped to remove peaks and square-root ends ([`pieces`]).
 //!
@@ -32,6 +33,7 @@ pub mod dome;
 pub mod line;
 pub mod outer;
 pub mod pieces;
+pub mod rect_fast;
 pub mod rect_texture;
 
 use glam::DVec3;
@@ -119,6 +121,16 @@ pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> D
                 .flatten()
             {
                 p.base * (k * rect_lambert(p, x, n, width / 2.0, height / 2.0))
+            } else if let Some(rel) = rule.texture_tolerance()
+                && rect_fast::applies(p)
+            {
+                // The fast path of a textured rect at a loose tolerance (rect_fast.rs).
+                let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
+                if p.profile.dark || !(c.jac > 0.0) || !c.jac.is_finite() {
+                    DVec3::ZERO
+                } else {
+                    p.base * rect_fast::chart_integral(p, &c, n, rel).unwrap_or(DVec3::NAN)
+                }
             } else {
                 let c = plane_chart(p, x, width / 2.0, height / 2.0, Region::Square);
                 chart_irradiance(p, &c, n, rule)
@@ -189,6 +201,11 @@ pub trait Rule {
     /// (`cpu::mesh::irradiance`): the reference's 1e-9 unless the rule says otherwise.
     fn piece_tolerance(&self) -> f64 {
         1e-9
+    }
+    /// The relative tolerance a textured rect's fast path ([`rect_fast`]) is run to; None: the
+    /// exact split path (`rect_texture`) runs.
+    fn texture_tolerance(&self) -> Option<f64> {
+        None
     }
     /// The whole chart integral (the base radiance not applied).
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3
@@ -365,6 +382,14 @@ impl Rule for Adaptive {
 
     fn piece_tolerance(&self) -> f64 {
         self.outer.rel
+    }
+
+    /// The tolerance asked of [`Adaptive::for_tolerance`] (its outer rule stops at a quarter of
+    /// it) when it is at least [`rect_fast::MIN_TOLERANCE`]; the reference (no shortcuts) and
+    /// tighter rules keep the exact split path.
+    fn texture_tolerance(&self) -> Option<f64> {
+        let rel = 4.0 * self.outer.rel;
+        (self.shortcuts && rel >= rect_fast::MIN_TOLERANCE * (1.0 - 1e-12)).then_some(rel)
     }
 
     fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3 {

@@ -254,6 +254,10 @@ pub struct RectTexture {
     pub image: Arc<Image>,
     filter: Filter,
     mean: DVec3,
+    /// The moment tree of the fast irradiance path (built lazily by the CPU on the first query
+    /// at a loose tolerance, `src/cpu/irradiance/rect_fast.rs`, and shared by clones). Typed
+    /// `Any` because prepare does not name cpu types.
+    pub irradiance: IrradianceSlot,
 }
 
 impl RectTexture {
@@ -263,6 +267,7 @@ impl RectTexture {
             image,
             filter,
             mean,
+            irradiance: IrradianceSlot::default(),
         }
     }
 

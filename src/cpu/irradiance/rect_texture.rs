@@ -18,7 +18,9 @@
 //!   vertical lines join the square's sides as straight edges in `critical::critical_ys`).
 //!
 //! Each smooth piece is integrated by the reference's adaptive Gauss–Kronrod rule to its
-//! tolerance (`Adaptive::REFERENCE`, ~1e-9 relative), as for an untextured shaped rect.
+//! tolerance (`Adaptive::REFERENCE`, ~1e-9 relative), as for an untextured shaped rect. This
+//! costs ~225 kernel evaluations per texel per receiver (~50 s for 2048 × 1024); at tolerances
+//! from 1e-4 on, `rect_fast` computes the same integral from moments of the texture instead.
 
 use glam::{DVec2, DVec3};
 
