@@ -57,19 +57,24 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Whether `path` is an out-of-line test module: a `tests.rs` that its parent module (`mod.rs`
-/// beside it, or the `<dir>.rs` it sits under) declares as `#[cfg(test)] mod tests;`.
+/// Whether `path` is an out-of-line test module: a file `NAME.rs` (e.g. `tests.rs`,
+/// `exact_tests.rs`) that its parent module (`mod.rs` beside it, or the `<dir>.rs` it sits
+/// under) declares as `#[cfg(test)] mod NAME;`.
 fn is_test_module(path: &Path) -> bool {
-    if path.file_name().is_none_or(|n| n != "tests.rs") {
+    let Some(stem) = path.file_stem().and_then(|s| s.to_str()) else {
+        return false;
+    };
+    if stem == "mod" {
         return false;
     }
     let Some(dir) = path.parent() else {
         return false;
     };
+    let declaration = format!("#[cfg(test)]\nmod {stem};");
     let parents = [dir.join("mod.rs"), dir.with_extension("rs")];
     parents
         .iter()
-        .any(|p| std::fs::read_to_string(p).is_ok_and(|t| t.contains("#[cfg(test)]\nmod tests;")))
+        .any(|p| std::fs::read_to_string(p).is_ok_and(|t| t.contains(&declaration)))
 }
 
 /// The crate modules a source file names outside its test sections (an out-of-line test
