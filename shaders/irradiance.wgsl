@@ -22,6 +22,9 @@
 //   call site is inlined by the shader compiler, and one copy of the quadrature instead of four
 //   cut lavapipe's compile time from ~10 s to ~7 s (and with the IES lookup inlined, from over
 //   5 minutes to under one).
+// f32: a (light, receiver) whose quadrature's loops were cut short (lavapipe only: its loops
+//   stop silently after 65,535 iterations, see irr_cut in shared/record.wgsl) is NaN here, and
+//   the host recomputes it on the CPU reference (query::PreparedScene::irradiance).
 // f32: the receiver normal is normalised in irradiance_main (the CPU: in cpu::irradiance_batch);
 //   a zero normal gives 0 on both.
 // GPU-only irradiance_main: the kernel's entry point.
@@ -120,7 +123,13 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn irradiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = sample_index(gid);
+    // One sample per lane_stride invocations (see Params::lane_stride): the others return.
+    let lane = sample_index(gid);
+    let stride = max(params.lane_stride, 1u);
+    if lane % stride != 0u {
+        return;
+    }
+    let i = lane / stride;
     if i >= params.count {
         return;
     }
@@ -133,7 +142,13 @@ fn irradiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var l = params.light_first; l < params.light_end; l++) {
         var v = vec3<f32>(0.0);
         if valid {
+            irr_cut = false;
             v = irradiance(lights[l], x, n);
+            if irr_cut {
+                // A loop was cut short (see irr_cut in shared/record.wgsl): NaN, which the
+                // host recomputes.
+                v = vec3<f32>(bitcast<f32>(0x7fc00000u));
+            }
         }
         add(i, l, v, &sum);
     }

@@ -8,15 +8,25 @@
 //   f64 replay is testkit::kernel_rule.
 // f32: an unshaped line piece takes the closed form only where it is tan-mapped (there its terms
 //   cannot cancel), else the inner rule (the CPU: the closed form everywhere).
-// f32: at most MAX_BPS breakpoints per line.
+// f32: at most MAX_BPS breakpoints per line besides an IES profile's, which are streamed: the
+//   CPU lists the profile's cones and planes that can meet the chart and sorts all their roots;
+//   the kernel, which has no array of a profile's size, walks the cones (planes) a line crosses
+//   in the order it crosses them, as a run of the list sorted by cosine (azimuth) on each side
+//   of the cosine's extremum (the pencil's closest approach), found by binary search
+//   (prepare::ies_kinks::KinkFamilies; layout in src/gpu/ies_atlas.rs), and merges them with
+//   the fixed breakpoints. A crossing is the quadratic's root on its side, clamped to the side.
 // GPU-only inner_node, inner_rule, max3, inner_adaptive: the kernel's inner rule (above).
+// GPU-only kink_step, kink_rank, cone_side, cone_run, plane_side, plane_run, run_next: the
+//   streamed IES breakpoints (above).
+// GPU-only line_piece: the body of the CPU's loop over pieces, a function here because the
+//   merge loop above calls it once per piece.
 
 // #import shared/record.wgsl
 // #import shared/shaping.wgsl
 // #import shared/roots.wgsl
 // #import irradiance/pieces.wgsl
 
-const MAX_BPS: u32 = 10u;
+const MAX_BPS: u32 = 14u;
 
 // Node k of the inner Gauss–Legendre rule on [s0, s0 + h] of one span's parameter.
 fn inner_node(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap, s0: f32, h: f32, k: u32) -> vec3<f32> {
@@ -71,6 +81,7 @@ fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: 
     var parent = vec3<f32>(0.0);
     var ql = vec3<f32>(0.0);
     var step = 0u;
+    var done = false;
     loop {
         let mid = 0.5 * (p0 + p1);
         let r = inner_rule(light, n, a, e1, sp, select(p0, mid, step == 2u), select(p1, mid, step == 1u));
@@ -89,6 +100,7 @@ fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: 
         if d + 1u >= IRR_INNER_DEPTH || max3(abs(fine - parent)) <= IRR_INNER_TOL * max3(abs(fine)) {
             sum += fine;
             if top == 0u {
+                done = true;
                 break;
             }
             top -= 1u;
@@ -109,7 +121,253 @@ fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: 
         }
         step = 1u;
     }
+    if !done {
+        // Cut short by the device's loop budget (see irr_cut).
+        irr_cut = true;
+    }
     return sum;
+}
+
+// One binary-search step over the sorted floats ies_atlas[off + i], i < n, for the count of
+// those below x (or not above x, with `inclusive`): lh = (lo, hi) brackets the count. Written
+// out, not looped (see IES_SEARCH_STEPS in shared/ies.wgsl: lavapipe's loop budget).
+fn kink_step(off: u32, x: f32, inclusive: bool, lh: vec2<u32>) -> vec2<u32> {
+    if lh.x >= lh.y {
+        return lh;
+    }
+    let mid = (lh.x + lh.y) / 2u;
+    let v = ies_atlas[off + mid];
+    if v < x || (inclusive && v == x) {
+        return vec2<u32>(mid + 1u, lh.y);
+    }
+    return vec2<u32>(lh.x, mid);
+}
+
+// How many of the n sorted floats at ies_atlas[off] are below x (inclusive: not above x);
+// KINK_SEARCH_STEPS halvings cover the longest list the packer writes.
+fn kink_rank(off: u32, n: u32, x: f32, inclusive: bool) -> u32 {
+    var lh = vec2<u32>(0u, n);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    lh = kink_step(off, x, inclusive, lh);
+    return lh.x;
+}
+
+// A run of IES kinks a line crosses on one side [s0, s1] of its split point: `left` crossings
+// remain, the next at list index `idx` (stepping up or down, cyclically for planes); `next` is
+// its X (1e30 when none is left).
+struct KinkRun {
+    s0: f32,
+    s1: f32,
+    split: f32,
+    hi: f32,
+    side: u32,
+    idx: u32,
+    left: u32,
+    up: bool,
+    next: f32,
+}
+
+// Cones: the run on side `side` (0: [lo, split], 1: [split, hi]) of the extremum of −ŵ·axis.
+fn cone_side(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, side: u32) -> KinkRun {
+    var r = run;
+    r.side = side;
+    if side == 1u {
+        r.s0 = r.split;
+        r.s1 = r.hi;
+    } else {
+        r.s1 = r.split;
+    }
+    r.left = 0u;
+    let n = u32(ies_atlas[kb]);
+    let axis = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
+    let off = kb + IES_KINKS_HEADER;
+    if n == 0u || !(r.s1 > r.s0) {
+        return r;
+    }
+    let w0 = al + el * r.s0;
+    let w1 = al + el * r.s1;
+    let c0 = -dot(w0, axis) / length(w0);
+    let c1 = -dot(w1, axis) / length(w1);
+    if c1 > c0 {
+        let first = kink_rank(off, n, c0, true);
+        r.left = max(kink_rank(off, n, c1, false), first) - first;
+        r.idx = first;
+        r.up = true;
+    } else if c1 < c0 {
+        let below = kink_rank(off, n, c0, false);
+        r.left = below - min(kink_rank(off, n, c1, true), below);
+        r.idx = below - 1u;
+        r.up = false;
+    }
+    return r;
+}
+
+// The run of cones along w = al + X el over [lo, hi] (light frame), its first crossing found.
+fn cone_run(kb: u32, al: vec3<f32>, el: vec3<f32>, lo: f32, hi: f32) -> KinkRun {
+    var r: KinkRun;
+    r.s0 = lo;
+    r.hi = hi;
+    let axis = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
+    let xe = axis_approach(axis, al, el);
+    r.split = hi;
+    if xe.y > 0.0 && xe.x > lo && xe.x < hi {
+        r.split = xe.x;
+    }
+    r = cone_side(r, kb, al, el, 0u);
+    return run_next(r, kb, al, el, true, false);
+}
+
+// Planes of the pencil: the run on side `side` of the line's closest approach to the pencil's
+// axis (the azimuth about it turns one way, by less than 90°, on each side).
+fn plane_side(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, side: u32) -> KinkRun {
+    var r = run;
+    r.side = side;
+    if side == 1u {
+        r.s0 = r.split;
+        r.s1 = r.hi;
+    } else {
+        r.s1 = r.split;
+    }
+    r.left = 0u;
+    let np = u32(ies_atlas[kb + 4u]);
+    let off = kb + IES_KINKS_HEADER + u32(ies_atlas[kb]);
+    if np == 0u || !(r.s1 > r.s0) {
+        return r;
+    }
+    let p = vec3<f32>(ies_atlas[kb + 5u], ies_atlas[kb + 6u], ies_atlas[kb + 7u]);
+    let u = vec3<f32>(ies_atlas[kb + 8u], ies_atlas[kb + 9u], ies_atlas[kb + 10u]);
+    let v = cross(p, u);
+    let w0 = al + el * r.s0;
+    let w1 = al + el * r.s1;
+    let q0 = vec2<f32>(dot(w0, u), dot(w0, v));
+    let q1 = vec2<f32>(dot(w1, u), dot(w1, v));
+    // The azimuth of q0 mod π, and the signed turn from q0 to q1.
+    var g0 = atan2_accurate(q0.y, q0.x);
+    if g0 < 0.0 {
+        g0 += PI;
+    }
+    if g0 >= PI {
+        g0 -= PI;
+    }
+    let d = atan2_accurate(q0.x * q1.y - q0.y * q1.x, dot(q0, q1));
+    let g1 = g0 + d;
+    if d > 0.0 {
+        let first = kink_rank(off, np, g0, true);
+        if g1 < PI {
+            r.left = max(kink_rank(off, np, g1, false), first) - first;
+        } else {
+            r.left = np - first + kink_rank(off, np, g1 - PI, false);
+        }
+        r.idx = first % np;
+        r.up = true;
+    } else if d < 0.0 {
+        let below = kink_rank(off, np, g0, false);
+        if g1 >= 0.0 {
+            r.left = below - min(kink_rank(off, np, g1, true), below);
+        } else {
+            r.left = below + np - kink_rank(off, np, g1 + PI, true);
+        }
+        r.idx = (below + np - 1u) % np;
+        r.up = false;
+    }
+    return r;
+}
+
+// The run of the pencil's planes along w = al + X el over [lo, hi], its first crossing found.
+fn plane_run(kb: u32, al: vec3<f32>, el: vec3<f32>, lo: f32, hi: f32) -> KinkRun {
+    var r: KinkRun;
+    r.s0 = lo;
+    r.hi = hi;
+    let p = vec3<f32>(ies_atlas[kb + 5u], ies_atlas[kb + 6u], ies_atlas[kb + 7u]);
+    let ep = el - p * dot(el, p);
+    let ee = dot(ep, ep);
+    r.split = hi;
+    if ee > 0.0 {
+        let xp = -dot(al, ep) / ee;
+        if xp > lo && xp < hi {
+            r.split = xp;
+        }
+    }
+    r = plane_side(r, kb, al, el, 0u);
+    return run_next(r, kb, al, el, false, false);
+}
+
+// The run's next crossing (`advance`: past the current one), moving to the second side when
+// the first is done; `cones` says which family the run walks.
+fn run_next(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, cones: bool, advance: bool) -> KinkRun {
+    var r = run;
+    if advance && r.left > 0u {
+        r.left -= 1u;
+        let nc = u32(ies_atlas[kb]);
+        let np = u32(ies_atlas[kb + 4u]);
+        if cones {
+            r.idx = select(r.idx - 1u, r.idx + 1u, r.up);
+        } else {
+            r.idx = select((r.idx + np - 1u) % np, (r.idx + 1u) % np, r.up);
+        }
+    }
+    if r.left == 0u && r.side == 0u {
+        if cones {
+            r = cone_side(r, kb, al, el, 1u);
+        } else {
+            r = plane_side(r, kb, al, el, 1u);
+        }
+    }
+    r.next = 1e30;
+    if r.left == 0u {
+        return r;
+    }
+    var x = r.s0;
+    if cones {
+        let axis = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
+        let cs = ies_atlas[kb + IES_KINKS_HEADER + r.idx];
+        let roots = cone_roots_on_line(axis, cs, al, el);
+        let mask = u32(roots.z);
+        // The root on this side: the valid one nearest to [s0, s1].
+        var best = 1e30;
+        if (mask & 1u) != 0u {
+            let d = max(max(r.s0 - roots.x, roots.x - r.s1), 0.0);
+            if d < best {
+                best = d;
+                x = roots.x;
+            }
+        }
+        if (mask & 2u) != 0u {
+            let d = max(max(r.s0 - roots.y, roots.y - r.s1), 0.0);
+            if d < best {
+                best = d;
+                x = roots.y;
+            }
+        }
+    } else {
+        let np = u32(ies_atlas[kb + 4u]);
+        let p = vec3<f32>(ies_atlas[kb + 5u], ies_atlas[kb + 6u], ies_atlas[kb + 7u]);
+        let u = vec3<f32>(ies_atlas[kb + 8u], ies_atlas[kb + 9u], ies_atlas[kb + 10u]);
+        let mo = kb + IES_KINKS_HEADER + u32(ies_atlas[kb]) + np + 2u * r.idx;
+        let m = u * ies_atlas[mo] + cross(p, u) * ies_atlas[mo + 1u];
+        let den = dot(m, el);
+        if den != 0.0 {
+            x = -dot(m, al) / den;
+        }
+    }
+    r.next = clamp(x, r.s0, r.s1);
+    return r;
 }
 
 // ∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX along w = a + X e1, X ∈ [x0, x1].
@@ -137,18 +395,25 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
     graded[1] = 0u;
     var count = 2u;
     let axis = light.axis.xyz;
-    for (var ci = 0u; ci < kink_count(light); ci++) {
-        let r = cone_roots_on_line(axis, kink_cos(light, ci), a, e1);
-        let mask = u32(r.z);
-        if (mask & 1u) != 0u && r.x > lo && r.x < hi {
-            bp[count] = r.x;
-            graded[count] = 0u;
-            count += 1u;
+    {
+        var ci = 0u;
+        for (; ci < kink_count(light); ci++) {
+            let r = cone_roots_on_line(axis, kink_cos(light, ci), a, e1);
+            let mask = u32(r.z);
+            if (mask & 1u) != 0u && r.x > lo && r.x < hi {
+                bp[count] = r.x;
+                graded[count] = 0u;
+                count += 1u;
+            }
+            if (mask & 2u) != 0u && r.y > lo && r.y < hi {
+                bp[count] = r.y;
+                graded[count] = 0u;
+                count += 1u;
+            }
         }
-        if (mask & 2u) != 0u && r.y > lo && r.y < hi {
-            bp[count] = r.y;
-            graded[count] = 0u;
-            count += 1u;
+        if ci < kink_count(light) {
+            // Cut short by the device's loop budget (see irr_cut).
+            irr_cut = true;
         }
     }
     if has_flag(light, FLAG_FOCUS_PLANE) {
@@ -170,17 +435,77 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
             count += 1u;
         }
     }
-    for (var i = 1u; i < count; i++) {
-        let v = bp[i];
-        let g = graded[i];
-        var j = i;
-        while j > 0u && bp[j - 1u] > v {
-            bp[j] = bp[j - 1u];
-            graded[j] = graded[j - 1u];
-            j -= 1u;
+    // An IES profile's planes that are not in its pencil (a cone of 90°) are fixed breakpoints;
+    // its cones and the pencil's planes are streamed below.
+    let has_ies = has_flag(light, FLAG_IES);
+    let kb = u32(light.ies.w);
+    let al = to_local_dir(light, a);
+    let el = to_local_dir(light, e1);
+    if has_ies {
+        // The streams' split points too (where the line is nearest the cone axis and the
+        // pencil's axis): a crossing exactly there (an axis-aligned line through a plane of
+        // the pencil, a cone touched) belongs to neither side's run.
+        let axis_c = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
+        let xe = axis_approach(axis_c, al, el);
+        if ies_atlas[kb] > 0.0 && xe.y > 0.0 && xe.x > lo && xe.x < hi {
+            bp[count] = xe.x;
+            graded[count] = 0u;
+            count += 1u;
         }
-        bp[j] = v;
-        graded[j] = g;
+        let axis_p = vec3<f32>(ies_atlas[kb + 5u], ies_atlas[kb + 6u], ies_atlas[kb + 7u]);
+        let ep = el - axis_p * dot(el, axis_p);
+        if ies_atlas[kb + 4u] > 0.0 && dot(ep, ep) > 0.0 {
+            let xp = -dot(al, ep) / dot(ep, ep);
+            if xp > lo && xp < hi {
+                bp[count] = xp;
+                graded[count] = 0u;
+                count += 1u;
+            }
+        }
+        let extra = u32(ies_atlas[kb + 11u]);
+        {
+            var k = 0u;
+            for (; k < extra; k++) {
+                let o = kb + 12u + 3u * k;
+                let m = vec3<f32>(ies_atlas[o], ies_atlas[o + 1u], ies_atlas[o + 2u]);
+                let den = dot(m, el);
+                if den != 0.0 {
+                    let xk = -dot(m, al) / den;
+                    if xk > lo && xk < hi {
+                        bp[count] = xk;
+                        graded[count] = 0u;
+                        count += 1u;
+                    }
+                }
+            }
+            if k < extra {
+                // Cut short by the device's loop budget (see irr_cut).
+                irr_cut = true;
+            }
+        }
+    }
+    {
+        var i = 1u;
+        for (; i < count; i++) {
+            let v = bp[i];
+            let g = graded[i];
+            var j = i;
+            while j > 0u && bp[j - 1u] > v {
+                bp[j] = bp[j - 1u];
+                graded[j] = graded[j - 1u];
+                j -= 1u;
+            }
+            if j > 0u && bp[j - 1u] > v {
+                // Cut short by the device's loop budget (see irr_cut).
+                irr_cut = true;
+            }
+            bp[j] = v;
+            graded[j] = g;
+        }
+        if i < count {
+            // Cut short by the device's loop budget (see irr_cut).
+            irr_cut = true;
+        }
     }
     // The line's closest approach to x: X* and the width √m/|e1|, m = |a × e1|²/|e1|².
     let e12 = dot(e1, e1);
@@ -190,26 +515,75 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
     let width = cr / e12;
     let m = cr * cr / e12;
     let unshaped = !has_flag(light, FLAG_SHAPING);
+    // The streamed IES crossings (see the header); none without a profile.
+    var cones: KinkRun;
+    cones.next = 1e30;
+    var planes: KinkRun;
+    planes.next = 1e30;
+    if has_ies {
+        cones = cone_run(kb, al, el, lo, hi);
+        planes = plane_run(kb, al, el, lo, hi);
+    }
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i + 1u < count; i++) {
-        let t0 = bp[i];
-        let t1 = bp[i + 1u];
-        if !(t1 > t0) {
-            continue;
+    // Pieces [t0, t1] between consecutive breakpoints of the fixed list (index fi next) merged
+    // with the two runs.
+    var t0 = bp[0];
+    var gr0 = graded[0];
+    var fi = 1u;
+    var done = false;
+    loop {
+        var t1 = bp[fi];
+        var gr1 = graded[fi];
+        var src_kind = 0u;
+        if cones.next < t1 {
+            t1 = cones.next;
+            gr1 = 0u;
+            src_kind = 1u;
         }
-        let pm = piece_map(t0, t1, x_star, width, false, false);
-        if unshaped && pm.tan_map && m > 0.0 {
-            // (n·w)/|w|⁴ dX = (width/m²)(n·perp cos²u + width n·e1 sin u cos u) du.
-            let np = dot(n, perp);
-            let nw = ne * width;
-            let p1 = np * (0.5 * pm.u1 + 0.25 * sin(2.0 * pm.u1)) + nw * 0.5 * sin(pm.u1) * sin(pm.u1);
-            let p0 = np * (0.5 * pm.u0 + 0.25 * sin(2.0 * pm.u0)) + nw * 0.5 * sin(pm.u0) * sin(pm.u0);
-            sum += vec3<f32>(max(width / (m * m) * (p1 - p0), 0.0));
-            continue;
+        if planes.next < t1 {
+            t1 = planes.next;
+            gr1 = 0u;
+            src_kind = 2u;
         }
+        if t1 > t0 {
+            sum += line_piece(light, n, a, e1, t0, t1, gr0 != 0u, gr1 != 0u, x_star, width, m, perp, unshaped);
+            t0 = t1;
+        }
+        gr0 = gr1;
+        if src_kind == 1u {
+            cones = run_next(cones, kb, al, el, true, true);
+        } else if src_kind == 2u {
+            planes = run_next(planes, kb, al, el, false, true);
+        } else {
+            fi += 1u;
+            if fi >= count {
+                done = true;
+                break;
+            }
+        }
+    }
+    if !done {
+        // Cut short by the device's loop budget (see irr_cut).
+        irr_cut = true;
+    }
+    return sum;
+}
+
+// One smooth piece [t0, t1] of a line (g0, g1: whether its ends are graded), see line_integral.
+fn line_piece(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, t0: f32, t1: f32, g0: bool, g1: bool, x_star: f32, width: f32, m: f32, perp: vec3<f32>, unshaped: bool) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    let pm = piece_map(t0, t1, x_star, width, false, false);
+    if unshaped && pm.tan_map && m > 0.0 {
+        // (n·w)/|w|⁴ dX = (width/m²)(n·perp cos²u + width n·e1 sin u cos u) du.
+        let ne = dot(n, e1);
+        let np = dot(n, perp);
+        let nw = ne * width;
+        let p1 = np * (0.5 * pm.u1 + 0.25 * sin(2.0 * pm.u1)) + nw * 0.5 * sin(pm.u1) * sin(pm.u1);
+        let p0 = np * (0.5 * pm.u0 + 0.25 * sin(2.0 * pm.u0)) + nw * 0.5 * sin(pm.u0) * sin(pm.u0);
+        return vec3<f32>(max(width / (m * m) * (p1 - p0), 0.0));
+    }
+    {
         // Grade only the quarter next to a graded end (see graded_parts in the CPU twin).
-        let g0 = graded[i] != 0u;
-        let g1 = graded[i + 1u] != 0u;
         let q = 0.25 * (t1 - t0);
         var cuts = array<f32, 4>(t0, t0, t1, t1);
         if g0 {
@@ -218,16 +592,30 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
         if g1 {
             cuts[2] = t1 - q;
         }
-        for (var part = 0u; part < 3u; part++) {
-            let p0 = cuts[part];
-            let p1 = cuts[part + 1u];
-            if !(p1 > p0) {
-                continue;
+        {
+            var part = 0u;
+            for (; part < 3u; part++) {
+                let p0 = cuts[part];
+                let p1 = cuts[part + 1u];
+                if !(p1 > p0) {
+                    continue;
+                }
+                let pp = piece_map(p0, p1, x_star, width, part == 0u && g0, part == 2u && g1);
+                let spans = span_count(pp);
+                {
+                    var j = 0u;
+                    for (; j < spans; j++) {
+                        sum += inner_adaptive(light, n, a, e1, span(pp, j, spans));
+                    }
+                    if j < spans {
+                        // Cut short by the device's loop budget (see irr_cut).
+                        irr_cut = true;
+                    }
+                }
             }
-            let pp = piece_map(p0, p1, x_star, width, part == 0u && g0, part == 2u && g1);
-            let spans = span_count(pp);
-            for (var j = 0u; j < spans; j++) {
-                sum += inner_adaptive(light, n, a, e1, span(pp, j, spans));
+            if part < 3u {
+                // Cut short by the device's loop budget (see irr_cut).
+                irr_cut = true;
             }
         }
     }

@@ -36,16 +36,23 @@ fn outer_gk(light: Record, c: Chart, n: vec3<f32>, sp: PieceMap, s0: f32, s1: f3
     let h = s1 - s0;
     var k = vec3<f32>(0.0);
     var g = vec3<f32>(0.0);
-    for (var i = 0u; i < 15u; i++) {
-        let yd = map_eval(sp, s0 + h * IRR_GK_X[i], true);
-        if yd.y == 0.0 {
-            continue;
+    {
+        var i = 0u;
+        for (; i < 15u; i++) {
+            let yd = map_eval(sp, s0 + h * IRR_GK_X[i], true);
+            if yd.y == 0.0 {
+                continue;
+            }
+            let xi = x_interval(c, yd.x);
+            if xi.z > 0.0 {
+                let v = line_integral(light, n, c.w0 + c.e2 * yd.x, c.e1, xi.x, xi.y) * (h * yd.y * c.jac);
+                k += IRR_GK_WK[i] * v;
+                g += IRR_GK_WG[i] * v;
+            }
         }
-        let xi = x_interval(c, yd.x);
-        if xi.z > 0.0 {
-            let v = line_integral(light, n, c.w0 + c.e2 * yd.x, c.e1, xi.x, xi.y) * (h * yd.y * c.jac);
-            k += IRR_GK_WK[i] * v;
-            g += IRR_GK_WG[i] * v;
+        if i < 15u {
+            // Cut short by the device's loop budget (see irr_cut).
+            irr_cut = true;
         }
     }
     return vec4<f32>(k, max3(abs(k - g)));
@@ -81,6 +88,10 @@ fn outer_adaptive(light: Record, c: Chart, n: vec3<f32>, sp: PieceMap) -> vec3<f
             top += 2u;
         }
     }
+    if top > 0u {
+        // Cut short by the device's loop budget (see irr_cut).
+        irr_cut = true;
+    }
     return sum;
 }
 
@@ -92,12 +103,26 @@ fn chart_integral(light: Record, c: Chart, n: vec3<f32>) -> vec3<f32> {
     var ys: array<f32, MAX_YS>;
     let count = critical_ys(light, c, n, &ys);
     var total = vec3<f32>(0.0);
-    for (var i = 0u; i + 1u < count; i++) {
-        let pole = outer_pole(c, ys[i], ys[i + 1u]);
-        let pm = piece_map(ys[i], ys[i + 1u], pole.x, pole.y, false, false);
-        let spans = span_count(pm);
-        for (var j = 0u; j < spans; j++) {
-            total += outer_adaptive(light, c, n, span(pm, j, spans));
+    {
+        var i = 0u;
+        for (; i + 1u < count; i++) {
+            let pole = outer_pole(c, ys[i], ys[i + 1u]);
+            let pm = piece_map(ys[i], ys[i + 1u], pole.x, pole.y, false, false);
+            let spans = span_count(pm);
+            {
+                var j = 0u;
+                for (; j < spans; j++) {
+                    total += outer_adaptive(light, c, n, span(pm, j, spans));
+                }
+                if j < spans {
+                    // Cut short by the device's loop budget (see irr_cut).
+                    irr_cut = true;
+                }
+            }
+        }
+        if i + 1u < count {
+            // Cut short by the device's loop budget (see irr_cut).
+            irr_cut = true;
         }
     }
     return total;

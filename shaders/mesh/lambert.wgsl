@@ -150,18 +150,25 @@ fn mesh_lambert(light: Record, x: vec3<f32>, n: vec3<f32>) -> f32 {
     let count = u32(light.size.x);
     let double_sided = has_flag(light, FLAG_DOUBLE_SIDED);
     var sum = 0.0;
-    for (var t = 0u; t < count; t++) {
-        let k = light.tex.z + t * MESH_TRIANGLE_WORDS;
-        let q0 = vec3<f32>(mesh_atlas[k], mesh_atlas[k + 1u], mesh_atlas[k + 2u]) - x;
-        let e1 = vec3<f32>(mesh_atlas[k + 3u], mesh_atlas[k + 4u], mesh_atlas[k + 5u]);
-        let e2 = vec3<f32>(mesh_atlas[k + 6u], mesh_atlas[k + 7u], mesh_atlas[k + 8u]);
-        let q1 = q0 + e1;
-        let q2 = q0 + e2;
-        let c = dot(cross(e1, e2), q0);
-        let facing = c < 0.0 || (double_sided && c != 0.0);
-        let above = max(max(dot(n, q0), dot(n, q1)), dot(n, q2)) > 0.0;
-        if facing && above {
-            sum += triangle_lambert(q0, q1, q2, n);
+    {
+        var t = 0u;
+        for (; t < count; t++) {
+            let k = light.tex.z + t * MESH_TRIANGLE_WORDS;
+            let q0 = vec3<f32>(mesh_atlas[k], mesh_atlas[k + 1u], mesh_atlas[k + 2u]) - x;
+            let e1 = vec3<f32>(mesh_atlas[k + 3u], mesh_atlas[k + 4u], mesh_atlas[k + 5u]);
+            let e2 = vec3<f32>(mesh_atlas[k + 6u], mesh_atlas[k + 7u], mesh_atlas[k + 8u]);
+            let q1 = q0 + e1;
+            let q2 = q0 + e2;
+            let c = dot(cross(e1, e2), q0);
+            let facing = c < 0.0 || (double_sided && c != 0.0);
+            let above = max(max(dot(n, q0), dot(n, q1)), dot(n, q2)) > 0.0;
+            if facing && above {
+                sum += triangle_lambert(q0, q1, q2, n);
+            }
+        }
+        if t < count {
+            // Cut short by the device's loop budget (see irr_cut).
+            irr_cut = true;
         }
     }
     return sum;

@@ -35,7 +35,7 @@ struct Record {
     // Irradiance: (diffuse, |det M|, cos θ of kink A, cos θ of kink B) (FLAG_KINK_A/B).
     irr: vec4<f32>,
     // IES (FLAG_IES): (atlas base of the profile, an exact integer in f32; angleScale;
-    // normalisation or tilt scale; 0).
+    // normalisation or tilt scale; base of its kinks block, read by irradiance/line.wgsl).
     ies: vec4<f32>,
     // Textured dome (FLAG_DOME_TEXTURE): columns of A_eff⁻¹ (world → dome, DESIGN.md §6 D1).
     // Textured rect (FLAG_RECT_TEXTURE): tex_inv0.rgb is the texture's mean colour.
@@ -71,8 +71,11 @@ struct Params {
     row_stride: u32,
     // Summed mode, not the first group: add this group's sum to the row already written.
     accumulate: u32,
+    // Invocations per sample: lavapipe's loop budget (see irr_cut) is shared by the
+    // invocations it runs together, so an irradiance call whose quadrature is long runs one
+    // sample per lane_stride invocations (GpuContext::lane_stride).
+    lane_stride: u32,
     pad0: u32,
-    pad1: u32,
     // GPU-resident sampling (sample_resident_main): the generator's seed, samples per point, the
     // first point's key (DESIGN.md §9 S3), the light choice (SELECT_POWER or SELECT_BOUND, plus
     // SELECT_HAS_NORMALS). 0 for every other kernel.
@@ -81,6 +84,15 @@ struct Params {
     first_point: u32,
     select: u32,
 }
+
+// Set when a loop of the irradiance quadrature ends before its own condition says so: lavapipe
+// leaves an invocation's loops silently once they have run 65,535 iterations in all (Mesa's
+// gallivm loop limiter), and every loop after that point runs at most once. A loop that stops
+// short is the only way such a cut changes a value, so the quadrature's loops check their own
+// condition after they end, and irradiance_main writes NaN for a cut (light, sample), which the
+// host recomputes on the CPU reference (query::PreparedScene::irradiance). A real GPU never
+// cuts.
+var<private> irr_cut: bool;
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> lights: array<Record>;

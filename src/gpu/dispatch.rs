@@ -28,17 +28,26 @@ pub(crate) struct GpuLights {
     count: usize,
     /// The optional kernel parts any of the lights needs (`Record::features`).
     features: Features,
+    /// Whether some IES-shaped light's irradiance is the device's (not FLAG_HOST_IRRADIANCE).
+    irradiance_ies: bool,
 }
 
 impl GpuLights {
+    /// Whether some light's irradiance quadrature may run long on the device (an IES-shaped
+    /// light it integrates: GpuContext::stepping).
+    pub(super) fn long_quadrature(&self) -> bool {
+        self.irradiance_ies
+    }
+
     /// The pipeline variant `kernel` needs for these lights: the optional parts some light
     /// needs (`GpuContext::pipeline` drops those the kernel's source lacks). The irradiance
-    /// kernel integrates no IES-shaped or textured light (the host does, see
-    /// prepare::Prepared::irradiance_on_host), so it never needs either lookup.
+    /// kernel integrates no textured light (the host does, see
+    /// prepare::Prepared::irradiance_on_host), so it never needs the texture lookup; it needs
+    /// the IES lookup only for IES-shaped lights it integrates.
     pub(super) fn variant(&self, kernel: Kernel) -> Features {
         let mut f = self.features;
         if kernel == Kernel::Irradiance {
-            f.ies = false;
+            f.ies = self.irradiance_ies;
             f.texture = false;
         }
         f
@@ -213,6 +222,10 @@ impl GpuContext {
             features: records
                 .iter()
                 .fold(Features::default(), |f, r| f.union(r.features())),
+            irradiance_ies: records.iter().any(|r| {
+                r.flags & super::record::FLAG_IES != 0
+                    && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
+            }),
         }))
     }
 
@@ -249,7 +262,8 @@ impl GpuContext {
             *scratch = Some(self.scratch(key, lights));
         }
         let s = scratch.as_ref().expect("set above");
-        let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, &mut out);
+        let lane_stride = self.lane_stride(kernel, lights);
+        let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, lane_stride, &mut out);
         let oom = pollster::block_on(oom.pop());
         let validation = pollster::block_on(validation.pop());
         // A lost device fails every later call with validation errors about invalid buffers;
@@ -347,6 +361,7 @@ impl GpuContext {
         a: Input<'_>,
         b: Option<Input<'_>>,
         per_light: bool,
+        lane_stride: u32,
         out: &mut [[f32; 3]],
     ) -> Result<()> {
         let n = a.rows.len();
@@ -360,8 +375,8 @@ impl GpuContext {
             if let (Some(buf), Some(b)) = (&s.buf_b, b) {
                 self.write_rows(buf, b, start..start + count)?;
             }
-            let grid = self.grid(count as u32);
-            let block = params_block(groups, align, count as u32, per_light, grid);
+            let grid = self.grid(count as u32 * lane_stride);
+            let block = params_block(groups, align, count as u32, per_light, grid, lane_stride);
             self.queue.write_buffer(&s.params, 0, &block);
             let mut enc = self
                 .device
@@ -503,6 +518,7 @@ pub(super) fn params_block(
     count: u32,
     per_light: bool,
     (gx, _): (u32, u32),
+    lane_stride: u32,
 ) -> Vec<u8> {
     let mut block = vec![0u8; groups.len() * align];
     for (g, &(first, end)) in groups.iter().enumerate() {
@@ -513,6 +529,7 @@ pub(super) fn params_block(
             per_light: per_light as u32,
             row_stride: gx * WORKGROUP_SIZE,
             accumulate: (g > 0) as u32,
+            lane_stride,
             ..Params::default()
         };
         block[g * align..g * align + std::mem::size_of::<Params>()]

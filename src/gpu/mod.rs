@@ -74,6 +74,13 @@ fn pipeline_name(kernel: Kernel, features: Features) -> String {
 /// Environment variable that picks an adapter by (case-insensitive) name substring.
 pub const ADAPTER_ENV: &str = "LUXEVAL_ADAPTER";
 
+
+
+/// The invocations llvmpipe runs together and whose loops share one budget (its SIMD vector
+/// of 8 f32 lanes; [`GpuContext::lane_stride`] also spreads samples over whole workgroups if
+/// that is measured to be the unit).
+pub const LLVMPIPE_SHARED_LANES: u32 = 8;
+
 fn instance() -> wgpu::Instance {
     // Backends and flags honour WGPU_BACKEND, WGPU_VALIDATION, ... (wgpu's own variables).
     wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env())
@@ -428,11 +435,27 @@ impl GpuContext {
     /// per light, so there each dispatch takes one light. Elsewhere, groups bound the time of
     /// one dispatch (an OS watchdog resets a GPU that is busy for seconds).
     pub fn lights_per_dispatch(&self, kernel: Kernel) -> usize {
+        // (The irradiance kernel detects a cut too, see `lane_stride`.)
         match (kernel, self.is_llvmpipe()) {
             (Kernel::Irradiance, true) => 1,
             (Kernel::Irradiance, false) => 64,
             (_, true) => 16384,
             (_, false) => usize::MAX,
+        }
+    }
+
+    /// Invocations per sample of `kernel` over `lights` (`Params::lane_stride`). llvmpipe
+    /// leaves an invocation's loops silently after 65,535 iterations, a budget its invocations
+    /// share when it runs them together; the irradiance kernel detects a cut (`irr_cut` in
+    /// shaders/shared/record.wgsl: NaN, which the host recomputes), and where a light's
+    /// quadrature may be long (an IES profile's kinks multiply a line's pieces) runs one sample
+    /// per [`LLVMPIPE_SHARED_LANES`] invocations so that each has the budget to itself.
+    /// Elsewhere: 1.
+    pub(crate) fn lane_stride(&self, kernel: Kernel, lights: &GpuLights) -> u32 {
+        if self.is_llvmpipe() && kernel == Kernel::Irradiance && lights.long_quadrature() {
+            LLVMPIPE_SHARED_LANES
+        } else {
+            1
         }
     }
 

@@ -113,7 +113,7 @@ pub struct Record {
     /// Irradiance: (diffuse, |det M|, cos θ of kink A, cos θ of kink B).
     pub irr: [f32; 4],
     /// IES (FLAG_IES): (atlas base of the profile, exact in f32; angleScale; normalisation or
-    /// tilt scale; 0).
+    /// tilt scale; base of its kinks block, `super::ies_atlas`).
     pub ies: [f32; 4],
     /// Textured dome (FLAG_DOME_TEXTURE): columns of `A_eff⁻¹` (world → dome, §6 D1); w: 0.
     /// Textured rect (FLAG_RECT_TEXTURE): `tex_inv[0]` is the texture's mean colour.
@@ -178,7 +178,10 @@ pub struct Params {
     pub per_light: u32,
     pub row_stride: u32,
     pub accumulate: u32,
-    pub pad: [u32; 2],
+    /// Invocations per sample (1, or on llvmpipe more for an irradiance call with a light whose
+    /// quadrature is long: `GpuContext::lane_stride`); the others return at once.
+    pub lane_stride: u32,
+    pub pad: u32,
     /// GPU-resident sampling (`sample_resident_main`): the generator's seed, samples per point,
     /// the first point's key (DESIGN.md §9 S3) and the light choice ([`SELECT_POWER`] or
     /// [`SELECT_BOUND`], plus [`SELECT_HAS_NORMALS`]). 0 for every other kernel.
@@ -205,7 +208,7 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 /// scene's mesh atlas (`gpu::mesh_atlas`: a mesh light's, a masked dome's).
 pub fn pack(
     p: &Prepared,
-    ies_base: Option<u32>,
+    ies_base: Option<super::ies_atlas::IesBases>,
     tex_offset: Option<u32>,
     atlas: Option<[u32; 4]>,
 ) -> Record {
@@ -264,7 +267,12 @@ pub fn pack(
     }
     if let (Some(ies), Some(base)) = (&p.ies, ies_base) {
         r.flags |= FLAG_IES;
-        r.ies = [base as f32, ies.angle_scale as f32, ies.scale as f32, 0.0];
+        r.ies = [
+            base.profile as f32,
+            ies.angle_scale as f32,
+            ies.scale as f32,
+            base.kinks as f32,
+        ];
     }
     if let (Some(t), Some(offset)) = (p.dome_texture(), tex_offset) {
         r.flags |= FLAG_DOME_TEXTURE;

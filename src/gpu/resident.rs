@@ -127,7 +127,8 @@ impl GpuContext {
         }
         let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
         let wg = count.div_ceil(WORKGROUP_SIZE);
-        let grid = self.grid(count);
+        let lane_stride = self.lane_stride(kernel, lights);
+        let grid = self.grid(count * lane_stride);
         if grid.1 > max_groups {
             return Err(LuxError::input(
                 "count",
@@ -149,7 +150,7 @@ impl GpuContext {
         };
         // One Params block per light group at the uniform offset alignment.
         let align = self.params_align();
-        let block = params_block(&groups, align, count, per_light, grid);
+        let block = params_block(&groups, align, count, per_light, grid, lane_stride);
         // Emission and intensity read no second input; bind the first again (read-only
         // aliasing is allowed).
         let bound = [(a, in_bytes), (b.unwrap_or(a), in_bytes), (out, out_bytes)];
@@ -275,7 +276,7 @@ impl GpuContext {
             None => &sampling.buffer,
         };
         let align = self.params_align();
-        let mut block = params_block(&[(0, n_lights)], align, count, false, grid);
+        let mut block = params_block(&[(0, n_lights)], align, count, false, grid, 1);
         let params = Params {
             seed: draw.seed,
             per_point: draw.per_point,

@@ -125,3 +125,84 @@ pub fn ies_kinks(profile: &Profile, s: f64) -> IesKinks {
     }
     k
 }
+
+/// The most planes outside the pencil that [`IesKinks::families`] keeps (the kernel adds them
+/// to a line's fixed breakpoints, whose array is sized for them).
+pub const MAX_EXTRA_PLANES: usize = 2;
+
+/// [`IesKinks`] as the GPU quadrature streams them along a line (shaders/irradiance/line.wgsl):
+/// every profile cone shares one axis (type C: −Z, B: −Y, A: +Z) and every plane but a cone of
+/// 90° contains one axis (C and A: Z, B: Y). Along a line `w = a + X e` the cosine of `−ŵ` with
+/// the cone axis has one extremum, and the azimuth of `w` about the pencil's axis turns one
+/// way, so on each side of those points the crossed cones (planes) are a run of the list
+/// sorted by cosine (azimuth), found by binary search: no breakpoint array of the profile's
+/// size is needed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KinkFamilies {
+    /// The cones' common axis and their cosines, ascending (duplicates dropped).
+    pub cone_axis: DVec3,
+    pub cone_cos: Vec<f64>,
+    /// The pencil's axis P and a unit `u ⊥ P` (with `v = P × u` the frame of azimuths).
+    pub pencil_axis: DVec3,
+    pub pencil_u: DVec3,
+    /// Per plane of the pencil, ascending in δ ∈ [0, π): the azimuth δ (from u towards v) of
+    /// the directions the plane holds, and its unit normal's (u, v) coordinates.
+    pub planes: Vec<(f64, f64, f64)>,
+    /// Planes not through P (the cone of 90°, a plane ⊥ the cone axis): unit normals.
+    pub extra: Vec<DVec3>,
+}
+
+impl IesKinks {
+    /// The kinks grouped as [`KinkFamilies`]; None when they are not one family of coaxial
+    /// cones and one pencil of planes plus at most [`MAX_EXTRA_PLANES`] others (angleScale on
+    /// types B and A lists no kinks at all and gives an empty family; any other mixture cannot
+    /// come from [`ies_kinks`], and is refused rather than streamed wrongly).
+    pub fn families(&self) -> Option<KinkFamilies> {
+        let cone_axis = self.cones.first().map_or(DVec3::NEG_Z, |c| c.0);
+        if self.cones.iter().any(|c| c.0 != cone_axis) {
+            return None;
+        }
+        let mut cone_cos: Vec<f64> = self.cones.iter().map(|c| c.1).collect();
+        cone_cos.sort_by(f64::total_cmp);
+        cone_cos.dedup();
+        let unit: Vec<DVec3> = self
+            .planes
+            .iter()
+            .map(|m| m.normalize_or_zero())
+            .filter(|m| *m != DVec3::ZERO)
+            .collect();
+        // The pencil's axis: ⊥ to most normals. Candidates: the frame axes the types use.
+        let on = |p: DVec3, m: &DVec3| m.dot(p).abs() <= 1e-12;
+        let pencil_axis = [DVec3::Z, DVec3::Y, DVec3::X]
+            .into_iter()
+            .max_by_key(|p| unit.iter().filter(|m| on(*p, m)).count())
+            .unwrap_or(DVec3::Z);
+        let (pencil, extra): (Vec<DVec3>, Vec<DVec3>) =
+            unit.iter().partition(|m| on(pencil_axis, m));
+        if extra.len() > MAX_EXTRA_PLANES {
+            return None;
+        }
+        let pencil_u = pencil_axis.any_orthonormal_vector();
+        let pencil_v = pencil_axis.cross(pencil_u);
+        let mut planes: Vec<(f64, f64, f64)> = pencil
+            .iter()
+            .map(|m| {
+                let (mu, mv) = (m.dot(pencil_u), m.dot(pencil_v));
+                // The plane holds the azimuths of (−mv, mu) and its opposite.
+                let d = mu.atan2(-mv).rem_euclid(std::f64::consts::PI);
+                let d = if d >= std::f64::consts::PI { 0.0 } else { d };
+                (d, mu, mv)
+            })
+            .collect();
+        planes.sort_by(|a, b| a.0.total_cmp(&b.0));
+        planes.dedup_by(|a, b| a.0 == b.0);
+        Some(KinkFamilies {
+            cone_axis,
+            cone_cos,
+            pencil_axis,
+            pencil_u,
+            planes,
+            extra,
+        })
+    }
+}

@@ -52,6 +52,17 @@ pub struct PreparedIes {
     pub kinks: ies_kinks::IesKinks,
 }
 
+impl PreparedIes {
+    /// The profile's kinks as the GPU quadrature streams them ([`ies_kinks::KinkFamilies`]);
+    /// None where the kernel cannot split at them: angleScale on types B and A bends the grid
+    /// lines into surfaces that are neither cones nor planes (the reference's adaptive rules
+    /// take them, the f32 rule would miss them), so that light's irradiance is the host's.
+    pub fn device_families(&self) -> Option<ies_kinks::KinkFamilies> {
+        let bent = self.angle_scale != 0.0 && self.profile.kind != ies::PhotometricType::C;
+        if bent { None } else { self.kinks.families() }
+    }
+}
+
 /// ShapingAPI's inputs as the evaluation uses them (DESIGN.md §2 "Shaping", spec/002).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShapingConsts {
@@ -440,8 +451,10 @@ impl Prepared {
             } else {
                 GpuPath::HostIntensity("it is a mesh light")
             }
-        } else if ies.is_some() {
-            GpuPath::HostIrradiance("it is IES-shaped")
+        } else if ies.as_ref().is_some_and(|i| i.device_families().is_none()) {
+            GpuPath::HostIrradiance(
+                "its IES profile's grid lines are bent by angleScale (types A and B)",
+            )
         } else {
             match &kind {
                 KindData::Dome { texture: Some(_) } => {

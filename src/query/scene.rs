@@ -3,6 +3,7 @@
 use std::sync::Mutex;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
@@ -40,6 +41,8 @@ pub struct PreparedScene {
     /// they would need, over the device's storage binding limit.
     pub(super) sampling_gpu:
         std::sync::OnceLock<std::result::Result<crate::gpu::sample::SampleLights, u64>>,
+    /// Irradiance rows the kernel gave up on and the host recomputed (`redo_spent_rows`).
+    spent_rows: std::sync::atomic::AtomicUsize,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -116,6 +119,7 @@ impl PreparedScene {
             sampling_env: Default::default(),
             sampling_tables: Default::default(),
             sampling_gpu: Default::default(),
+            spent_rows: Default::default(),
         })
     }
 
@@ -258,9 +262,60 @@ impl PreparedScene {
             cpu::irradiance_batch(&self.lights, points, normals, per_light, rule)
         })?;
         if matches!(self.backend, Backend::Gpu(_)) {
+            self.redo_spent_rows(points, normals, per_light, rule, &mut out);
             self.add_host_irradiance(points, normals, per_light, rule, &mut out);
         }
         Ok(out)
+    }
+
+    /// Rows the irradiance kernel gave up on (NaN: a loop cut short by llvmpipe's loop budget,
+    /// `GpuContext::lane_stride`) are recomputed here on the CPU reference: with `per_light` that light's row, else the receiver's sum over the lights
+    /// the device integrates (the host lights are added after). Finite inputs never give NaN
+    /// otherwise (DESIGN.md §5), so a NaN row is exactly a row cut short.
+    fn redo_spent_rows(
+        &self,
+        points: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        per_light: bool,
+        rule: &Adaptive,
+        out: &mut [[f32; 3]],
+    ) {
+        let n = points.len();
+        let spent: Vec<usize> = (0..out.len())
+            .filter(|&r| out[r].iter().any(|v| v.is_nan()))
+            .collect();
+        if spent.is_empty() {
+            return;
+        }
+        self.spent_rows
+            .fetch_add(spent.len(), std::sync::atomic::Ordering::Relaxed);
+        let redo: Vec<(usize, [f32; 3])> = spent
+            .par_iter()
+            .map(|&r| {
+                let (i, lights) = if per_light {
+                    (r % n, &self.lights[r / n..r / n + 1])
+                } else {
+                    (r, &self.lights[..])
+                };
+                let (x, nn) = (&points[i..i + 1], &normals[i..i + 1]);
+                let sum: DVec3 = lights
+                    .iter()
+                    .filter(|l| !l.irradiance_on_host())
+                    .map(|l| cpu::irradiance_batch(std::slice::from_ref(l), x, nn, true, rule)[0])
+                    .sum();
+                (r, sum.as_vec3().to_array())
+            })
+            .collect();
+        for (r, v) in redo {
+            out[r] = v;
+        }
+    }
+
+    /// How many rows the irradiance kernel gave up on and the CPU reference recomputed
+    /// (`redo_spent_rows`), over this scene's calls: the tests bound it.
+    #[cfg(any(test, feature = "testkit"))]
+    pub fn spent_rows(&self) -> usize {
+        self.spent_rows.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// On a GPU evaluator, the kernels give 0 for the lights `on_host` names for the query
