@@ -3,9 +3,11 @@
 //! area-light type under every transform kind, with and without angleScale and normalize,
 //! combined with random cone and focus; emission, radiance and intensity within
 //! check::TOLERANCE outside the excluded band (which includes the jumps of a profile at its
-//! range ends, check::emission_margin). Irradiance of an IES-shaped light is the CPU
-//! reference's on the GPU path as well (the f32 quadrature does not split at a profile's angle
-//! nodes); the last test holds the GPU path to exactly that.
+//! range ends, check::emission_margin, and for irradiance a lit sliver bounded by one,
+//! check::irradiance_margin). Irradiance is the device's: its f32 quadrature splits each line
+//! at the profile's grid cones and planes (streamed, shaders/irradiance/line.wgsl) and the
+//! outer integral at their critical Ys (critical.wgsl ies_ys); a receiver whose quadrature
+//! lavapipe's loop budget cuts short is recomputed on the host (the last test).
 
 use crate::common;
 
@@ -13,7 +15,7 @@ use luxeval::testkit::check;
 use luxeval::testkit::ies::{SHAPES, with_random_ies};
 use luxeval::testkit::irradiance_samples;
 use luxeval::testkit::{Rng, TRANSFORMS, random_light};
-use luxeval::{Accumulate, Light, Reference, TemperatureMode};
+use luxeval::{Accumulate, Asset, Ies, Light, Reference, Shaping, TemperatureMode};
 
 fn lights(rng: &mut Rng, continuous: bool) -> Vec<Light> {
     let mut out = Vec::new();
@@ -46,7 +48,7 @@ fn gpu_matches_cpu_on_ies_shaped_lights() {
             emission: 160,
             intensity: 160,
             radiance: 160,
-            irradiance: std::env::var("IES_IRR").ok().and_then(|v| v.parse().ok()).unwrap_or(0),
+            irradiance: 6,
         };
         let seed = 5 + continuous as u64;
         let report = check::check_with(&gpu, &refs, counts, seed).expect("GPU check runs");
@@ -74,10 +76,11 @@ fn gpu_matches_cpu_on_ies_shaped_lights() {
 }
 
 #[test]
-fn gpu_irradiance_of_ies_lights_is_the_reference() {
+fn gpu_irradiance_of_ies_lights_beside_plain_lights() {
     let Some(gpu) = common::gpu() else { return };
     let mut rng = Rng::new(77);
-    // An IES-shaped sphere and rect beside two plain lights, in a mixed order.
+    // IES-shaped spheres and rects beside plain lights, in a mixed order: per-light rows within
+    // the tolerance of the reference, and the summed rows their sum.
     let lights = vec![
         with_random_ies(random_light(1, "rotate", &mut rng, 0), &mut rng, 3, false),
         random_light(2, "uniform-scale", &mut rng, 1),
@@ -102,20 +105,13 @@ fn gpu_irradiance_of_ies_lights_is_the_reference() {
             let x = glam::Vec3::from_array(points[i]).as_dvec3();
             let nn = glam::Vec3::from_array(normals[i]).as_dvec3().normalize();
             let cpu = r.irradiance(x, nn);
-            let got = per[k * n + i];
-            if k % 2 == 0 {
-                let e = check::rel_error(cpu, got);
-                if std::env::var("IES_DEBUG").is_ok() {
-                    println!("light {k} receiver {i}: cpu {cpu:?} gpu {got:?} rel {e:.3e}");
-                }
-                lit += (cpu.max_element() > 0.0) as usize;
-            } else {
-                let e = check::rel_error(cpu, got);
-                assert!(
-                    e < 1e-4 || cpu.max_element() < 1e-30,
-                    "light {k} receiver {i}: {e}"
-                );
-            }
+            let e = check::rel_error(cpu, per[k * n + i]);
+            assert!(
+                e < check::TOLERANCE || cpu.max_element() < 1e-30,
+                "light {k} receiver {i}: {cpu:?} vs {:?}: {e}",
+                per[k * n + i]
+            );
+            lit += (k % 2 == 0 && cpu.max_element() > 0.0) as usize;
         }
     }
     assert!(lit > 10, "only {lit} lit receivers of the IES lights");
@@ -132,31 +128,60 @@ fn gpu_irradiance_of_ies_lights_is_the_reference() {
     }
 }
 
+/// A 1°-by-5° type C profile (181 × 73 angles) falling off smoothly.
+fn dense_profile() -> Vec<u8> {
+    let v: Vec<f64> = (0..=180).map(f64::from).collect();
+    let h: Vec<f64> = (0..=72).map(|k| 5.0 * k as f64).collect();
+    let list = |xs: &[f64]| xs.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
+    let mut s = String::from("IESNA:LM-63-2002\r\n[TEST] dense\r\nTILT=NONE\r\n");
+    s += &format!("1 -1 1 {} {} 1 2 0.1 0.1 0\r\n1 1 0\r\n", v.len(), h.len());
+    s += &format!("{}\r\n{}\r\n", list(&v), list(&h));
+    for hh in &h {
+        let row: Vec<f64> = v
+            .iter()
+            .map(|vv| 100.0 + 50.0 * (vv.to_radians() * 3.0).cos() * (hh.to_radians() * 2.0).sin())
+            .collect();
+        s += &list(&row);
+        s += "\r\n";
+    }
+    s.into_bytes()
+}
+
+/// A receiver close to a large light with a dense profile: every line of its chart crosses
+/// dozens of the profile's surfaces, more loop iterations than lavapipe runs per invocation
+/// (65,535). The kernel notices its loops were cut short and the host recomputes those rows:
+/// on lavapipe the values are the reference's, rounded; on a real GPU the kernel's.
 #[test]
-fn debug_one() {
+fn a_receiver_over_lavapipes_loop_budget_is_recomputed_on_the_host() {
     let Some(gpu) = common::gpu() else { return };
-    for (cont, seedskip) in [(false, 0), (true, 1)] {
-        let mut rng = Rng::new(0x1E5_1E5);
-        let mut ls = lights(&mut rng, false);
-        if seedskip == 1 {
-            ls = lights(&mut rng, true);
-        }
-        let _ = cont;
-        for (id, p, nrm) in [
-            (86usize, [-0.8765542f32, 0.18446743, 3.2341542], [0.90839237f32, -0.40195024, 0.1151489]),
-            (264, [0.20338061, -0.31543806, -0.78499174], [-0.11213456, -0.6084655, 0.78561795]),
-            (87, [4.6904674, -2.357509, 3.2333617], [-0.71703076, 0.66523486, 0.20815723]),
-            (135, [-2.6514022, 0.20634073, -2.981806], [-0.65956634, 0.66326606, 0.35362458]),
-            (322, [-0.52080333, -1.1556053, -3.1090562], [0.5111534, -0.5802436, 0.63406587]),
-        ] {
-            let l = &ls[id];
-            let r = Reference::new(l, TemperatureMode::Spec).unwrap();
-            let cpu = r.irradiance(glam::Vec3::from_array(p).as_dvec3(), glam::Vec3::from_array(nrm).as_dvec3().normalize());
-            let reps: usize = std::env::var("REPS").ok().and_then(|v| v.parse().ok()).unwrap_or(1);
-            let got = gpu.irradiance(std::slice::from_ref(l), &vec![p; reps], &vec![nrm; reps], Accumulate::Sum).unwrap();
-            let kr = luxeval::testkit::kernel_rule_irradiance(&r, glam::Vec3::from_array(p).as_dvec3(), glam::Vec3::from_array(nrm).as_dvec3().normalize());
-            println!("kernel rule f64 {kr:?}");
-            println!("batch {seedskip} light {id} {:?}: cpu {cpu:?} gpu {:?} ies {:?}", l.path, got[0], l.shaping.as_ref().map(|s| (s.cone_angle, s.cone_softness, s.focus, s.ies.as_ref().map(|i| i.angle_scale))));
-        }
+    let ies = Ies::new(Asset::from_bytes("dense.ies", dense_profile()));
+    let light = Light::rect(2.0, 2.0).with_shaping(Shaping {
+        ies: Some(ies),
+        ..Shaping::default()
+    });
+    let r = Reference::new(&light, TemperatureMode::Spec).expect("valid light");
+    // In front of the rect (it emits toward −Z), 0.05 to 0.3 away, facing it.
+    let points: Vec<[f32; 3]> = (0..8)
+        .map(|k| [0.1 * k as f32 - 0.35, 0.05 * k as f32, -0.05 - 0.035 * k as f32])
+        .collect();
+    let normals = vec![[0.0f32, 0.0, 1.0]; points.len()];
+    let scene = gpu.prepare(std::slice::from_ref(&light)).expect("prepared");
+    let got = scene
+        .irradiance(&points, &normals, Accumulate::Sum)
+        .expect("GPU irradiance");
+    for (i, (x, n)) in points.iter().zip(&normals).enumerate() {
+        let cpu = r.irradiance(
+            glam::Vec3::from_array(*x).as_dvec3(),
+            glam::Vec3::from_array(*n).as_dvec3(),
+        );
+        let e = check::rel_error(cpu, got[i]);
+        assert!(cpu.max_element() > 0.0, "receiver {i} unlit");
+        assert!(e < check::TOLERANCE, "receiver {i}: {cpu:?} vs {:?}: {e}", got[i]);
+    }
+    if gpu.device_name().contains("llvmpipe") {
+        assert!(
+            scene.spent_rows() > 0,
+            "no receiver went over lavapipe's budget: the test no longer exercises the host path"
+        );
     }
 }

@@ -4,20 +4,31 @@
 // f32: arcs are bracketed on IRR_ARC_SAMPLES samples (the CPU: 64) and bisected 26 times (the
 //   CPU: 80, f64 resolution), specialised to the chart's arcs (arc_bisect, arc_push_root) where
 //   the CPU calls the generic cpu::roots::bracket_roots.
-// f32: near-duplicate Ys are merged within 1e-6 of the Y-range (the CPU: 1e-13), and at most
-//   MAX_YS are kept.
+// f32: near-duplicate Ys are merged within 1e-6 of the Y-range (the CPU: 1e-13). At most
+//   MAX_YS are kept: a chart that has more (an IES profile's many grid surfaces near a large
+//   light) sets irr_cut (shared/record.wgsl), and the host recomputes that receiver.
+// f32: an IES profile's grid surfaces (ies_ys) are listed only where the region is a square or
+//   a disk (the CPU's chart_ies_kinks bounds a cylinder's too); a cylinder tests every surface,
+//   which adds Ys outside the lit part only. Their angle test has a margin of 1e-4 rad (the
+//   CPU: 1e-6).
 // f32: a plane of the pencil is detected with |m·e1| ≤ 1e-5·|m||e1| (the CPU: 1e-12).
 // GPU-only arc_bisect, arc_push_root: see above.
+// GPU-only ies_plane: reads a plane of the kinks block (the CPU holds them in a list).
 
 // #import irradiance/chart.wgsl
 // #import shared/roots.wgsl
 
-const MAX_YS: u32 = 48u;
+const MAX_YS: u32 = 96u;
 
 fn push_y(ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32>, y: f32, c: Chart) {
-    if *count < MAX_YS && y >= c.ya && y <= c.yb {
-        (*ys)[*count] = y;
-        *count += 1u;
+    if y >= c.ya && y <= c.yb {
+        if *count < MAX_YS {
+            (*ys)[*count] = y;
+            *count += 1u;
+        } else {
+            // More breakpoints than the array holds: the host recomputes (see the header).
+            irr_cut = true;
+        }
     }
 }
 
@@ -25,6 +36,31 @@ fn push_dir(ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32>, w:
     let y = chart_y(c, w);
     if y.y > 0.0 {
         push_y(ys, count, y.x, c);
+    }
+}
+
+// The Ys of the planes of the pencil (the planes through x holding e1) tangent to the cone
+// −ŵ·axis = cs: |m·axis| = sin θ.
+fn pencil_tangent_ys(ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32>, c: Chart, axis: vec3<f32>, cs: f32) {
+    let e1u = normalize(c.e1);
+    let m1 = orthonormal_pair_a(e1u);
+    let m2 = orthonormal_pair_b(e1u);
+    let pa = dot(m1, axis);
+    let pb = dot(m2, axis);
+    let ra = sqrt(pa * pa + pb * pb);
+    let s = sqrt(max(1.0 - cs * cs, 0.0));
+    if ra >= s && ra > 0.0 {
+        let t0 = atan2_accurate(pb, pa);
+        let q = clamp(s / ra, -1.0, 1.0);
+        let d = atan2_accurate(sqrt(max(1.0 - q * q, 0.0)), q);
+        for (var k = 0; k < 2; k++) {
+            let t = select(t0 - d, t0 + d, k == 0);
+            let mm = m1 * cos(t) + m2 * sin(t);
+            let me2 = dot(mm, c.e2);
+            if me2 != 0.0 {
+                push_y(ys, count, -dot(mm, c.w0) / me2, c);
+            }
+        }
     }
 }
 
@@ -168,29 +204,9 @@ fn critical_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f3
             }
         }
     }
-    let e1u = normalize(c.e1);
-    let m1 = orthonormal_pair_a(e1u);
-    let m2 = orthonormal_pair_b(e1u);
-    let pa = dot(m1, axis);
-    let pb = dot(m2, axis);
-    let ra = sqrt(pa * pa + pb * pb);
     for (var ci = 0u; ci < n_cones; ci++) {
         let cs = kink_cos(light, ci);
-        // Planes of the pencil tangent to the cone: |m·axis| = sin θ.
-        let s = sqrt(max(1.0 - cs * cs, 0.0));
-        if ra >= s && ra > 0.0 {
-            let t0 = atan2_accurate(pb, pa);
-            let q = clamp(s / ra, -1.0, 1.0);
-            let d = atan2_accurate(sqrt(max(1.0 - q * q, 0.0)), q);
-            for (var k = 0; k < 2; k++) {
-                let t = select(t0 - d, t0 + d, k == 0);
-                let mm = m1 * cos(t) + m2 * sin(t);
-                let me2 = dot(mm, c.e2);
-                if me2 != 0.0 {
-                    push_y(ys, &count, -dot(mm, c.w0) / me2, c);
-                }
-            }
-        }
+        pencil_tangent_ys(ys, &count, c, axis, cs);
         if c.region == REGION_SQUARE {
             for (var k = 0; k < 2; k++) {
                 let xs = select(1.0, -1.0, k == 0);
@@ -238,6 +254,9 @@ fn critical_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f3
             push_y(ys, &count, -dot(m, c.w0) / me2, c);
         }
     }
+    if has_flag(light, FLAG_IES) {
+        ies_ys(light, c, n, ys, &count);
+    }
     // Insertion sort, then drop near-duplicates.
     for (var i = 1u; i < count; i++) {
         let v = (*ys)[i];
@@ -259,4 +278,161 @@ fn critical_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f3
     // Keep the upper end exact.
     (*ys)[kept - 1u] = c.yb;
     return kept;
+}
+
+// Plane k of a kinks block (src/gpu/ies_atlas.rs): the pencil's (normal from its (u, v)
+// coordinates), then the others.
+fn ies_plane(kb: u32, k: u32, np: u32, normals_off: u32, u: vec3<f32>, v: vec3<f32>) -> vec3<f32> {
+    if k < np {
+        return u * ies_atlas[normals_off + 2u * k] + v * ies_atlas[normals_off + 2u * k + 1u];
+    }
+    let o = kb + 12u + 3u * (k - np);
+    return vec3<f32>(ies_atlas[o], ies_atlas[o + 1u], ies_atlas[o + 2u]);
+}
+
+// The Ys where an IES profile's grid surfaces change the inner structure (see the CPU twin):
+// the chart in the light's frame (a linear map keeps X and Y), each cone and plane of the
+// kinks block (src/gpu/ies_atlas.rs) that can meet the region's directions tangent to a line
+// of the pencil, crossing the region's edges and arcs, the horizon, the focus plane and the
+// profile's other surfaces.
+fn ies_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32>) {
+    let kb = u32(light.ies.w);
+    var lc = c;
+    lc.w0 = to_local_dir(light, c.w0);
+    lc.e1 = to_local_dir(light, c.e1);
+    lc.e2 = to_local_dir(light, c.e2);
+    lc.arc_c0 = to_local_dir(light, c.arc_c0);
+    lc.arc_c1 = to_local_dir(light, c.arc_c1);
+    lc.arc_u = to_local_dir(light, c.arc_u);
+    lc.arc_v = to_local_dir(light, c.arc_v);
+    // Planes through x: a world normal m is Mᵀm here (the receiver's horizon, the focus plane).
+    let fixed0 = vec3<f32>(dot(light.world_x.xyz, n), dot(light.world_y.xyz, n), dot(light.world_z.xyz, n));
+    let ax = light.axis.xyz;
+    let fixed1 = vec3<f32>(dot(light.world_x.xyz, ax), dot(light.world_y.xyz, ax), dot(light.world_z.xyz, ax));
+    let n_fixed = select(1u, 2u, has_flag(light, FLAG_FOCUS_PLANE));
+    // The region's directions lie within alpha of w0 (CPU: outer::direction_cone).
+    var r = 1e30;
+    if lc.region == REGION_SQUARE {
+        r = length(lc.e1) + length(lc.e2);
+    } else if lc.region == REGION_DISK {
+        r = sqrt(dot(lc.e1, lc.e1) + dot(lc.e2, lc.e2));
+    }
+    let dw = length(lc.w0);
+    var alpha = 10.0;
+    if r < 0.5 * dw {
+        alpha = asin(r / dw) + 1e-4;
+    }
+    let cdir = -lc.w0 / dw;
+    let nc = u32(ies_atlas[kb]);
+    let axis_c = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
+    let theta_c = atan2_accurate(length(cross(cdir, axis_c)), dot(cdir, axis_c));
+    let np = u32(ies_atlas[kb + 4u]);
+    let p = vec3<f32>(ies_atlas[kb + 5u], ies_atlas[kb + 6u], ies_atlas[kb + 7u]);
+    let u = vec3<f32>(ies_atlas[kb + 8u], ies_atlas[kb + 9u], ies_atlas[kb + 10u]);
+    let v = cross(p, u);
+    let ne = u32(ies_atlas[kb + 11u]);
+    let cos_off = kb + IES_KINKS_HEADER;
+    let normals_off = cos_off + nc + np;
+    // Cones: tangent to the pencil, across the square's sides and the arcs, across the fixed
+    // planes.
+    for (var k = 0u; k < nc; k++) {
+        let cs = ies_atlas[cos_off + k];
+        let theta_k = atan2_accurate(sqrt(max(1.0 - cs * cs, 0.0)), cs);
+        if abs(theta_c - theta_k) > alpha {
+            continue;
+        }
+        pencil_tangent_ys(ys, count, lc, axis_c, cs);
+        if lc.region == REGION_SQUARE {
+            for (var side = 0u; side < 2u; side++) {
+                let xs = select(1.0, -1.0, side == 0u);
+                let rr = cone_roots_on_line(axis_c, cs, lc.w0 + lc.e1 * xs, lc.e2);
+                let mask = u32(rr.z);
+                if (mask & 1u) != 0u {
+                    push_y(ys, count, rr.x, lc);
+                }
+                if (mask & 2u) != 0u {
+                    push_y(ys, count, rr.y, lc);
+                }
+            }
+        }
+        for (var ai = 0u; ai < lc.n_arcs; ai++) {
+            arc_cone_crossings(ys, count, lc, ai, axis_c, cs);
+        }
+        for (var f = 0u; f < n_fixed; f++) {
+            let dirs = plane_cone_dirs(select(fixed0, fixed1, f == 1u), axis_c, cs);
+            if dirs.ok {
+                push_dir(ys, count, dirs.a, lc);
+                push_dir(ys, count, dirs.b, lc);
+            }
+        }
+    }
+    // Planes (the pencil's, then the others): along a line of the pencil, across the square's
+    // sides and the arcs, across the fixed planes, the other planes and the cones.
+    if np >= 2u {
+        push_dir(ys, count, p, lc);
+        push_dir(ys, count, -p, lc);
+    }
+    for (var k = 0u; k < np + ne; k++) {
+        let m = ies_plane(kb, k, np, normals_off, u, v);
+        if asin(min(abs(dot(normalize(m), cdir)), 1.0)) > alpha {
+            continue;
+        }
+        let me1 = dot(m, lc.e1);
+        let me2 = dot(m, lc.e2);
+        let mw0 = dot(m, lc.w0);
+        if abs(me1) <= 1e-5 * length(m) * length(lc.e1) && me2 != 0.0 {
+            push_y(ys, count, -mw0 / me2, lc);
+        }
+        if lc.region == REGION_SQUARE && me2 != 0.0 {
+            push_y(ys, count, -(mw0 - me1) / me2, lc);
+            push_y(ys, count, -(mw0 + me1) / me2, lc);
+        }
+        for (var ai = 0u; ai < lc.n_arcs; ai++) {
+            let cc = select(lc.arc_c0, lc.arc_c1, ai == 1u);
+            let rt = lin_trig_roots(dot(m, lc.arc_u), dot(m, lc.arc_v), -dot(m, cc));
+            if rt.z > 0.0 {
+                let ta = wrap_into(rt.x, lc.t0);
+                if ta <= lc.t1 {
+                    push_dir(ys, count, arc_at(lc, ai, ta), lc);
+                }
+                let tb = wrap_into(rt.y, lc.t0);
+                if tb <= lc.t1 {
+                    push_dir(ys, count, arc_at(lc, ai, tb), lc);
+                }
+            }
+        }
+        for (var f = 0u; f < n_fixed; f++) {
+            let d = cross(m, select(fixed0, fixed1, f == 1u));
+            if dot(d, d) > 0.0 {
+                push_dir(ys, count, d, lc);
+                push_dir(ys, count, -d, lc);
+            }
+        }
+        // Plane ∩ plane: the pencil's meet on its axis (above); an other plane meets each.
+        if k >= np {
+            for (var k2 = 0u; k2 < np + ne; k2++) {
+                let m2 = ies_plane(kb, k2, np, normals_off, u, v);
+                if asin(min(abs(dot(normalize(m2), cdir)), 1.0)) > alpha {
+                    continue;
+                }
+                let d = cross(m, m2);
+                if dot(d, d) > 0.0 {
+                    push_dir(ys, count, d, lc);
+                    push_dir(ys, count, -d, lc);
+                }
+            }
+        }
+        for (var kc = 0u; kc < nc; kc++) {
+            let cs = ies_atlas[cos_off + kc];
+            let theta_k = atan2_accurate(sqrt(max(1.0 - cs * cs, 0.0)), cs);
+            if abs(theta_c - theta_k) > alpha {
+                continue;
+            }
+            let dirs = plane_cone_dirs(m, axis_c, cs);
+            if dirs.ok {
+                push_dir(ys, count, dirs.a, lc);
+                push_dir(ys, count, dirs.b, lc);
+            }
+        }
+    }
 }

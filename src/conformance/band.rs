@@ -629,8 +629,28 @@ pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
             m = m.min(scale(theta_min - cone, (CONE_BAND * cone).max(band)));
         }
     }
+    // An IES profile's jumps (its range ends, ies_jumps) bound the lit part as the cone edge
+    // does: where every lit direction of the outline lies within IES_JUMP_BAND of a jump, the
+    // lit part is a sliver whose width the GPU's f32 direction (IES_DIRECTION_ROUNDING) moves
+    // by more than half the tolerance of itself.
+    if let Some(ies) = &p.ies {
+        let lit_distance = outline
+            .iter()
+            .map(|q| (p.to_local * (x - *q)).normalize())
+            .filter(|el| ies_factor(&ies.profile, *el, ies.angle_scale) > 0.0)
+            .map(|el| ies_jumps(p, el))
+            .fold(f64::NEG_INFINITY, f64::max);
+        if lit_distance.is_finite() {
+            m = m.min(scale(lit_distance, IES_JUMP_BAND.max(band)));
+        }
+    }
     m
 }
+
+/// The width (radians) below which a lit sliver bounded by an IES jump is excluded from the
+/// irradiance comparison: the GPU's direction error `IES_DIRECTION_ROUNDING` moves the jump by
+/// half the tolerance of a sliver this wide (see `irradiance_margin`).
+const IES_JUMP_BAND: f64 = IES_DIRECTION_ROUNDING / (0.5 * super::TOLERANCE);
 
 /// How close (in pixels, or relative for a cross face edge) a textured dome's sample may come to
 /// a discontinuity f32 may straddle before it is excluded: 2000 times the ~W·2⁻²⁴ px of f32

@@ -305,7 +305,7 @@ pub fn check_with(
                 got[i],
                 pts[i],
                 Some(nrms[i]),
-                0.0,
+                irradiance_floor(p, dvec(pts[i])),
             )
         }));
     }
@@ -320,6 +320,27 @@ pub fn check_with(
         host_only,
     })
 }
+
+/// The smallest irradiance a comparison resolves at `x`: [`IRRADIANCE_FLOOR`] of the light's
+/// unshaped scale there, `max(base) · Ω` with Ω the solid angle of its bounding sphere seen
+/// from x (2π for a dome, a distant light or x inside the sphere). An f32 sum of terms of that
+/// scale cannot resolve less: a lit sliver whose reference value is a few 1e-33 of it (an IES
+/// profile's range end grazing the light) is 0 on the device, and both are "nothing".
+pub fn irradiance_floor(p: &crate::prepare::Prepared, x: DVec3) -> f64 {
+    let r = p.bound_radius();
+    let d = (x - p.origin).length();
+    let omega = if r > 0.0 && d > r {
+        let s = r / d;
+        2.0 * std::f64::consts::PI * (1.0 - (1.0 - s * s).sqrt())
+    } else {
+        2.0 * std::f64::consts::PI
+    };
+    IRRADIANCE_FLOOR * p.base.abs().max_element() * omega
+}
+
+/// See [`irradiance_floor`]: 1e-10, three orders of magnitude below f32's resolution of such a
+/// sum (~1e-7) and six below the tolerance.
+pub const IRRADIANCE_FLOOR: f64 = 1e-10;
 
 /// (CPU value, margin, GPU value, input a, input b, error floor).
 type SampleEval = (DVec3, f64, [f32; 3], [f32; 3], Option<[f32; 3]>, f64);

@@ -6,7 +6,9 @@
 
 use glam::DVec3;
 
-use crate::cpu::irradiance::{Rule, irradiance_with};
+use crate::cpu::irradiance::chart::Chart;
+use crate::cpu::irradiance::{Rule, critical, irradiance_with, outer};
+use crate::prepare::Prepared;
 use crate::query::Reference;
 use crate::rules::{
     IRR_GL_INNER, IRR_INNER_DEPTH, IRR_INNER_TOL, IRR_OUTER_DEPTH, IRR_OUTER_TOL, MAX_U_SPAN,
@@ -80,6 +82,23 @@ impl Rule for KernelRule {
 
     fn unshaped_closed_form(&self, tan_mapped: bool) -> bool {
         tan_mapped
+    }
+
+    /// The kernel's outer breakpoints: the shaping's (`critical_ys`) and an IES profile's
+    /// grid surfaces that meet the chart (`critical::ies_ys`; critical.wgsl `ies_ys`).
+    fn chart(&self, p: &Prepared, chart: &Chart, n: DVec3) -> DVec3 {
+        if p.profile.dark || !(chart.jac > 0.0) || !chart.jac.is_finite() {
+            return DVec3::ZERO;
+        }
+        let mut ys = critical::critical_ys(p, chart, n);
+        if let Some(ies) = &p.ies {
+            let local = outer::chart_ies_kinks(p, chart);
+            ys.extend(critical::ies_ys(p, chart, n, local.as_ref().unwrap_or(&ies.kinks)));
+            ys.sort_by(f64::total_cmp);
+            let span = ys[ys.len() - 1] - ys[0];
+            ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+        }
+        outer::chart_integral(p, chart, n, &ys, self)
     }
 }
 
