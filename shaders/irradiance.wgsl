@@ -6,13 +6,14 @@
 //   formula when (d / smaller half-extent)·(d / height above its plane) exceeds
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
-// On the host: lights flagged FLAG_HOST_IRRADIANCE (IES-shaped lights, textured domes and
-//   textured rects, masked domes, mesh lights whose triangles may hide one another) give 0 here and the host adds the CPU reference's value
-//   (prepare::Prepared::irradiance_on_host gives the reasons): this f32 quadrature does not
-//   split at a profile's angle nodes as the reference's line integrals do, and misses lit
-//   features narrower than its nodes; a textured dome's exact integral splits at texel-centre
-//   lines (a textured rect's, texel lines on its surface). The pipeline is built without the
-//   optional parts IES and TEXTURE (gpu::shaders::Features).
+// On the host: lights flagged FLAG_HOST_IRRADIANCE (textured domes and textured rects, masked
+//   domes, mesh lights whose triangles may hide one another, IES profiles bent by angleScale)
+//   give 0 here and the host adds the CPU reference's value (prepare::Prepared::irradiance_on_host
+//   gives the reasons): a textured dome's exact integral splits at texel-centre lines (a textured
+//   rect's, texel lines on its surface). The pipeline is built without the optional part
+//   TEXTURE, and without IES unless an IES-shaped light is integrated here
+//   (gpu::shaders::Features). An IES-shaped light's lines split at its profile's grid surfaces
+//   (irradiance/line.wgsl) and its outer integral at their critical Ys (irradiance/critical.wgsl).
 // Optional parts: the chart quadrature (CHART) and treatAsLine (LINE) are compiled in only for
 //   scenes with a light that may need them (gpu::record::Record::features, which
 //   follows this file's switch): on lavapipe the quadrature is nearly all of the pipeline's

@@ -132,7 +132,12 @@ fn gpu_irradiance_of_ies_lights_beside_plain_lights() {
 fn dense_profile() -> Vec<u8> {
     let v: Vec<f64> = (0..=180).map(f64::from).collect();
     let h: Vec<f64> = (0..=72).map(|k| 5.0 * k as f64).collect();
-    let list = |xs: &[f64]| xs.iter().map(|x| format!("{x}")).collect::<Vec<_>>().join(" ");
+    let list = |xs: &[f64]| {
+        xs.iter()
+            .map(|x| format!("{x}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
     let mut s = String::from("IESNA:LM-63-2002\r\n[TEST] dense\r\nTILT=NONE\r\n");
     s += &format!("1 -1 1 {} {} 1 2 0.1 0.1 0\r\n1 1 0\r\n", v.len(), h.len());
     s += &format!("{}\r\n{}\r\n", list(&v), list(&h));
@@ -162,7 +167,13 @@ fn a_receiver_over_lavapipes_loop_budget_is_recomputed_on_the_host() {
     let r = Reference::new(&light, TemperatureMode::Spec).expect("valid light");
     // In front of the rect (it emits toward −Z), 0.05 to 0.3 away, facing it.
     let points: Vec<[f32; 3]> = (0..8)
-        .map(|k| [0.1 * k as f32 - 0.35, 0.05 * k as f32, -0.05 - 0.035 * k as f32])
+        .map(|k| {
+            [
+                0.1 * k as f32 - 0.35,
+                0.05 * k as f32,
+                -0.05 - 0.035 * k as f32,
+            ]
+        })
         .collect();
     let normals = vec![[0.0f32, 0.0, 1.0]; points.len()];
     let scene = gpu.prepare(std::slice::from_ref(&light)).expect("prepared");
@@ -176,7 +187,11 @@ fn a_receiver_over_lavapipes_loop_budget_is_recomputed_on_the_host() {
         );
         let e = check::rel_error(cpu, got[i]);
         assert!(cpu.max_element() > 0.0, "receiver {i} unlit");
-        assert!(e < check::TOLERANCE, "receiver {i}: {cpu:?} vs {:?}: {e}", got[i]);
+        assert!(
+            e < check::TOLERANCE,
+            "receiver {i}: {cpu:?} vs {:?}: {e}",
+            got[i]
+        );
     }
     if gpu.device_name().contains("llvmpipe") {
         assert!(

@@ -429,11 +429,59 @@ fn bad_buffers_are_refused_with_typed_errors() {
     r.device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
 }
 
+/// IES-shaped lights' irradiance is integrated on the device (shaders/irradiance/line.wgsl):
+/// GPU-resident calls give the host path's values, rows the kernel could not finish (NaN,
+/// recomputed by the host path) aside.
+#[test]
+fn ies_irradiance_matches_the_host_path() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let scene = eval.prepare(&lights_with_ies()[11..]).unwrap();
+    let mut rng = Rng::new(5);
+    let n = 97;
+    let pts = points(&mut rng, n);
+    let normals = unit_rows(&mut rng, n);
+    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
+    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    let rows = scene.len() * n;
+    let out = r.output(rows);
+    let mut enc = r.encoder();
+    scene
+        .encode_irradiance(
+            &mut enc,
+            &pts_buf,
+            &nrm_buf,
+            &out,
+            n as u32,
+            Accumulate::PerLight,
+        )
+        .unwrap();
+    let got = r.finish(enc, &out, rows);
+    let host = scene
+        .irradiance(&pts, &normals, Accumulate::PerLight)
+        .unwrap();
+    let finished: Vec<usize> = (0..rows).filter(|&i| !got[i][0].is_nan()).collect();
+    assert!(
+        finished.len() * 10 >= rows * 9,
+        "{} of {rows} rows finished",
+        finished.len()
+    );
+    let pick = |v: &[[f32; 3]]| finished.iter().map(|&i| v[i]).collect::<Vec<_>>();
+    assert_same("IES irradiance PerLight", &pick(&got), &pick(&host));
+}
+
 #[test]
 fn host_irradiance_lights_are_refused_by_name() {
     let Some(r) = renderer() else { return };
     let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
-    let lights = lights_with_ies();
+    let mut lights = lights_with_ies();
+    // A type B profile under angleScale: its grid lines are bent, its irradiance the host's.
+    let mut rng = Rng::new(12);
+    let mut bent = with_random_ies(random_light(2, "rotate", &mut rng, 102), &mut rng, 6, false);
+    if let Some(ies) = bent.shaping.as_mut().and_then(|s| s.ies.as_mut()) {
+        ies.angle_scale = 0.8;
+    }
+    lights.insert(12, bent);
     let ies_path = lights[12].path.clone();
     let scene = eval.prepare(&lights).unwrap();
     let n = 64;

@@ -28,10 +28,10 @@
 // 5. Counts and offsets are read from f32 atlas values (u32(x)): exact because the packer refuses
 //    atlases of 2^24 floats or more.
 // 6. The lookup in ies_of is the optional part IES (`// #if IES`, gpu::shaders::Features): each
-//    kernel is built without it for scenes with no profile, and the irradiance kernel always
-//    without it (it integrates no IES-shaped light, see shaders/irradiance.wgsl). Inlined at
-//    every shaping call of the irradiance quadrature, the lookup took lavapipe's compiler
-//    minutes; left in but disabled by a pipeline-overridable constant, still 3 s.
+//    kernel is built without it for scenes with no profile, the irradiance kernel for scenes
+//    whose IES-shaped lights all keep their irradiance on the host (GpuLights::variant). The
+//    irradiance quadrature calls it once per inner node, in one copy (irradiance/line.wgsl):
+//    inlined at every shaping call of the old quadrature, it took lavapipe's compiler minutes.
 // GPU-only search_step: the CPU's loop body in find_interval, written out (divergence 4).
 // Not divergences (checked): at a frame's poles (both atan2 arguments zero) atan2_accurate gives
 // 0 and the CPU twin returns 0 explicitly (f64::atan2(0, −0) would be π); the folds 360 − H,

@@ -282,8 +282,8 @@ pub fn check_with(
             )
         }));
         // Irradiance: the CPU values (quadratures) are computed in parallel. Not for the lights
-        // whose irradiance the GPU path takes from the CPU reference (IES-shaped lights,
-        // textured domes and rects: Prepared::irradiance_on_host), so there is nothing to compare.
+        // whose irradiance the GPU path takes from the CPU reference (textured domes and rects,
+        // bent IES profiles: Prepared::irradiance_on_host), so there is nothing to compare.
         let ni = if p.irradiance_on_host() {
             0
         } else {

@@ -74,8 +74,6 @@ fn pipeline_name(kernel: Kernel, features: Features) -> String {
 /// Environment variable that picks an adapter by (case-insensitive) name substring.
 pub const ADAPTER_ENV: &str = "LUXEVAL_ADAPTER";
 
-
-
 /// The invocations llvmpipe runs together and whose loops share one budget (its SIMD vector
 /// of 8 f32 lanes; [`GpuContext::lane_stride`] also spreads samples over whole workgroups if
 /// that is measured to be the unit).

@@ -11,10 +11,11 @@ pub enum GpuPath {
     /// Every query on the device.
     Device,
     /// Every query on the device but irradiance, which is the CPU reference's until the f32
-    /// quadrature can match it; the reason is a phrase ("it is IES-shaped"):
-    /// - IES-shaped lights: the kernel's quadrature does not split at a profile's angle nodes as
-    ///   the reference's line integrals do, and misses lit features narrower than its nodes
-    ///   (measured: up to 100 % on receivers that see a thin lit band of a striped profile).
+    /// quadrature can match it; the reason is a phrase ("it is a textured dome"):
+    /// - IES profiles of types A and B under angleScale: it bends their grid lines into
+    ///   surfaces that are neither cones nor planes, which the kernel cannot split at
+    ///   (`PreparedIes::device_families`; every other IES-shaped light is integrated on the
+    ///   device, its lines split at the profile's grid cones and planes).
     /// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
     ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a
     ///   dome's irradiance depends on the normal only, so the reference evaluates it once per

@@ -206,3 +206,147 @@ impl IesKinks {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn profile(
+        kind: PhotometricType,
+        h: &[f64],
+        v: &[f64],
+        h_fold: HFold,
+        v_fold: VFold,
+    ) -> Profile {
+        Profile {
+            kind,
+            h: h.to_vec(),
+            v: v.to_vec(),
+            candela: vec![1.0; h.len() * v.len()],
+            h_fold,
+            v_fold,
+            tilt: None,
+        }
+    }
+
+    /// Every kink of every type and fold is in the families exactly as the kernel streams it:
+    /// cones on one axis with their cosines ascending, planes of the pencil ascending in
+    /// azimuth δ ∈ [0, π), each holding the direction at δ, the rest among the extras.
+    #[test]
+    fn families_hold_every_kink_sorted() {
+        use HFold::*;
+        use PhotometricType::*;
+        let cases = [
+            profile(
+                C,
+                &[0.0],
+                &[0.0, 10.0, 35.5, 90.0, 120.0],
+                Constant,
+                VFold::AsGiven,
+            ),
+            profile(
+                C,
+                &[0.0, 30.0, 90.0],
+                &[0.0, 45.0, 90.0],
+                Quadrant,
+                VFold::AsGiven,
+            ),
+            profile(
+                C,
+                &[0.0, 45.0, 180.0],
+                &[90.0, 135.0, 180.0],
+                Half,
+                VFold::AsGiven,
+            ),
+            profile(
+                C,
+                &[90.0, 180.0, 270.0],
+                &[0.0, 60.0],
+                HalfC90,
+                VFold::AsGiven,
+            ),
+            profile(
+                C,
+                &[0.0, 100.0, 200.0, 300.0, 360.0],
+                &[0.0, 20.0],
+                Full,
+                VFold::AsGiven,
+            ),
+            profile(
+                B,
+                &[0.0, 20.0, 90.0],
+                &[0.0, 30.0, 90.0],
+                Mirror,
+                VFold::Mirror,
+            ),
+            profile(
+                B,
+                &[-40.0, 0.0, 50.0],
+                &[-80.0, -10.0, 90.0],
+                AsGiven,
+                VFold::AsGiven,
+            ),
+            profile(
+                A,
+                &[0.0, 25.0, 90.0],
+                &[0.0, 45.0, 90.0],
+                Mirror,
+                VFold::Mirror,
+            ),
+            profile(
+                A,
+                &[0.0],
+                &[-90.0, 0.0, 15.0, 90.0],
+                Constant,
+                VFold::AsGiven,
+            ),
+        ];
+        for p in &cases {
+            for s in [0.0, 0.8, -1.2] {
+                let k = ies_kinks(p, s);
+                let f = k.families().expect("families");
+                assert!(
+                    f.cone_cos.windows(2).all(|w| w[0] < w[1]),
+                    "{:?}",
+                    f.cone_cos
+                );
+                for (axis, cos) in &k.cones {
+                    assert_eq!(*axis, f.cone_axis);
+                    assert!(f.cone_cos.contains(cos), "cone {cos} of {:?}", p.kind);
+                }
+                let pv = f.pencil_axis.cross(f.pencil_u);
+                assert!(f.planes.windows(2).all(|w| w[0].0 < w[1].0));
+                for &(d, mu, mv) in &f.planes {
+                    assert!((0.0..std::f64::consts::PI).contains(&d), "δ {d}");
+                    let m = f.pencil_u * mu + pv * mv;
+                    let held = f.pencil_u * d.cos() + pv * d.sin();
+                    assert!(m.dot(held).abs() < 1e-12 && m.dot(f.pencil_axis).abs() < 1e-12);
+                }
+                for m in &k.planes {
+                    let m = m.normalize();
+                    let in_pencil = f
+                        .planes
+                        .iter()
+                        .any(|&(_, mu, mv)| (f.pencil_u * mu + pv * mv).cross(m).length() < 1e-12);
+                    let extra = f.extra.iter().any(|e| e.cross(m).length() < 1e-12);
+                    assert!(in_pencil || extra, "plane {m} of {:?} s {s}", p.kind);
+                }
+            }
+        }
+    }
+
+    /// angleScale bends the grid lines of types B and A: the light keeps its irradiance on the
+    /// host (PreparedIes::device_families), whose kinks list is empty for them.
+    #[test]
+    fn bent_profiles_list_no_kinks() {
+        let p = profile(
+            PhotometricType::B,
+            &[0.0, 30.0],
+            &[0.0, 40.0],
+            HFold::Mirror,
+            VFold::Mirror,
+        );
+        assert_eq!(ies_kinks(&p, 0.7), IesKinks::default());
+        assert!(!ies_kinks(&p, 0.0).planes.is_empty());
+    }
+}

@@ -155,10 +155,16 @@ impl PreparedScene {
     /// pairs, as [`PreparedScene::encode_emission`] does.
     ///
     /// Refused with [`LuxError::NotOnDevice`] naming the first such light when the scene holds
-    /// a light whose irradiance the host path computes on the CPU (IES-shaped lights, textured
-    /// domes and textured rects): the kernel gives 0 for them, which this path would return as
-    /// if it were the answer. Prepare those lights in a scene of their own and use
-    /// [`PreparedScene::irradiance`] for them.
+    /// a light whose irradiance the host path computes on the CPU (textured domes and textured
+    /// rects, IES profiles of types A and B under angleScale): the kernel gives 0 for them,
+    /// which this path would return as if it were the answer. Prepare those lights in a scene
+    /// of their own and use [`PreparedScene::irradiance`] for them.
+    ///
+    /// A (light, receiver) the kernel cannot finish is NaN (the host path recomputes such rows
+    /// on the CPU reference; this path has no host step): on any adapter, a chart that needs
+    /// more outer breakpoints than the kernel holds (96: an IES profile with many grid
+    /// surfaces across a large light seen from near), and on llvmpipe (lavapipe), whose loops
+    /// stop silently after 65,535 iterations per invocation, a quadrature cut short.
     pub fn encode_irradiance(
         &self,
         encoder: &mut wgpu::CommandEncoder,
