@@ -58,6 +58,16 @@ fn gpu_matches_cpu_on_ies_shaped_lights() {
     }
     reports.sort_by(|a, b| b.max_rel_error.total_cmp(&a.max_rel_error));
     println!("IES conformance on {device}: {total} samples, {excluded} excluded");
+    let irradiance: Vec<_> = reports
+        .iter()
+        .filter(|r| format!("{:?}", r.query) == "Irradiance")
+        .collect();
+    println!(
+        "  irradiance: {} samples, {} excluded, worst {:.3e}",
+        irradiance.iter().map(|r| r.samples).sum::<usize>(),
+        irradiance.iter().map(|r| r.excluded).sum::<usize>(),
+        irradiance.first().map_or(0.0, |r| r.max_rel_error)
+    );
     for r in reports.iter().take(8) {
         println!(
             "  {:>10.3e}  {:?} {:>14} {}  worst {:?}",
