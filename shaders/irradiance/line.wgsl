@@ -16,8 +16,8 @@
 //   (prepare::ies_kinks::KinkFamilies; layout in src/gpu/ies_atlas.rs), and merges them with
 //   the fixed breakpoints. A crossing is the quadratic's root on its side, clamped to the side.
 // GPU-only inner_node, inner_rule, max3, inner_adaptive: the kernel's inner rule (above).
-// GPU-only kink_step, kink_rank, cone_side, cone_run, plane_side, plane_run, run_next: the
-//   streamed IES breakpoints (above).
+// GPU-only kink_step, kink_rank, run_side, cone_side, cone_run, plane_side, plane_run, run_next:
+//   the streamed IES breakpoints (above).
 // GPU-only line_piece: the body of the CPU's loop over pieces, a function here because the
 //   merge loop above calls it once per piece.
 
@@ -183,8 +183,8 @@ struct KinkRun {
     next: f32,
 }
 
-// Cones: the run on side `side` (0: [lo, split], 1: [split, hi]) of the extremum of −ŵ·axis.
-fn cone_side(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, side: u32) -> KinkRun {
+// The run moved to side `side` (0: [lo, split], 1: [split, hi]), no crossing counted yet.
+fn run_side(run: KinkRun, side: u32) -> KinkRun {
     var r = run;
     r.side = side;
     if side == 1u {
@@ -194,6 +194,12 @@ fn cone_side(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, side: u32) -> 
         r.s1 = r.split;
     }
     r.left = 0u;
+    return r;
+}
+
+// Cones: the run on side `side` of the extremum of −ŵ·axis.
+fn cone_side(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, side: u32) -> KinkRun {
+    var r = run_side(run, side);
     let n = u32(ies_atlas[kb]);
     let axis = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
     let off = kb + IES_KINKS_HEADER;
@@ -236,15 +242,7 @@ fn cone_run(kb: u32, al: vec3<f32>, el: vec3<f32>, lo: f32, hi: f32) -> KinkRun 
 // Planes of the pencil: the run on side `side` of the line's closest approach to the pencil's
 // axis (the azimuth about it turns one way, by less than 90°, on each side).
 fn plane_side(run: KinkRun, kb: u32, al: vec3<f32>, el: vec3<f32>, side: u32) -> KinkRun {
-    var r = run;
-    r.side = side;
-    if side == 1u {
-        r.s0 = r.split;
-        r.s1 = r.hi;
-    } else {
-        r.s1 = r.split;
-    }
-    r.left = 0u;
+    var r = run_side(run, side);
     let np = u32(ies_atlas[kb + 4u]);
     let off = kb + IES_KINKS_HEADER + u32(ies_atlas[kb]);
     if np == 0u || !(r.s1 > r.s0) {

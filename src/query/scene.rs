@@ -268,10 +268,12 @@ impl PreparedScene {
         Ok(out)
     }
 
-    /// Rows the irradiance kernel gave up on (NaN: a loop cut short by llvmpipe's loop budget,
-    /// `GpuContext::lane_stride`) are recomputed here on the CPU reference: with `per_light` that light's row, else the receiver's sum over the lights
-    /// the device integrates (the host lights are added after). Finite inputs never give NaN
-    /// otherwise (DESIGN.md §5), so a NaN row is exactly a row cut short.
+    /// Rows the irradiance kernel could not finish (NaN: a chart with more outer breakpoints
+    /// than the kernel holds, or on llvmpipe a loop cut short by its budget,
+    /// `GpuContext::lane_stride`; `irr_cut` in shaders/shared/record.wgsl) are recomputed here
+    /// on the CPU reference: with `per_light` that light's row, else the receiver's sum over
+    /// the lights the device integrates (the host lights are added after). Finite inputs never
+    /// give NaN otherwise (DESIGN.md §5), so a NaN row is exactly such a row.
     fn redo_spent_rows(
         &self,
         points: &[[f32; 3]],
