@@ -268,3 +268,23 @@ fn ies_lookup_has_no_loop() {
         "{body}"
     );
 }
+
+/// The IES kink lists' binary search (irradiance/line.wgsl `kink_rank`) is written out, as
+/// many steps as the packer allows a list (`KINK_SEARCH_STEPS`): a loop there would spend
+/// lavapipe's budget on every line.
+#[test]
+fn kink_search_is_written_out_for_the_longest_list() {
+    let src = SOURCES
+        .iter()
+        .find(|(name, _)| *name == "irradiance/line.wgsl")
+        .unwrap()
+        .1;
+    let body = &src[src.find("fn kink_rank(").unwrap()..];
+    let body = &body[..body.find("\n}").unwrap()];
+    assert!(!body.contains("loop") && !body.contains("for ("), "{body}");
+    assert_eq!(
+        body.matches("lh = kink_step(").count() as u32,
+        luxeval::testkit::ies_replay::KINK_SEARCH_STEPS,
+        "{body}"
+    );
+}

@@ -15,6 +15,11 @@
 //   of the cosine's extremum (the pencil's closest approach), found by binary search
 //   (prepare::ies_kinks::KinkFamilies; layout in src/gpu/ies_atlas.rs), and merges them with
 //   the fixed breakpoints. A crossing is the quadratic's root on its side, clamped to the side.
+//   The two split points are fixed breakpoints too (the CPU has no such points): a crossing
+//   exactly there (an axis-aligned line meeting a plane of the pencil at its closest approach)
+//   belongs to neither side's run.
+// f32: every loop checks its own condition after it ends and sets irr_cut if it stopped short
+//   (lavapipe's loop budget, see shared/record.wgsl); the CPU has no such limit.
 // GPU-only inner_node, inner_rule, max3, inner_adaptive: the kernel's inner rule (above).
 // GPU-only kink_step, kink_rank, run_side, cone_side, cone_run, plane_side, plane_run, run_next:
 //   the streamed IES breakpoints (above).

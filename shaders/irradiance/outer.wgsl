@@ -4,6 +4,8 @@
 // f32: the kernel's outer rule: per span the Gauss–Kronrod 7/15 pair, halved while Gauss and
 //   Kronrod differ by more than IRR_OUTER_TOL of the Kronrod value, at most IRR_OUTER_DEPTH
 //   times, depth first, instead of the reference's globally adaptive Gauss–Kronrod to 1e-9.
+// f32: every loop checks its own condition after it ends and sets irr_cut if it stopped short
+//   (lavapipe's loop budget, see shared/record.wgsl); the CPU has no such limit.
 // GPU-only outer_gk, outer_adaptive: the kernel's outer rule (above).
 
 // #import irradiance/chart.wgsl

@@ -21,7 +21,8 @@
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: a triangle costs
 //   at most 12 (one in mesh_lambert, 3 clipping, 4 Lambert edges, 4 sliver arcs; the
 //   quadrature is written out), so at most MESH_TRIANGLES_SUMMED (4096) triangles stay inside
-//   it (49,152) for one such mesh per dispatch group.
+//   it (49,152) for one such mesh per dispatch group; the triangle loop still checks its own
+//   condition after it ends and sets irr_cut if it stopped short (shared/record.wgsl).
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl

@@ -7,7 +7,8 @@ use glam::Vec3;
 use crate::prepare::ies::{HFold, PhotometricType, VFold};
 
 pub use crate::gpu::ies_atlas::{
-    Atlas, AtlasError, HEADER_LEN, MAX_LEN, SEARCH_STEPS, pack_atlas, wgsl_constants,
+    Atlas, AtlasError, HEADER_LEN, KINK_SEARCH_STEPS, MAX_LEN, SEARCH_STEPS, pack_atlas,
+    wgsl_constants,
 };
 
 /// math.wgsl's `atan2_accurate`, replayed in f32 (the shader's atan2 for every angle).
