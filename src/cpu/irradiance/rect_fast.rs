@@ -90,7 +90,15 @@ const G5W: [f64; 5] = [
 /// handles shaping kinks ([`Kernel::kinked`], the clipped rule's line splits) stays for the day
 /// that bias is found; IES profiles were never tried.
 pub fn applies(p: &Prepared) -> bool {
-    p.rect_texture().is_some() && p.ies.is_none() && p.shaping.is_none()
+    p.rect_texture().is_some() && p.ies.is_none()
+}
+
+/// The rule of a cell (see [`Kernel::rule_kind`]).
+#[derive(Clone, Copy, PartialEq)]
+enum RuleKind {
+    Zero,
+    Moments,
+    Clipped,
 }
 
 /// The smooth kernel `K = S(−ŵ)·max(0, n·w)·J/|w|⁴` of the chart integral (module docs).
@@ -127,20 +135,29 @@ impl Kernel<'_> {
         )
     }
 
-    /// The cell's rule: 0 behind the horizon, the moment rule where the horizon does not cross
-    /// it, else [`Kernel::clipped`].
-    fn cell_rule(&self, tree: &Tree, cell: &Cell) -> DVec3 {
-        let r = tree.rect(cell);
+    /// Which rule a cell takes: none behind the horizon, the moment rule where neither the
+    /// horizon nor a shaping kink may cross it (K smooth on it), else [`Kernel::clipped`].
+    fn rule_kind(&self, r: Rect) -> RuleKind {
         let (c, a, b) = self.horizon();
         let hs = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)]
             .map(|(x, y)| c + a * x + b * y);
         if hs.iter().all(|&h| !(h > 0.0)) {
-            return DVec3::ZERO;
+            RuleKind::Zero
+        } else if hs.iter().all(|&h| h > 0.0) && !self.kinked(r) {
+            RuleKind::Moments
+        } else {
+            RuleKind::Clipped
         }
-        if hs.iter().all(|&h| h > 0.0) && !self.kinked(r) {
-            return self.rule(r, &tree.moments(cell));
+    }
+
+    /// The cell's rule (see [`Kernel::rule_kind`]).
+    fn cell_rule(&self, tree: &Tree, cell: &Cell) -> DVec3 {
+        let r = tree.rect(cell);
+        match self.rule_kind(r) {
+            RuleKind::Zero => DVec3::ZERO,
+            RuleKind::Moments => self.rule(r, &tree.moments(cell)),
+            RuleKind::Clipped => self.clipped(tree, r),
         }
-        self.clipped(tree, r)
     }
 
     /// Whether a kink of the shaping factor (`Prepared::profile`: the cone edge, the
@@ -203,6 +220,9 @@ impl Kernel<'_> {
                     cuts.push(u);
                 }
             }
+        }
+        if self.shaped {
+            self.kink_cuts(&mut cuts, swap, (c, p, q), (u0, u1, v0, v1));
         }
         cuts.sort_by(f64::total_cmp);
         let lim = |u: f64| {
@@ -270,6 +290,74 @@ impl Kernel<'_> {
             }
         }
         sum
+    }
+
+    /// The outer cuts of [`Kernel::clipped`] that the shaping's kinks need: the u where the
+    /// inner structure of the lines u = const changes, so that the outer integrand (the inner
+    /// integral as a function of u) is smooth between cuts and the 5-point rule across lines
+    /// converges at its order, as `critical::critical_ys` splits the reference's outer
+    /// integral. They are where a kink curve crosses the cell's sides v = v0, v1 or the
+    /// horizon line (a root enters or leaves a line's interval), where a kink cone is tangent
+    /// to a line of the pencil (two roots appear together: the inner integral has a
+    /// square-root-type point there), and the line through the axis direction when the
+    /// shaping is singular there. `h = c + p·u + q·v` is the horizon in (u, v).
+    fn kink_cuts(
+        &self,
+        cuts: &mut Vec<f64>,
+        swap: bool,
+        (c, p, q): (f64, f64, f64),
+        (u0, u1, v0, v1): (f64, f64, f64, f64),
+    ) {
+        let ch = self.chart;
+        let (eu, ev) = if swap { (ch.e2, ch.e1) } else { (ch.e1, ch.e2) };
+        // The lines along which u runs: the sides v = v0, v1 and the horizon line.
+        let mut edges = vec![(ch.w0 + ev * v0, eu), (ch.w0 + ev * v1, eu)];
+        if q != 0.0 {
+            edges.push((ch.w0 - ev * (c / q), eu - ev * (p / q)));
+        }
+        let mut us = Vec::new();
+        let axis = self.p.axis;
+        for k in &self.p.profile.kinks {
+            match *k {
+                Kink::Cone { cos } => {
+                    for &(a, d) in &edges {
+                        us.extend(cone_roots_on_line(axis, cos, a, d));
+                    }
+                    // Planes through x containing ev (the lines u = const) tangent to the
+                    // cone: normals m ⊥ ev with |m·axis| = sin θ (as `critical.rs`'s
+                    // pencil tangents, with the roles of the chart axes swapped or not).
+                    let s = (1.0 - cos * cos).max(0.0).sqrt();
+                    let (m1, m2) = ev.normalize().any_orthonormal_pair();
+                    let (pa, pb) = (m1.dot(axis), m2.dot(axis));
+                    let ra = pa.hypot(pb);
+                    if ra >= s && ra > 0.0 {
+                        let t0 = pb.atan2(pa);
+                        let d = (s / ra).clamp(-1.0, 1.0).acos();
+                        for t in [t0 + d, t0 - d] {
+                            let m = m1 * t.cos() + m2 * t.sin();
+                            if m.dot(eu) != 0.0 {
+                                us.push(-m.dot(ch.w0) / m.dot(eu));
+                            }
+                        }
+                    }
+                }
+                Kink::Plane { m, .. } => {
+                    for &(a, d) in &edges {
+                        if m.dot(d) != 0.0 {
+                            us.push(-m.dot(a) / m.dot(d));
+                        }
+                    }
+                }
+            }
+        }
+        if self.p.profile.axis_singular {
+            // The line of the pencil through the axis directions.
+            let m = ev.cross(axis);
+            if m.dot(eu) != 0.0 {
+                us.push(-m.dot(ch.w0) / m.dot(eu));
+            }
+        }
+        cuts.extend(us.into_iter().filter(|&u| u > u0 && u < u1));
     }
 
     /// The cell's moment rule `Σ K(x_ab) W_ab`.
@@ -360,7 +448,12 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         let value: DVec3 = kids.iter().map(|c| c.1).sum();
         let err = (value - own).abs();
         let r = tree.rect(&cell);
-        let key = if k.near(r) {
+        // A clipped rule over more than one texel piece samples t across its kinks or jumps:
+        // neither it nor its children's rules converge there, and both can miss the same texel
+        // (a cell whose lit part lies in one child gets that child's very rule points), so
+        // such a cell is split untrusted down to single pieces, where t is a polynomial.
+        let sampled = tree.pieces(&cell) > 1 && k.kinked(r) && k.rule_kind(r) == RuleKind::Clipped;
+        let key = if sampled || k.near(r) {
             f64::INFINITY
         } else {
             err.max_element()
