@@ -30,8 +30,29 @@
 //!   smoothstep start, focus plane: `Prepared::profile`) is integrated by
 //!   [`Kernel::clipped`], a 5 × 5 Gauss rule on the part in front of the horizon whose lines
 //!   are split at the shaping's kinks (the roots `line::line_integral` splits at), with t
-//!   sampled; no rule point then lies where K = 0, so no lit sliver goes unseen. Subdivision
-//!   goes on below pieces until the estimates meet the tolerance.
+//!   sampled; no rule point then lies where K = 0, so no lit sliver goes unseen along a line.
+//!   Across lines the rule is split where a kink's inner roots change (a kink cone crossing
+//!   the cell's sides or the horizon line, or tangent to the pencil of lines; the focus plane
+//!   crossing them), as `critical::critical_ys` splits the reference's outer integral, so
+//!   that the outer integrand is smooth on each part and no lit cap of the cone lies between
+//!   two lines unseen. Subdivision goes on below pieces until the estimates meet the tolerance.
+//! - The clipped rule samples t, so over several texel pieces it samples across t's kinks
+//!   (bilinear) or jumps (nearest): neither it nor its children's rules converge there, and
+//!   the estimate can read 0 while both miss a texel (a cell whose lit part lies in one child
+//!   gets that child's very rule points). This was the bias that kept shaped rects on the
+//!   exact path: at 256 × 128, nearest, sheared, grazing receiver (the lit part a few texels
+//!   between the horizon and the cone), 1.0e-4 and 3.0e-4 error at 1e-4 and at 1e-3, 1.1e-4
+//!   and 4.6e-4 at 1e-2 (not the tolerance's); with the texture lit in one texel of it only, 33 % of that texel's light found,
+//!   the same at rel 1e-4, 1e-6, 1e-8. For a shaped light a clipped cell over more than one
+//!   piece is therefore split untrusted down to single pieces (where t is a polynomial and
+//!   the rule converges): that case then < 5e-8, every shaped 256 × 128 one ≤ 5e-7 at 1e-4. The outer splits above were
+//!   needed too: without them 4 one-texel textures of 16 × 8 (of shaped rects) were missed
+//!   entirely (a lit cap between two lines).
+//! - Unshaped rects still trust a horizon-cut clipped cell over several pieces (it keeps their
+//!   grazing receivers at ~1–2.5 ms on 2048 × 1024; splitting those cells too measured ~12–25
+//!   ms). Random textures do not show it (worst 0.30 of the tolerance at 256 × 128), but
+//!   one-texel textures do: 5 cases of 16 × 8 (unshaped, both filters, both transforms, the
+//!   9 receivers of the tests) off by 1.2e-4 to 100 % at 1e-4. Not fixed here.
 //! - Guard against a peak no rule point sees: a cell is split without being trusted while its
 //!   world half-diagonal R exceeds half the lower bound `|w_c| − R` of its distance from x
 //!   (FMM's well-separated criterion), unless the receiver's horizon hides all of it.
@@ -39,13 +60,15 @@
 //! Threshold ([`MIN_TOLERANCE`], `Rule::texture_tolerance`): `Adaptive::for_tolerance(rel)`
 //! with rel ≥ 1e-4 (the CLI's and Python's default) takes this path; tighter tolerances and the
 //! reference (`Adaptive::REFERENCE`, 1e-9) keep the exact split path unchanged. At 1e-5 the
-//! estimates were measured to miss by 2–4× (1.9e-5 unshaped nearest, 3.6e-5 shaped).
+//! estimates were measured to miss by 2–4× (1.9e-5 unshaped nearest, 3.6e-5 shaped, the latter
+//! before the shaped fix above; not measured since).
 //!
 //! What this does not prove: the error estimate is a-posteriori (as the reference's
 //! Gauss–Kronrod estimates are), not an a-priori bound; the tests measure the result against
-//! the 1e-9 reference on random textures (sizes to 64 × 32 in the default run, 256 × 128 with
-//! `--ignored`), near, grazing and far receivers. Shaped rects are left to the exact path
-//! ([`applies`]: a bias was measured there), IES profiles too.
+//! the 1e-9 reference on random textures, unshaped and shaped (cone, softness, focus with
+//! tint; sizes to 64 × 32 in the default run, 256 × 128 with `--ignored`), and on one-texel
+//! textures of shaped rects (8 × 4; 16 × 8 with `--ignored`), near, grazing and far receivers.
+//! IES profiles are left to the exact path ([`applies`]: never tried here).
 
 use std::collections::BinaryHeap;
 
@@ -82,13 +105,12 @@ const G5W: [f64; 5] = [
     0.236_926_885_056_189_1,
 ];
 
-/// Whether the fast path takes `p` (a textured rect): unshaped only. Shaped rects keep the exact
-/// split path: with a cone and focus the release-only 256 × 128 comparison measured a bias the
-/// estimates do not see (nearest filter, sheared transform, horizon through the rect: 1.0e-4
-/// and 3.0e-4 at 1e-4, 1.1e-4 and 4.6e-4 at 1e-2, where the exact path at 1e-5 agrees with the
-/// reference to 1e-9), and sharper cones (softness < 0.25) missed by up to 30×. The code that
-/// handles shaping kinks ([`Kernel::kinked`], the clipped rule's line splits) stays for the day
-/// that bias is found; IES profiles were never tried.
+/// Whether the fast path takes `p`: a textured rect, unshaped or shaped by ShapingAPI's cone,
+/// softness, focus and focusTint (their kinks handled as the module docs say; the shaped bias
+/// once measured here was the clipped rule sampling the texture across texel pieces). With an
+/// IES profile the exact split path runs: its kinks (`prepare::ies_kinks`) are not listed by
+/// `Prepared::profile`, which [`Kernel::kinked`] and the clipped rule read, and it was never
+/// measured here.
 pub fn applies(p: &Prepared) -> bool {
     p.rect_texture().is_some() && p.ies.is_none()
 }
@@ -477,8 +499,8 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
     let mut forced = usize::from(first.key == f64::INFINITY);
     let mut heap = BinaryHeap::new();
     heap.push(first);
-    // The estimates are not bounds, so the sum stops well inside rel (the shaped bias of
-    // `applies` did not change from rel/8 to rel/16: it is not the stop's).
+    // The estimates are not bounds, so the sum stops well inside rel (the shaped bias once
+    // measured did not change from rel/8 to rel/16: it was not the stop's, see module docs).
     let q = rel / 16.0;
     for _ in 0..MAX_SPLITS {
         let tiny = 1e-14 * total.abs().max_element();
