@@ -40,9 +40,11 @@ fn skewed() -> DMat4 {
     ) * shear
 }
 
-/// A wide soft cone with a tinted focus, and a narrow cone with the thinnest smoothstep the
-/// fast path takes (softness 0.25; its edge crosses the rect for several receivers).
-fn shapings() -> [Option<Shaping>; 3] {
+/// A wide soft cone with a tinted focus, a narrow cone with the thinnest smoothstep the
+/// fast path takes (softness 0.25; its edge crosses the rect for several receivers), and a
+/// tinted focus alone (no cone: its only kink is the focus plane, |cos θ|^0.7 there, which
+/// crosses the sheared rect for the three receivers nearest to it).
+fn shapings() -> [Option<Shaping>; 4] {
     [
         None,
         Some(Shaping {
@@ -57,6 +59,13 @@ fn shapings() -> [Option<Shaping>; 3] {
             focus_tint: DVec3::ONE,
             cone_angle: 30.0,
             cone_softness: 0.25,
+            ies: None,
+        }),
+        Some(Shaping {
+            focus: 0.7,
+            focus_tint: DVec3::new(0.2, 0.5, 1.0),
+            cone_angle: 180.0,
+            cone_softness: 0.0,
             ies: None,
         }),
     ]
