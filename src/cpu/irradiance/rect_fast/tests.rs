@@ -43,8 +43,9 @@ fn skewed() -> DMat4 {
 /// A wide soft cone with a tinted focus, a narrow cone with the thinnest smoothstep the
 /// fast path takes (softness 0.25; its edge crosses the rect for several receivers), and a
 /// tinted focus alone (no cone: its only kink is the focus plane, |cos θ|^0.7 there, which
-/// crosses the sheared rect for the three receivers nearest to it).
-fn shapings() -> [Option<Shaping>; 4] {
+/// crosses the sheared rect for the three receivers nearest to it), and a hard 35° cone
+/// (softness 0: a jump at its edge).
+fn shapings() -> [Option<Shaping>; 5] {
     [
         None,
         Some(Shaping {
@@ -65,6 +66,13 @@ fn shapings() -> [Option<Shaping>; 4] {
             focus: 0.7,
             focus_tint: DVec3::new(0.2, 0.5, 1.0),
             cone_angle: 180.0,
+            cone_softness: 0.0,
+            ies: None,
+        }),
+        Some(Shaping {
+            focus: 0.0,
+            focus_tint: DVec3::ONE,
+            cone_angle: 35.0,
             cone_softness: 0.0,
             ies: None,
         }),
