@@ -65,9 +65,10 @@
 //!
 //! What this does not prove: the error estimate is a-posteriori (as the reference's
 //! Gauss–Kronrod estimates are), not an a-priori bound; the tests measure the result against
-//! the 1e-9 reference on random textures, unshaped and shaped (cone, softness, focus with
-//! tint; sizes to 64 × 32 in the default run, 256 × 128 with `--ignored`), and on one-texel
-//! textures of shaped rects (8 × 4; 16 × 8 with `--ignored`), near, grazing and far receivers.
+//! the 1e-9 reference on random textures, unshaped and shaped (cones with softness 0 to 0.4,
+//! focus with tint, focus alone; sizes to 64 × 32 in the default run, 256 × 128 with
+//! `--ignored`), and on one-texel textures of shaped rects (8 × 4; 16 × 8 with `--ignored`),
+//! near, grazing and far receivers.
 //! IES profiles are left to the exact path ([`applies`]: never tried here).
 
 use std::collections::BinaryHeap;
