@@ -46,8 +46,9 @@
 //!   the same at rel 1e-4, 1e-6, 1e-8. For a shaped light a clipped cell over more than one
 //!   piece is therefore split untrusted down to single pieces (where t is a polynomial and
 //!   the rule converges): that case then < 5e-8, every shaped 256 × 128 one ≤ 5e-7 at 1e-4. The outer splits above were
-//!   needed too: without them 4 one-texel textures of 16 × 8 (of shaped rects) were missed
-//!   entirely (a lit cap between two lines).
+//!   needed too: without them (in a variant that split only the kink-crossed cells) 4
+//!   one-texel textures of 16 × 8 of shaped rects were missed entirely (a lit cap between
+//!   two lines).
 //! - Unshaped rects still trust a horizon-cut clipped cell over several pieces (it keeps their
 //!   grazing receivers at ~1–2.5 ms on 2048 × 1024; splitting those cells too measured ~12–25
 //!   ms). Random textures do not show it (worst 0.30 of the tolerance at 256 × 128), but
