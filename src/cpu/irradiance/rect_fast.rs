@@ -49,11 +49,11 @@
 //!   needed too: without them (in a variant that split only the kink-crossed cells) 4
 //!   one-texel textures of 16 × 8 of shaped rects were missed entirely (a lit cap between
 //!   two lines).
-//! - Unshaped rects still trust a horizon-cut clipped cell over several pieces (it keeps their
-//!   grazing receivers at ~1–2.5 ms on 2048 × 1024; splitting those cells too measured ~12–25
-//!   ms). Random textures do not show it (worst 0.30 of the tolerance at 256 × 128), but
-//!   one-texel textures do: 5 cases of 16 × 8 (unshaped, both filters, both transforms, the
-//!   9 receivers of the tests) off by 1.2e-4 to 100 % at 1e-4. Not fixed here.
+//! - Unshaped rects too: while a horizon-cut clipped cell over several pieces was trusted
+//!   (grazing receivers at ~1–2.5 ms on 2048 × 1024), random textures did not show it (worst
+//!   0.30 of the tolerance at 256 × 128) but one-texel textures did: 5 cases of 16 × 8
+//!   (unshaped, both filters, both transforms, the 9 receivers of the tests) off by 1.2e-4 to
+//!   100 % at 1e-4. Such cells are split untrusted too (grazing receivers ~12–25 ms).
 //! - Guard against a peak no rule point sees: a cell is split without being trusted while its
 //!   world half-diagonal R exceeds half the lower bound `|w_c| − R` of its distance from x
 //!   (FMM's well-separated criterion), unless the receiver's horizon hides all of it.
@@ -478,10 +478,10 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         // lies in one child gets that child's very rule points (estimate exactly 0), and a
         // lit texel between the points of both goes unseen. Measured (module docs): a shaped
         // 256 × 128 rect off by 3.0e-4 at every tolerance, a one-texel texture found to 33 %.
-        // So for a shaped light such a cell is split untrusted down to single pieces, where t
-        // is a polynomial and the clipped rule converges. (Unshaped rects keep trusting it:
-        // see the module docs for what that costs and what it leaves.)
-        let sampled = k.shaped && tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
+        // So such a cell is split untrusted down to single pieces, where t is a polynomial and
+        // the clipped rule converges, shaped or not (unshaped, a horizon-cut cell: one-texel
+        // textures were missed by up to 100 % while it was trusted, module docs).
+        let sampled = tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
         let key = if sampled || k.near(r) {
             f64::INFINITY
         } else {
