@@ -30,8 +30,30 @@
 //!   smoothstep start, focus plane: `Prepared::profile`) is integrated by
 //!   [`Kernel::clipped`], a 5 × 5 Gauss rule on the part in front of the horizon whose lines
 //!   are split at the shaping's kinks (the roots `line::line_integral` splits at), with t
-//!   sampled; no rule point then lies where K = 0, so no lit sliver goes unseen. Subdivision
-//!   goes on below pieces until the estimates meet the tolerance.
+//!   sampled; no rule point then lies where K = 0, so no lit sliver goes unseen along a line.
+//!   Across lines the rule is split where a kink's inner roots change (a kink cone crossing
+//!   the cell's sides or the horizon line, or tangent to the pencil of lines; the focus plane
+//!   crossing them), as `critical::critical_ys` splits the reference's outer integral, so
+//!   that the outer integrand is smooth on each part and no lit cap of the cone lies between
+//!   two lines unseen. Subdivision goes on below pieces until the estimates meet the tolerance.
+//! - The clipped rule samples t, so over several texel pieces it samples across t's kinks
+//!   (bilinear) or jumps (nearest): neither it nor its children's rules converge there, and
+//!   the estimate can read 0 while both miss a texel (a cell whose lit part lies in one child
+//!   gets that child's very rule points). This was the bias that kept shaped rects on the
+//!   exact path: at 256 × 128, nearest, sheared, grazing receiver (the lit part a few texels
+//!   between the horizon and the cone), 1.0e-4 and 3.0e-4 error at 1e-4 and at 1e-3, 1.1e-4
+//!   and 4.6e-4 at 1e-2 (not the tolerance's); with the texture lit in one texel of it only, 33 % of that texel's light found,
+//!   the same at rel 1e-4, 1e-6, 1e-8. For a shaped light a clipped cell over more than one
+//!   piece is therefore split untrusted down to single pieces (where t is a polynomial and
+//!   the rule converges): that case then < 5e-8, every shaped 256 × 128 one ≤ 5e-7 at 1e-4. The outer splits above were
+//!   needed too: without them (in a variant that split only the kink-crossed cells) 4
+//!   one-texel textures of 16 × 8 of shaped rects were missed entirely (a lit cap between
+//!   two lines).
+//! - Unshaped rects too: while a horizon-cut clipped cell over several pieces was trusted
+//!   (grazing receivers at ~1–2.5 ms on 2048 × 1024), random textures did not show it (worst
+//!   0.30 of the tolerance at 256 × 128) but one-texel textures did: 5 cases of 16 × 8
+//!   (unshaped, both filters, both transforms, the 9 receivers of the tests) off by 1.2e-4 to
+//!   100 % at 1e-4. Such cells are split untrusted too (grazing receivers ~12–25 ms).
 //! - Guard against a peak no rule point sees: a cell is split without being trusted while its
 //!   world half-diagonal R exceeds half the lower bound `|w_c| − R` of its distance from x
 //!   (FMM's well-separated criterion), unless the receiver's horizon hides all of it.
@@ -39,13 +61,16 @@
 //! Threshold ([`MIN_TOLERANCE`], `Rule::texture_tolerance`): `Adaptive::for_tolerance(rel)`
 //! with rel ≥ 1e-4 (the CLI's and Python's default) takes this path; tighter tolerances and the
 //! reference (`Adaptive::REFERENCE`, 1e-9) keep the exact split path unchanged. At 1e-5 the
-//! estimates were measured to miss by 2–4× (1.9e-5 unshaped nearest, 3.6e-5 shaped).
+//! estimates were measured to miss by 2–4× (1.9e-5 unshaped nearest, 3.6e-5 shaped, the latter
+//! before the shaped fix above; not measured since).
 //!
 //! What this does not prove: the error estimate is a-posteriori (as the reference's
 //! Gauss–Kronrod estimates are), not an a-priori bound; the tests measure the result against
-//! the 1e-9 reference on random textures (sizes to 64 × 32 in the default run, 256 × 128 with
-//! `--ignored`), near, grazing and far receivers. Shaped rects are left to the exact path
-//! ([`applies`]: a bias was measured there), IES profiles too.
+//! the 1e-9 reference on random textures, unshaped and shaped (cones with softness 0 to 0.4,
+//! focus with tint, focus alone; sizes to 64 × 32 in the default run, 256 × 128 with
+//! `--ignored`), and on one-texel textures of shaped rects (8 × 4; 16 × 8 with `--ignored`),
+//! near, grazing and far receivers.
+//! IES profiles are left to the exact path ([`applies`]: never tried here).
 
 use std::collections::BinaryHeap;
 
@@ -82,15 +107,22 @@ const G5W: [f64; 5] = [
     0.236_926_885_056_189_1,
 ];
 
-/// Whether the fast path takes `p` (a textured rect): unshaped only. Shaped rects keep the exact
-/// split path: with a cone and focus the release-only 256 × 128 comparison measured a bias the
-/// estimates do not see (nearest filter, sheared transform, horizon through the rect: 1.0e-4
-/// and 3.0e-4 at 1e-4, 1.1e-4 and 4.6e-4 at 1e-2, where the exact path at 1e-5 agrees with the
-/// reference to 1e-9), and sharper cones (softness < 0.25) missed by up to 30×. The code that
-/// handles shaping kinks ([`Kernel::kinked`], the clipped rule's line splits) stays for the day
-/// that bias is found; IES profiles were never tried.
+/// Whether the fast path takes `p`: a textured rect, unshaped or shaped by ShapingAPI's cone,
+/// softness, focus and focusTint (their kinks handled as the module docs say; the shaped bias
+/// once measured here was the clipped rule sampling the texture across texel pieces). With an
+/// IES profile the exact split path runs: its kinks (`prepare::ies_kinks`) are not listed by
+/// `Prepared::profile`, which [`Kernel::kinked`] and the clipped rule read, and it was never
+/// measured here.
 pub fn applies(p: &Prepared) -> bool {
-    p.rect_texture().is_some() && p.ies.is_none() && p.shaping.is_none()
+    p.rect_texture().is_some() && p.ies.is_none()
+}
+
+/// The rule of a cell (see [`Kernel::rule_kind`]).
+#[derive(Clone, Copy, PartialEq)]
+enum RuleKind {
+    Zero,
+    Moments,
+    Clipped,
 }
 
 /// The smooth kernel `K = S(−ŵ)·max(0, n·w)·J/|w|⁴` of the chart integral (module docs).
@@ -127,20 +159,29 @@ impl Kernel<'_> {
         )
     }
 
-    /// The cell's rule: 0 behind the horizon, the moment rule where the horizon does not cross
-    /// it, else [`Kernel::clipped`].
-    fn cell_rule(&self, tree: &Tree, cell: &Cell) -> DVec3 {
-        let r = tree.rect(cell);
+    /// Which rule a cell takes: none behind the horizon, the moment rule where neither the
+    /// horizon nor a shaping kink may cross it (K smooth on it), else [`Kernel::clipped`].
+    fn rule_kind(&self, r: Rect) -> RuleKind {
         let (c, a, b) = self.horizon();
         let hs = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)]
             .map(|(x, y)| c + a * x + b * y);
         if hs.iter().all(|&h| !(h > 0.0)) {
-            return DVec3::ZERO;
+            RuleKind::Zero
+        } else if hs.iter().all(|&h| h > 0.0) && !self.kinked(r) {
+            RuleKind::Moments
+        } else {
+            RuleKind::Clipped
         }
-        if hs.iter().all(|&h| h > 0.0) && !self.kinked(r) {
-            return self.rule(r, &tree.moments(cell));
+    }
+
+    /// The cell's rule (see [`Kernel::rule_kind`]).
+    fn cell_rule(&self, tree: &Tree, cell: &Cell) -> DVec3 {
+        let r = tree.rect(cell);
+        match self.rule_kind(r) {
+            RuleKind::Zero => DVec3::ZERO,
+            RuleKind::Moments => self.rule(r, &tree.moments(cell)),
+            RuleKind::Clipped => self.clipped(tree, r),
         }
-        self.clipped(tree, r)
     }
 
     /// Whether a kink of the shaping factor (`Prepared::profile`: the cone edge, the
@@ -203,6 +244,9 @@ impl Kernel<'_> {
                     cuts.push(u);
                 }
             }
+        }
+        if self.shaped {
+            self.kink_cuts(&mut cuts, swap, (c, p, q), (u0, u1, v0, v1));
         }
         cuts.sort_by(f64::total_cmp);
         let lim = |u: f64| {
@@ -270,6 +314,74 @@ impl Kernel<'_> {
             }
         }
         sum
+    }
+
+    /// The outer cuts of [`Kernel::clipped`] that the shaping's kinks need: the u where the
+    /// inner structure of the lines u = const changes, so that the outer integrand (the inner
+    /// integral as a function of u) is smooth between cuts and the 5-point rule across lines
+    /// converges at its order, as `critical::critical_ys` splits the reference's outer
+    /// integral. They are where a kink curve crosses the cell's sides v = v0, v1 or the
+    /// horizon line (a root enters or leaves a line's interval), where a kink cone is tangent
+    /// to a line of the pencil (two roots appear together: the inner integral has a
+    /// square-root-type point there), and the line through the axis direction when the
+    /// shaping is singular there. `h = c + p·u + q·v` is the horizon in (u, v).
+    fn kink_cuts(
+        &self,
+        cuts: &mut Vec<f64>,
+        swap: bool,
+        (c, p, q): (f64, f64, f64),
+        (u0, u1, v0, v1): (f64, f64, f64, f64),
+    ) {
+        let ch = self.chart;
+        let (eu, ev) = if swap { (ch.e2, ch.e1) } else { (ch.e1, ch.e2) };
+        // The lines along which u runs: the sides v = v0, v1 and the horizon line.
+        let mut edges = vec![(ch.w0 + ev * v0, eu), (ch.w0 + ev * v1, eu)];
+        if q != 0.0 {
+            edges.push((ch.w0 - ev * (c / q), eu - ev * (p / q)));
+        }
+        let mut us = Vec::new();
+        let axis = self.p.axis;
+        for k in &self.p.profile.kinks {
+            match *k {
+                Kink::Cone { cos } => {
+                    for &(a, d) in &edges {
+                        us.extend(cone_roots_on_line(axis, cos, a, d));
+                    }
+                    // Planes through x containing ev (the lines u = const) tangent to the
+                    // cone: normals m ⊥ ev with |m·axis| = sin θ (as `critical.rs`'s
+                    // pencil tangents, with the roles of the chart axes swapped or not).
+                    let s = (1.0 - cos * cos).max(0.0).sqrt();
+                    let (m1, m2) = ev.normalize().any_orthonormal_pair();
+                    let (pa, pb) = (m1.dot(axis), m2.dot(axis));
+                    let ra = pa.hypot(pb);
+                    if ra >= s && ra > 0.0 {
+                        let t0 = pb.atan2(pa);
+                        let d = (s / ra).clamp(-1.0, 1.0).acos();
+                        for t in [t0 + d, t0 - d] {
+                            let m = m1 * t.cos() + m2 * t.sin();
+                            if m.dot(eu) != 0.0 {
+                                us.push(-m.dot(ch.w0) / m.dot(eu));
+                            }
+                        }
+                    }
+                }
+                Kink::Plane { m, .. } => {
+                    for &(a, d) in &edges {
+                        if m.dot(d) != 0.0 {
+                            us.push(-m.dot(a) / m.dot(d));
+                        }
+                    }
+                }
+            }
+        }
+        if self.p.profile.axis_singular {
+            // The line of the pencil through the axis directions.
+            let m = ev.cross(axis);
+            if m.dot(eu) != 0.0 {
+                us.push(-m.dot(ch.w0) / m.dot(eu));
+            }
+        }
+        cuts.extend(us.into_iter().filter(|&u| u > u0 && u < u1));
     }
 
     /// The cell's moment rule `Σ K(x_ab) W_ab`.
@@ -360,7 +472,17 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         let value: DVec3 = kids.iter().map(|c| c.1).sum();
         let err = (value - own).abs();
         let r = tree.rect(&cell);
-        let key = if k.near(r) {
+        // A clipped rule samples t at its Gauss points; over more than one texel piece it
+        // samples across t's kinks (bilinear) or jumps (nearest), where neither it nor its
+        // children's rules converge, and both can miss the same texel: a cell whose lit part
+        // lies in one child gets that child's very rule points (estimate exactly 0), and a
+        // lit texel between the points of both goes unseen. Measured (module docs): a shaped
+        // 256 × 128 rect off by 3.0e-4 at every tolerance, a one-texel texture found to 33 %.
+        // So such a cell is split untrusted down to single pieces, where t is a polynomial and
+        // the clipped rule converges, shaped or not (unshaped, a horizon-cut cell: one-texel
+        // textures were missed by up to 100 % while it was trusted, module docs).
+        let sampled = tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
+        let key = if sampled || k.near(r) {
             f64::INFINITY
         } else {
             err.max_element()
@@ -379,8 +501,8 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
     let mut forced = usize::from(first.key == f64::INFINITY);
     let mut heap = BinaryHeap::new();
     heap.push(first);
-    // The estimates are not bounds, so the sum stops well inside rel (the shaped bias of
-    // `applies` did not change from rel/8 to rel/16: it is not the stop's).
+    // The estimates are not bounds, so the sum stops well inside rel (the shaped bias once
+    // measured did not change from rel/8 to rel/16: it was not the stop's, see module docs).
     let q = rel / 16.0;
     for _ in 0..MAX_SPLITS {
         let tiny = 1e-14 * total.abs().max_element();

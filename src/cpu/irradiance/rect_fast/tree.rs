@@ -270,6 +270,15 @@ impl Tree {
         }
     }
 
+    /// How many texel pieces the cell covers (1 for a sub-rect of a piece).
+    pub(super) fn pieces(&self, c: &Cell) -> u32 {
+        let r = match c {
+            Cell::Node(i) => self.nodes[*i as usize].range,
+            Cell::Block(r, _) => *r,
+        };
+        (r[1] - r[0]) * (r[3] - r[2])
+    }
+
     /// The cell's children; none when it is a sub-rect too small to split.
     pub(super) fn children(&self, c: &Cell) -> Vec<Cell> {
         match *c {
