@@ -49,11 +49,16 @@
 //!   needed too: without them (in a variant that split only the kink-crossed cells) 4
 //!   one-texel textures of 16 × 8 of shaped rects were missed entirely (a lit cap between
 //!   two lines).
-//! - Unshaped rects too: while a horizon-cut clipped cell over several pieces was trusted
-//!   (grazing receivers at ~1–2.5 ms on 2048 × 1024), random textures did not show it (worst
-//!   0.30 of the tolerance at 256 × 128) but one-texel textures did: 5 cases of 16 × 8
-//!   (unshaped, both filters, both transforms, the 9 receivers of the tests) off by 1.2e-4 to
-//!   100 % at 1e-4. Such cells are split untrusted too (grazing receivers ~12–25 ms).
+//! - Unshaped rects too: while a horizon-cut clipped cell over several pieces was trusted on
+//!   its estimate (grazing receivers at ~1–2.5 ms on 2048 × 1024), random textures did not
+//!   show it (worst 0.30 of the tolerance at 256 × 128) but one-texel textures did: 5 cases of
+//!   16 × 8 (unshaped, both filters, both transforms, the 9 receivers of the tests) off by
+//!   1.2e-4 to 100 % at 1e-4. The only kink there is the horizon, where K vanishes, so such a
+//!   cell's error is instead an a-priori bound of its whole contribution
+//!   ([`Kernel::cut_bound`]: `t_max · max(0, n·w)_corners · J · area / min|w|⁴`, t_max stored
+//!   per tree node), which shrinks like the cell's size cubed; the adaptive split refines it
+//!   as far as the tolerance needs (visibleRect's 128² map: 28 s, against 50 s splitting
+//!   every such cell to single pieces and 0.38 s trusting the estimates; BENCHMARKS.md).
 //! - Guard against a peak no rule point sees: a cell is split without being trusted while its
 //!   world half-diagonal R exceeds half the lower bound `|w_c| − R` of its distance from x
 //!   (FMM's well-separated criterion), unless the receiver's horizon hides all of it.
@@ -402,6 +407,27 @@ impl Kernel<'_> {
 
     /// Whether the cell must be split before its rule is trusted: it is not well separated
     /// from x (half-diagonal R > ½ (|w_c| − R)) and the horizon does not hide all of it.
+    /// An upper bound of `|∫ t·K|` over the cell `r` of an unshaped light, per channel:
+    /// `K = max(0, n·w)·J/|w|⁴` with `n·w` linear (largest at a corner) and `|w| ≥ |w_c| − R`
+    /// (see [`Kernel::near`]), times `t_max` and the cell's area. Infinite when the cell may
+    /// reach x.
+    fn cut_bound(&self, tmax: DVec3, r: Rect) -> DVec3 {
+        let (cx, cy, hx, hy) = r.centre();
+        let c = self.chart;
+        let wc = c.w0 + c.e1 * cx + c.e2 * cy;
+        let dmin = wc.length() - ((c.e1 * hx).length() + (c.e2 * hy).length());
+        if !(dmin > 0.0) {
+            return DVec3::INFINITY;
+        }
+        let corners = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)];
+        let hmax = corners
+            .iter()
+            .map(|&(x, y)| self.n.dot(c.w0 + c.e1 * x + c.e2 * y))
+            .fold(0.0, f64::max);
+        let area = (r.x1 - r.x0) * (r.y1 - r.y0);
+        tmax * (hmax * c.jac * area / (dmin * dmin * dmin * dmin))
+    }
+
     fn near(&self, r: Rect) -> bool {
         let (cx, cy, hx, hy) = r.centre();
         let c = self.chart;
@@ -478,14 +504,20 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         // lies in one child gets that child's very rule points (estimate exactly 0), and a
         // lit texel between the points of both goes unseen. Measured (module docs): a shaped
         // 256 × 128 rect off by 3.0e-4 at every tolerance, a one-texel texture found to 33 %.
-        // So such a cell is split untrusted down to single pieces, where t is a polynomial and
-        // the clipped rule converges, shaped or not (unshaped, a horizon-cut cell: one-texel
-        // textures were missed by up to 100 % while it was trusted, module docs).
+        // So such a cell is not trusted on its estimate. Shaped, it is split untrusted down to
+        // single pieces, where t is a polynomial and the clipped rule converges. Unshaped, the
+        // only kink is the horizon, where K vanishes: its error is the a-priori bound of its
+        // whole contribution (`Kernel::cut_bound`), which shrinks like its size cubed, so the
+        // adaptive split refines it only as far as the tolerance needs (one-texel textures were
+        // missed by up to 100 % while it was trusted on its estimate, module docs).
         let sampled = tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
-        let key = if sampled || k.near(r) {
-            f64::INFINITY
+        let (key, err) = if k.near(r) || (sampled && k.shaped) {
+            (f64::INFINITY, err)
+        } else if sampled {
+            let b = k.cut_bound(tree.t_max(&cell), r);
+            (b.max_element(), b)
         } else {
-            err.max_element()
+            (err.max_element(), err)
         };
         Active {
             key,

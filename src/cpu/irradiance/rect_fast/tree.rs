@@ -55,6 +55,8 @@ struct Node {
     rect: Rect,
     range: [u32; 4],
     w: Moments,
+    /// The largest |t| on the node, per channel (`Tree::t_max`).
+    tmax: DVec3,
     children: Vec<u32>,
 }
 
@@ -117,22 +119,50 @@ impl Tree {
             rect,
             range: r,
             w: [DVec3::ZERO; 9],
+            tmax: DVec3::ZERO,
             children: Vec::new(),
         });
-        let w = if (r[1] - r[0]) * (r[3] - r[2]) <= LEAF_PIECES {
-            self.block_moments(r, rect)
+        let (w, tmax) = if (r[1] - r[0]) * (r[3] - r[2]) <= LEAF_PIECES {
+            (self.block_moments(r, rect), self.block_tmax(r))
         } else {
             let kids: Vec<u32> = split_range(r).into_iter().map(|c| self.build(c)).collect();
             let mut w = [DVec3::ZERO; 9];
+            let mut tmax = DVec3::ZERO;
             for &k in &kids {
                 let c = &self.nodes[k as usize];
                 add_child_moments(&mut w, rect, c.rect, &c.w);
+                tmax = tmax.max(c.tmax);
             }
             self.nodes[idx as usize].children = kids;
-            w
+            (w, tmax)
         };
         self.nodes[idx as usize].w = w;
+        self.nodes[idx as usize].tmax = tmax;
         idx
+    }
+
+    /// The largest |t| over the pieces `r`: on a piece t is bilinear (or constant), so |t| is
+    /// largest at one of its corners.
+    fn block_tmax(&self, r: [u32; 4]) -> DVec3 {
+        let mut m = DVec3::ZERO;
+        for j in r[2] as usize..r[3] as usize {
+            let (_, y0, y1) = self.py[j];
+            for i in r[0] as usize..r[1] as usize {
+                let (_, x0, x1) = self.px[i];
+                for (x, y) in [(x0, y0), (x1, y0), (x0, y1), (x1, y1)] {
+                    m = m.max(self.value(i, j, x, y).abs());
+                }
+            }
+        }
+        m
+    }
+
+    /// The largest |t| on the cell, per channel (an upper bound for a sub-rect of a piece).
+    pub(super) fn t_max(&self, c: &Cell) -> DVec3 {
+        match c {
+            Cell::Node(i) => self.nodes[*i as usize].tmax,
+            Cell::Block(r, _) => self.block_tmax(*r),
+        }
     }
 
     /// The filtered texture on piece (i, j) at chart (X, Y) (inside the piece).
