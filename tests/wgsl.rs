@@ -269,14 +269,14 @@ fn ies_lookup_has_no_loop() {
     );
 }
 
-/// The IES kink lists' binary search (irradiance/line.wgsl `kink_rank`) is written out, as
+/// The IES kink lists' binary search (irradiance/kinks.wgsl `kink_rank`) is written out, as
 /// many steps as the packer allows a list (`KINK_SEARCH_STEPS`): a loop there would spend
 /// lavapipe's budget on every line.
 #[test]
 fn kink_search_is_written_out_for_the_longest_list() {
     let src = SOURCES
         .iter()
-        .find(|(name, _)| *name == "irradiance/line.wgsl")
+        .find(|(name, _)| *name == "irradiance/kinks.wgsl")
         .unwrap()
         .1;
     let body = &src[src.find("fn kink_rank(").unwrap()..];

@@ -17,6 +17,7 @@
 
 // #import irradiance/chart.wgsl
 // #import shared/roots.wgsl
+// #import irradiance/kinks.wgsl
 
 const MAX_YS: u32 = 96u;
 
@@ -286,8 +287,7 @@ fn ies_plane(kb: u32, k: u32, np: u32, normals_off: u32, u: vec3<f32>, v: vec3<f
     if k < np {
         return u * ies_atlas[normals_off + 2u * k] + v * ies_atlas[normals_off + 2u * k + 1u];
     }
-    let o = kb + 12u + 3u * (k - np);
-    return vec3<f32>(ies_atlas[o], ies_atlas[o + 1u], ies_atlas[o + 2u]);
+    return kink_vec(kb, 12u + 3u * (k - np));
 }
 
 // The Ys where an IES profile's grid surfaces change the inner structure (see the CPU twin):
@@ -324,11 +324,11 @@ fn ies_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f32, MA
     }
     let cdir = -lc.w0 / dw;
     let nc = u32(ies_atlas[kb]);
-    let axis_c = vec3<f32>(ies_atlas[kb + 1u], ies_atlas[kb + 2u], ies_atlas[kb + 3u]);
+    let axis_c = kink_vec(kb, 1u);
     let theta_c = atan2_accurate(length(cross(cdir, axis_c)), dot(cdir, axis_c));
     let np = u32(ies_atlas[kb + 4u]);
-    let p = vec3<f32>(ies_atlas[kb + 5u], ies_atlas[kb + 6u], ies_atlas[kb + 7u]);
-    let u = vec3<f32>(ies_atlas[kb + 8u], ies_atlas[kb + 9u], ies_atlas[kb + 10u]);
+    let p = kink_vec(kb, 5u);
+    let u = kink_vec(kb, 8u);
     let v = cross(p, u);
     let ne = u32(ies_atlas[kb + 11u]);
     let cos_off = kb + IES_KINKS_HEADER;

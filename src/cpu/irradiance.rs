@@ -427,14 +427,7 @@ impl Rule for Adaptive {
             // lines the integrand has kinks (where a line first meets a grid cone) that the
             // 7-point pair's estimate can miss (measured: 1.4e-2 on a 1e-2 map of luxtest
             // iesTest). The loose rules split there too.
-            let local = outer::chart_ies_kinks(p, chart);
-            let extra = critical::ies_ys(p, chart, n, local.as_ref().unwrap_or(&ies.kinks));
-            if !extra.is_empty() {
-                ys.extend(extra);
-                ys.sort_by(f64::total_cmp);
-                let span = ys[ys.len() - 1] - ys[0];
-                ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
-            }
+            critical::add_ies_ys(p, ies, chart, n, &mut ys);
         }
         if self.outer.abs == 0.0 && self.scale_fraction > 0.0 {
             // The scale of the answer from a coarse pass; an inner error δ on every line moves

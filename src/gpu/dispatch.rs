@@ -34,7 +34,7 @@ pub(crate) struct GpuLights {
 
 impl GpuLights {
     /// Whether some light's irradiance quadrature may run long on the device (an IES-shaped
-    /// light it integrates: GpuContext::stepping).
+    /// light it integrates, whose kinks multiply a line's pieces: GpuContext::lane_stride).
     pub(super) fn long_quadrature(&self) -> bool {
         self.irradiance_ies
     }

@@ -82,6 +82,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/irradiance/pieces.wgsl"),
     ),
     (
+        "irradiance/kinks.wgsl",
+        include_str!("../../shaders/irradiance/kinks.wgsl"),
+    ),
+    (
         "irradiance/line.wgsl",
         include_str!("../../shaders/irradiance/line.wgsl"),
     ),

@@ -92,16 +92,7 @@ impl Rule for KernelRule {
         }
         let mut ys = critical::critical_ys(p, chart, n);
         if let Some(ies) = &p.ies {
-            let local = outer::chart_ies_kinks(p, chart);
-            ys.extend(critical::ies_ys(
-                p,
-                chart,
-                n,
-                local.as_ref().unwrap_or(&ies.kinks),
-            ));
-            ys.sort_by(f64::total_cmp);
-            let span = ys[ys.len() - 1] - ys[0];
-            ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+            critical::add_ies_ys(p, ies, chart, n, &mut ys);
         }
         outer::chart_integral(p, chart, n, &ys, self)
     }

@@ -27,7 +27,7 @@ use crate::cpu::roots::{
     bracket_roots, cone_roots_on_line, lin_trig_roots, plane_cone_dirs, wrap_into,
 };
 use crate::prepare::ies_kinks::IesKinks;
-use crate::prepare::{Kink, Prepared, Profile};
+use crate::prepare::{Kink, Prepared, PreparedIes, Profile};
 
 /// Samples per arc when bracketing the roots of a degree-2 trigonometric polynomial (the
 /// kernel uses `rules::IRR_ARC_SAMPLES`, fewer, for speed).
@@ -269,6 +269,20 @@ pub fn critical_ys_with(
     let span = yb - ya;
     ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
     ys
+}
+
+/// `ys` (sorted, from [`critical_ys`]) with [`ies_ys`] of the profile's surfaces that can meet
+/// the chart (`outer::chart_ies_kinks`) merged in, sorted and de-duplicated as `critical_ys`
+/// does (the loose rules' and the GPU kernel's outer breakpoints).
+pub fn add_ies_ys(p: &Prepared, ies: &PreparedIes, chart: &Chart, n: DVec3, ys: &mut Vec<f64>) {
+    let local = super::outer::chart_ies_kinks(p, chart);
+    let extra = ies_ys(p, chart, n, local.as_ref().unwrap_or(&ies.kinks));
+    if !extra.is_empty() {
+        ys.extend(extra);
+        ys.sort_by(f64::total_cmp);
+        let span = ys[ys.len() - 1] - ys[0];
+        ys.dedup_by(|b, a| (*b - *a).abs() <= 1e-13 * span);
+    }
 }
 
 /// The Ys where an IES profile's grid lines change the inner structure (used by the loose
