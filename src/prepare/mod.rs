@@ -86,6 +86,12 @@ impl ShapingConsts {
             start: (1.0 - s.cone_softness.clamp(0.0, 1.0)) * cone,
         }
     }
+
+    /// A bound of the shaping factor's size per channel, IES aside: the cone factor lies in
+    /// [0, 1] and the focus factor `tint + f·(1 − tint)` (f in [0, 1]) between tint and 1.
+    pub fn factor_bound(&self) -> DVec3 {
+        DVec3::ONE.max(self.focus_tint.abs())
+    }
 }
 
 /// A validated light with its per-light constants.

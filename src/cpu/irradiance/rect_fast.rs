@@ -43,22 +43,25 @@
 //!   exact path: at 256 × 128, nearest, sheared, grazing receiver (the lit part a few texels
 //!   between the horizon and the cone), 1.0e-4 and 3.0e-4 error at 1e-4 and at 1e-3, 1.1e-4
 //!   and 4.6e-4 at 1e-2 (not the tolerance's); with the texture lit in one texel of it only, 33 % of that texel's light found,
-//!   the same at rel 1e-4, 1e-6, 1e-8. For a shaped light a clipped cell over more than one
-//!   piece is therefore split untrusted down to single pieces (where t is a polynomial and
+//!   the same at rel 1e-4, 1e-6, 1e-8. A clipped cell over more than one piece that a
+//!   shaping kink may cross is therefore split untrusted down to single pieces (where t is a polynomial and
 //!   the rule converges): that case then < 5e-8, every shaped 256 × 128 one ≤ 5e-7 at 1e-4. The outer splits above were
 //!   needed too: without them (in a variant that split only the kink-crossed cells) 4
 //!   one-texel textures of 16 × 8 of shaped rects were missed entirely (a lit cap between
 //!   two lines).
-//! - Unshaped rects too: while a horizon-cut clipped cell over several pieces was trusted on
-//!   its estimate (grazing receivers at ~1–2.5 ms on 2048 × 1024), random textures did not
-//!   show it (worst 0.30 of the tolerance at 256 × 128) but one-texel textures did: 5 cases of
-//!   16 × 8 (unshaped, both filters, both transforms, the 9 receivers of the tests) off by
-//!   1.2e-4 to 100 % at 1e-4. The only kink there is the horizon, where K vanishes, so such a
-//!   cell's error is instead an a-priori bound of its whole contribution
-//!   ([`Kernel::cut_bound`]: `t_max · max(0, n·w)_corners · J · area / min|w|⁴`, t_max stored
-//!   per tree node), which shrinks like the cell's size cubed; the adaptive split refines it
-//!   as far as the tolerance needs (visibleRect's 128² map: 28 s, against 50 s splitting
-//!   every such cell to single pieces and 0.38 s trusting the estimates; BENCHMARKS.md).
+//! - A cell over several pieces that the horizon cuts and no shaping kink may cross is not
+//!   sampled at all: the horizon's factor `max(0, n·w)` is bracketed on it by two parallel
+//!   planes of the chart ([`Kernel::bracket`]), so its rule is the moment rule of a smooth
+//!   kernel (every texel counted through the exact moments) and its error has an a-priori
+//!   bound `(D/2)·max|S·J/|w|⁴|·∫|t|`, D the band's height, which shrinks like the cell's
+//!   size cubed; the adaptive split refines such cells only as far as the tolerance needs,
+//!   and their bounds are held to half the tolerance ([`BOUND_SHARE`]; the estimates to
+//!   rel/16). History: while such cells of unshaped rects took the sampled clipped rule
+//!   trusted on its estimate, one-texel 16 × 8 textures (both filters, both transforms, the 9
+//!   receivers of the tests) were off by 1.2e-4 to 100 % at 1e-4 (random textures did not
+//!   show it); the bound of the whole contribution instead ([`Kernel::cut_bound`], still the
+//!   fallback where smaller) made visibleRect's 128² map take 28 s; the bracket takes it to
+//!   0.63 s and shaped rects' focus-only receivers from 20–39 ms to 1–4 ms (BENCHMARKS.md).
 //! - Guard against a peak no rule point sees: a cell is split without being trusted while its
 //!   world half-diagonal R exceeds half the lower bound `|w_c| − R` of its distance from x
 //!   (FMM's well-separated criterion), unless the receiver's horizon hides all of it.
@@ -69,11 +72,12 @@
 //! estimates were measured to miss by 2–4× (1.9e-5 unshaped nearest, 3.6e-5 shaped, the latter
 //! before the shaped fix above; not measured since).
 //!
-//! What this does not prove: the error estimate is a-posteriori (as the reference's
-//! Gauss–Kronrod estimates are), not an a-priori bound; the tests measure the result against
+//! What this does not prove: the error estimates of smooth cells are a-posteriori (as the
+//! reference's Gauss–Kronrod estimates are), not a-priori bounds, and the bracket bound
+//! trusts the moment rule of its smooth kernel; the tests measure the result against
 //! the 1e-9 reference on random textures, unshaped and shaped (cones with softness 0 to 0.4,
 //! focus with tint, focus alone; sizes to 64 × 32 in the default run, 256 × 128 with
-//! `--ignored`), and on one-texel textures of shaped rects (8 × 4; 16 × 8 with `--ignored`),
+//! `--ignored`), and on one-texel textures of unshaped and shaped rects (8 × 4; 16 × 8 with `--ignored`),
 //! near, grazing and far receivers.
 //! IES profiles are left to the exact path ([`applies`]: never tried here).
 
@@ -92,6 +96,15 @@ use tree::{Cell, GX, Moments, Rect, Tree};
 /// than 1e-4, and the reference) the exact split path runs. At 1e-5 the error estimates were
 /// measured to miss by 2–4× (module docs), at 1e-4 to 1e-2 the tests hold every receiver.
 pub const MIN_TOLERANCE: f64 = 1e-4;
+
+/// The share of the tolerance the summed error estimates are held to. The estimates are not
+/// bounds, so the sum stops well inside rel (the shaped bias once measured did not change from
+/// rel/8 to rel/16: it was not the stop's, see the module docs).
+const ESTIMATE_SHARE: f64 = 1.0 / 16.0;
+
+/// The share of the tolerance the summed a-priori bounds (horizon-cut cells of unshaped lights,
+/// [`Kernel::bracket`]) are held to: they hold whatever the texture, so half of it.
+const BOUND_SHARE: f64 = 0.5;
 
 /// At most this many cells are split per receiver (then the current sum is returned).
 const MAX_SPLITS: usize = 2_000_000;
@@ -136,6 +149,8 @@ struct Kernel<'a> {
     chart: &'a Chart,
     n: DVec3,
     shaped: bool,
+    /// A bound of the shaping factor's size, per channel (`ShapingConsts::factor_bound`).
+    s_max: DVec3,
 }
 
 impl Kernel<'_> {
@@ -179,14 +194,76 @@ impl Kernel<'_> {
         }
     }
 
-    /// The cell's rule (see [`Kernel::rule_kind`]).
-    fn cell_rule(&self, tree: &Tree, cell: &Cell) -> DVec3 {
+    /// The cell's rule (see [`Kernel::rule_kind`]) and a bound of its error where that is known
+    /// a priori (the bracket rule's), else 0: a cell over several texel pieces that the horizon
+    /// cuts and no shaping kink may cross takes [`Kernel::bracket`], other cut cells
+    /// [`Kernel::clipped`].
+    fn cell_rule(&self, tree: &Tree, cell: &Cell) -> (DVec3, DVec3) {
         let r = tree.rect(cell);
         match self.rule_kind(r) {
-            RuleKind::Zero => DVec3::ZERO,
-            RuleKind::Moments => self.rule(r, &tree.moments(cell)),
-            RuleKind::Clipped => self.clipped(tree, r),
+            RuleKind::Zero => (DVec3::ZERO, DVec3::ZERO),
+            RuleKind::Moments => (self.rule(r, &tree.moments(cell)), DVec3::ZERO),
+            RuleKind::Clipped if tree.pieces(cell) > 1 && !self.kinked(r) => {
+                let w = tree.moments(cell);
+                self.bracket(r, &w, tree.abs_integral(cell, r, &w))
+            }
+            RuleKind::Clipped => (self.clipped(tree, r), DVec3::ZERO),
         }
+    }
+
+    /// The bracket rule of a cell `r` that the horizon cuts and no shaping kink may cross, with
+    /// the texture's exact moments `w` and `tabs ≥ ∫|t|` over it: its value and a bound of its
+    /// error. There `K = max(0, h)·g` with `h = n·w` affine on the chart (its range [h₋, h₊] on
+    /// the cell is that of the corners) and `g = S(−ŵ)·J/|w|⁴` smooth (`|S| ≤ s_max`, the
+    /// shaping factor is smooth where no kink crosses). `max(0, h)` is convex, so on
+    /// [h₋, h₊] it lies between the line `λh` (λ = h₊/(h₊ − h₋)) and the parallel chord through
+    /// the ends `λ(h − h₋)`, a band of height `D = λ·(−h₋) ≤ (h₊ − h₋)/4`: with
+    /// `q = λh + D/2`, `|max(0, h) − q| ≤ D/2` everywhere on the cell, and
+    /// `|∫ t·K − ∫ t·q·g| ≤ (D/2)·max |g|·∫|t|`, `max |g| ≤ s_max·J/(|w_c| − R)⁴`. `q·g` is smooth, so
+    /// `∫ t·q·g` is the moment rule's (no sampling of t: no texel goes unseen). The bound
+    /// shrinks like the cell's size cubed, as [`Kernel::cut_bound`] (the whole contribution's)
+    /// does, but with `D/2 ≤ h₊/4` against `h₊` and `∫|t|` against `t_max · area`.
+    fn bracket(&self, r: Rect, w: &Moments, tabs: DVec3) -> (DVec3, DVec3) {
+        let (c0, a, b) = self.horizon();
+        let hs = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)]
+            .map(|(x, y)| c0 + a * x + b * y);
+        let hmax = hs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let hmin = hs.iter().copied().fold(f64::INFINITY, f64::min).min(0.0);
+        if !(hmax > 0.0) {
+            return (DVec3::ZERO, DVec3::ZERO);
+        }
+        let lambda = hmax / (hmax - hmin);
+        let d = lambda * -hmin;
+        let ch = self.chart;
+        let (cx, cy, hx, hy) = r.centre();
+        let mut value = DVec3::ZERO;
+        for j in 0..3 {
+            let y = cy + hy * GX[j];
+            for i in 0..3 {
+                let wab = w[3 * j + i];
+                if wab == DVec3::ZERO {
+                    continue;
+                }
+                let x = cx + hx * GX[i];
+                let wv = ch.w0 + ch.e1 * x + ch.e2 * y;
+                let l2 = wv.length_squared();
+                let q = lambda * (c0 + a * x + b * y) + 0.5 * d;
+                let g = q * ch.jac / (l2 * l2);
+                value += if self.shaped {
+                    wab * shaping(self.p, -wv / l2.sqrt()) * g
+                } else {
+                    wab * g
+                };
+            }
+        }
+        let wc = ch.w0 + ch.e1 * cx + ch.e2 * cy;
+        let dmin = wc.length() - ((ch.e1 * hx).length() + (ch.e2 * hy).length());
+        let bound = if dmin > 0.0 {
+            tabs * self.s_max * (0.5 * d * ch.jac / (dmin * dmin * dmin * dmin))
+        } else {
+            DVec3::INFINITY
+        };
+        (value, bound)
     }
 
     /// Whether a kink of the shaping factor (`Prepared::profile`: the cone edge, the
@@ -407,10 +484,9 @@ impl Kernel<'_> {
 
     /// Whether the cell must be split before its rule is trusted: it is not well separated
     /// from x (half-diagonal R > ½ (|w_c| − R)) and the horizon does not hide all of it.
-    /// An upper bound of `|∫ t·K|` over the cell `r` of an unshaped light, per channel:
-    /// `K = max(0, n·w)·J/|w|⁴` with `n·w` linear (largest at a corner) and `|w| ≥ |w_c| − R`
-    /// (see [`Kernel::near`]), times `t_max` and the cell's area. Infinite when the cell may
-    /// reach x.
+    /// An upper bound of `|∫ t·K|` over the cell `r`, per channel: `K = S·max(0, n·w)·J/|w|⁴`
+    /// with `|S| ≤ s_max`, `n·w` linear (largest at a corner) and `|w| ≥ |w_c| − R` (see
+    /// [`Kernel::near`]), times `t_max` and the cell's area. Infinite when the cell may reach x.
     fn cut_bound(&self, tmax: DVec3, r: Rect) -> DVec3 {
         let (cx, cy, hx, hy) = r.centre();
         let c = self.chart;
@@ -425,7 +501,7 @@ impl Kernel<'_> {
             .map(|&(x, y)| self.n.dot(c.w0 + c.e1 * x + c.e2 * y))
             .fold(0.0, f64::max);
         let area = (r.x1 - r.x0) * (r.y1 - r.y0);
-        tmax * (hmax * c.jac * area / (dmin * dmin * dmin * dmin))
+        tmax * self.s_max * (hmax * c.jac * area / (dmin * dmin * dmin * dmin))
     }
 
     fn near(&self, r: Rect) -> bool {
@@ -443,12 +519,14 @@ impl Kernel<'_> {
     }
 }
 
-/// An active cell: its value (the sum of its children's rules), their rules, its error.
+/// An active cell: its value (the sum of its children's rules), their rules and error
+/// bounds, its error (an estimate, or an a-priori bound when `bounded`).
 struct Active {
     key: f64,
     value: DVec3,
     err: DVec3,
-    kids: Vec<(Cell, DVec3)>,
+    bounded: bool,
+    kids: Vec<(Cell, (DVec3, DVec3))>,
 }
 
 impl PartialEq for Active {
@@ -477,9 +555,10 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         chart,
         n,
         shaped: p.shaping.is_some(),
+        s_max: p.shaping.as_ref().map_or(DVec3::ONE, |s| s.factor_bound()),
     };
-    let activate = |cell: Cell, own: DVec3| -> Active {
-        let kids: Vec<(Cell, DVec3)> = tree
+    let activate = |cell: Cell, (own, own_bound): (DVec3, DVec3)| -> Active {
+        let kids: Vec<(Cell, (DVec3, DVec3))> = tree
             .children(&cell)
             .into_iter()
             .map(|c| {
@@ -492,10 +571,11 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
                 key: 0.0,
                 value: own,
                 err: DVec3::ZERO,
+                bounded: false,
                 kids,
             };
         }
-        let value: DVec3 = kids.iter().map(|c| c.1).sum();
+        let value: DVec3 = kids.iter().map(|c| c.1.0).sum();
         let err = (value - own).abs();
         let r = tree.rect(&cell);
         // A clipped rule samples t at its Gauss points; over more than one texel piece it
@@ -504,44 +584,50 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         // lies in one child gets that child's very rule points (estimate exactly 0), and a
         // lit texel between the points of both goes unseen. Measured (module docs): a shaped
         // 256 × 128 rect off by 3.0e-4 at every tolerance, a one-texel texture found to 33 %.
-        // So such a cell is not trusted on its estimate. Shaped, it is split untrusted down to
-        // single pieces, where t is a polynomial and the clipped rule converges. Unshaped, the
-        // only kink is the horizon, where K vanishes: its error is the a-priori bound of its
-        // whole contribution (`Kernel::cut_bound`), which shrinks like its size cubed, so the
-        // adaptive split refines it only as far as the tolerance needs (one-texel textures were
-        // missed by up to 100 % while it was trusted on its estimate, module docs).
-        let sampled = tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
-        let (key, err) = if k.near(r) || (sampled && k.shaped) {
-            (f64::INFINITY, err)
-        } else if sampled {
-            let b = k.cut_bound(tree.t_max(&cell), r);
-            (b.max_element(), b)
+        // So such a cell is not trusted on its estimate. Where a shaping kink may cross it, it
+        // is split untrusted down to single pieces, where t is a polynomial and the clipped
+        // rule converges. Where only the horizon cuts it, its own rule is the bracket rule
+        // (`Kernel::bracket`: no sampling) whose error is at most `own_bound`, so the
+        // children's sum is off by at most `own_bound + |Σ children − own|` (or the whole
+        // contribution's `Kernel::cut_bound`, where smaller): a bound, not an estimate, held to
+        // its own share of the tolerance (`BOUND_SHARE`). One-texel textures were missed by up
+        // to 100 % while such cells were trusted on their estimates (module docs).
+        let cut = tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
+        let (key, err, bounded) = if k.near(r) || (cut && k.kinked(r)) {
+            (f64::INFINITY, err, false)
+        } else if cut {
+            let b = (own_bound + err).min(k.cut_bound(tree.t_max(&cell), r));
+            (b.max_element() * (ESTIMATE_SHARE / BOUND_SHARE), b, true)
         } else {
-            (err.max_element(), err)
+            (err.max_element(), err, false)
         };
         Active {
             key,
             value,
             err,
+            bounded,
             kids,
         }
     };
     let root = Cell::Node(0);
     let own = k.cell_rule(&tree, &root);
     let first = activate(root, own);
-    let (mut total, mut err) = (first.value, first.err);
+    // Estimated errors and a-priori bounds are summed apart, each held to its share of rel.
+    let mut total = first.value;
+    let mut err = [DVec3::ZERO; 2];
+    err[usize::from(first.bounded)] += first.err;
     let mut forced = usize::from(first.key == f64::INFINITY);
     let mut heap = BinaryHeap::new();
     heap.push(first);
-    // The estimates are not bounds, so the sum stops well inside rel (the shaped bias once
-    // measured did not change from rel/8 to rel/16: it was not the stop's, see module docs).
-    let q = rel / 16.0;
+    let shares = [ESTIMATE_SHARE * rel, BOUND_SHARE * rel];
     for _ in 0..MAX_SPLITS {
         let tiny = 1e-14 * total.abs().max_element();
         let done = forced == 0
-            && (err.x <= q * total.x.abs() + tiny)
-            && (err.y <= q * total.y.abs() + tiny)
-            && (err.z <= q * total.z.abs() + tiny);
+            && err.iter().zip(shares).all(|(e, q)| {
+                (e.x <= q * total.x.abs() + tiny)
+                    && (e.y <= q * total.y.abs() + tiny)
+                    && (e.z <= q * total.z.abs() + tiny)
+            });
         if done {
             break;
         }
@@ -554,11 +640,11 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
             forced -= 1;
         }
         total -= top.value;
-        err -= top.err;
+        err[usize::from(top.bounded)] -= top.err;
         for (c, own) in top.kids {
             let a = activate(c, own);
             total += a.value;
-            err += a.err;
+            err[usize::from(a.bounded)] += a.err;
             forced += usize::from(a.key == f64::INFINITY);
             heap.push(a);
         }

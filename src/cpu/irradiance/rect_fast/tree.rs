@@ -67,6 +67,9 @@ pub struct Tree {
     px: Vec<(AxisPiece, f64, f64)>,
     py: Vec<(AxisPiece, f64, f64)>,
     nodes: Vec<Node>,
+    /// Every texel is ≥ 0 in every channel: then `∫|t| = ∫t = Σ_ab W_ab` on any cell
+    /// ([`Tree::abs_integral`]).
+    nonnegative: bool,
 }
 
 /// The chart interval `[1 − 2·x1/n, 1 − 2·x0/n]` of each piece of an axis of n texels.
@@ -90,11 +93,13 @@ impl Tree {
     fn new(img: Arc<Image>, filter: Filter) -> Tree {
         let px = chart_pieces(img.width, filter);
         let py = chart_pieces(img.height, filter);
+        let nonnegative = img.rgb.iter().flatten().all(|&v| v >= 0.0);
         let mut t = Tree {
             img,
             px,
             py,
             nodes: Vec::new(),
+            nonnegative,
         };
         let (nx, ny) = (t.px.len() as u32, t.py.len() as u32);
         t.build([0, nx, 0, ny]);
@@ -162,6 +167,17 @@ impl Tree {
         match c {
             Cell::Node(i) => self.nodes[*i as usize].tmax,
             Cell::Block(r, _) => self.block_tmax(*r),
+        }
+    }
+
+    /// An upper bound of `∫|t|` over the cell `r` with moments `w`, per channel: the exact
+    /// `∫t = Σ_ab W_ab` (the ℓ_ab sum to 1) when the texture is nonnegative (bilinear and
+    /// nearest filtering keep it so), else `t_max · area`.
+    pub(super) fn abs_integral(&self, c: &Cell, r: Rect, w: &Moments) -> DVec3 {
+        if self.nonnegative {
+            w.iter().sum::<DVec3>().max(DVec3::ZERO)
+        } else {
+            self.t_max(c) * ((r.x1 - r.x0) * (r.y1 - r.y0))
         }
     }
 
