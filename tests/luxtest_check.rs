@@ -19,6 +19,10 @@ const NOT_SHIPPED: [&str; 2] = [
     "04f377f94ce81cd7b5101fffdf571454.ies",
 ];
 
+/// Irradiance receivers per IES-shaped light-frame (other lights: `Samples::per_query(150)`'s
+/// 38).
+const IES_IRRADIANCE_RECEIVERS: usize = 4;
+
 #[test]
 fn every_luxtest_light_at_every_frame_is_within_tolerance() {
     let Some(gpu) = common::gpu() else { return };
@@ -77,7 +81,15 @@ fn every_luxtest_light_at_every_frame_is_within_tolerance() {
             if prepared.is_empty() {
                 continue;
             }
-            let report = check::check(&gpu, &prepared, 150, frame as u64).expect("check runs");
+            // IES irradiance is a quadrature split at every grid cone and plane of the profile on
+            // both sides (the reference's in f64 at 1e-9): a few receivers per light-frame keep
+            // the suite's time in bounds (`ies_conformance` compares thousands of them).
+            let mut counts = check::Samples::per_query(150);
+            if name.starts_with("ies") {
+                counts.irradiance = IES_IRRADIANCE_RECEIVERS;
+            }
+            let report =
+                check::check_with(&gpu, &prepared, counts, frame as u64).expect("check runs");
             samples += report.samples;
             checked += prepared.len();
             if name.starts_with("ies") {
