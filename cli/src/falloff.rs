@@ -96,6 +96,7 @@ pub fn run(a: &FalloffArgs) -> CliResult {
     let map = scene.falloff(&plane, |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     crate::query::check_finite(&scene, 0, map.rgb.len(), &map.rgb)?;
+    crate::query::note_host_recomputed(&scene, map.rgb.len() as u64);
     let n = plane.normal();
     let comment = format!(
         "luxeval falloff: {} at {}; origin {:?} u {:?} v {:?}; normal ({}, {}, {}); {} lights on {}",

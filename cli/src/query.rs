@@ -150,11 +150,28 @@ pub fn run(args: &QueryArgs, query: Query, output: &Path) -> CliResult {
         bar.set_position(start);
     }
     bar.finish_and_clear();
+    if let Query::Irradiance { .. } = query {
+        note_host_recomputed(&scene, n * if args.per_light { lights } else { 1 });
+    }
     if let Query::Intensity { png: Some(png), .. } = query {
         plot_light(&eval, &scene, &args.scene, png)?;
     }
     writer.finish()?;
     Ok(())
+}
+
+/// Says on stderr how many of `rows` irradiance rows the device could not finish and the CPU
+/// reference recomputed (`PreparedScene::host_recomputed_rows`), when any: their values are
+/// the reference's, and they took the CPU's time.
+pub fn note_host_recomputed(scene: &PreparedScene, rows: u64) {
+    let k = scene.host_recomputed_rows();
+    if k > 0 {
+        eprintln!(
+            "note: {k} of {rows} irradiance rows were recomputed on the CPU reference: the \
+             device could not finish their quadrature (more breakpoints than the kernel holds, \
+             or a software GPU's loop budget)"
+        );
+    }
 }
 
 /// A progress bar on a terminal for `total` items, nothing when stderr is redirected (indicatif

@@ -321,3 +321,68 @@ fn blender_studio_maps_decode_and_evaluate() {
         "{e:?}"
     );
 }
+
+/// A falloff map the device cannot finish everywhere says so: a plane 0.1 in front of a 2 × 2
+/// rect shaped by a dense IES profile (`testkit::ies::dense_profile`), on the GPU. On lavapipe
+/// its receivers go over the loop budget, the CPU reference recomputes them, and stderr says
+/// how many (`PreparedScene::host_recomputed_rows`); on any device the map is the CPU path's
+/// within the tolerance of each.
+#[test]
+fn falloff_says_which_receivers_the_host_recomputed() {
+    let Some(gpu) = common::gpu() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("dense.ies"),
+        luxeval::testkit::ies::dense_profile(),
+    )
+    .unwrap();
+    let stage = dir.path().join("dense.usda");
+    std::fs::write(
+        &stage,
+        "#usda 1.0\ndef RectLight \"L\" (\n    prepend apiSchemas = [\"ShapingAPI\"]\n)\n{\n    \
+         float inputs:width = 2\n    float inputs:height = 2\n    \
+         asset inputs:shaping:ies:file = @dense.ies@\n}\n",
+    )
+    .unwrap();
+    let mut maps = Vec::new();
+    for device in ["gpu", "cpu"] {
+        let out = dir.path().join(format!("{device}.exr"));
+        let o = luxeval(&[
+            "falloff",
+            stage.to_str().unwrap(),
+            "--origin",
+            "-0.5,-0.5,-0.1",
+            "--u",
+            "1,0,0",
+            "--v",
+            "0,1,0",
+            "--res",
+            "4,2",
+            "--device",
+            device,
+            "-o",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let said = stderr(&o).contains("irradiance rows were recomputed on the CPU reference");
+        if device == "cpu" {
+            assert!(!said, "{}", stderr(&o));
+        } else if gpu.device_name().contains("llvmpipe") {
+            assert!(said, "no note on lavapipe: {}", stderr(&o));
+            assert!(
+                stderr(&o).contains("of 8 irradiance rows"),
+                "{}",
+                stderr(&o)
+            );
+        }
+        maps.push(luxeval_cli::io::exr::read_exr(&out).unwrap().rgb);
+    }
+    for (g, c) in maps[0].iter().zip(&maps[1]) {
+        for k in 0..3 {
+            assert!(
+                c[k] > 0.0 && (g[k] - c[k]).abs() <= 2e-4 * c[k],
+                "{g:?} vs {c:?}"
+            );
+        }
+    }
+}

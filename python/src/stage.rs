@@ -209,6 +209,7 @@ impl Stage {
             paired(a_name, a_rows.len(), b_name, b_rows.len())?;
         }
         let scene = self.prepare_for(py, &o)?;
+        let recomputed = scene.host_recomputed_rows();
         let n = a_rows.len();
         let l = scene.len();
         let (acc, width) = if per_light {
@@ -255,8 +256,30 @@ impl Stage {
             py.check_signals()?;
             start = end;
         }
+        if matches!(q, Query::Irradiance) {
+            self.warn_host_recomputed(py, scene.host_recomputed_rows() - recomputed, width * n)?;
+        }
         let shape: Vec<usize> = if per_light { vec![l, n, 3] } else { vec![n, 3] };
         Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+    }
+}
+
+impl Stage {
+    /// A `UserWarning` when `k` of a call's `rows` irradiance rows were recomputed on the CPU
+    /// reference because the device could not finish them
+    /// (`PreparedScene::host_recomputed_rows`; the command line's `note:` line).
+    fn warn_host_recomputed(&self, py: Python<'_>, k: usize, rows: usize) -> PyResult<()> {
+        if k == 0 {
+            return Ok(());
+        }
+        let msg = format!(
+            "{}: {k} of {rows} irradiance rows were recomputed on the CPU reference: the device \
+             could not finish their quadrature (more breakpoints than the kernel holds, or a \
+             software GPU's loop budget)",
+            self.path.display()
+        );
+        let msg = std::ffi::CString::new(msg.replace('\0', " ")).expect("no NUL");
+        PyErr::warn(py, &py.get_type::<PyUserWarning>(), &msg, 2)
     }
 }
 
@@ -615,6 +638,7 @@ impl Stage {
         }
         let plane = Plane::new(origin, u, v, w, h).map_err(|e| errors::lux(e, None))?;
         let scene = self.prepare_for(py, &o)?;
+        let recomputed = scene.host_recomputed_rows();
         let normal = plane.normal().as_vec3().to_array();
         let pixels = plane.pixels();
         let mut out = zeros::<f32>(pixels.checked_mul(3))?;
@@ -650,6 +674,7 @@ impl Stage {
             py.check_signals()?;
             j0 = j1;
         }
+        self.warn_host_recomputed(py, scene.host_recomputed_rows() - recomputed, pixels)?;
         Ok(PyArray1::from_vec(py, out)
             .reshape([h as usize, w as usize, 3])?
             .into_any())

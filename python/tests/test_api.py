@@ -14,6 +14,7 @@ import sys
 import textwrap
 import threading
 import time
+import warnings
 import tracemalloc
 from pathlib import Path
 
@@ -420,3 +421,46 @@ def test_every_public_name_has_a_docstring():
     assert issubclass(luxeval.InputError, ValueError)
     assert issubclass(luxeval.DeviceError, RuntimeError)
     assert issubclass(luxeval.DeviceWarning, RuntimeWarning)
+
+
+def dense_ies() -> str:
+    """The 1°-by-5° type C profile of ``luxeval::testkit::ies::dense_profile``: near a large
+    light shaped by it, a receiver's quadrature crosses more grid surfaces than lavapipe's loop
+    budget allows."""
+    v = list(range(181))
+    h = [5 * k for k in range(73)]
+    out = "IESNA:LM-63-2002\r\n[TEST] dense\r\nTILT=NONE\r\n"
+    out += f"1 -1 1 {len(v)} {len(h)} 1 2 0.1 0.1 0\r\n1 1 0\r\n"
+    out += " ".join(map(str, v)) + "\r\n" + " ".join(map(str, h)) + "\r\n"
+    for hh in h:
+        row = [100 + 50 * np.cos(np.radians(vv) * 3) * np.sin(np.radians(hh) * 2) for vv in v]
+        out += " ".join(repr(float(x)) for x in row) + "\r\n"
+    return out
+
+
+def test_the_host_recomputed_rows_are_announced(tmp_path, cli):
+    """Irradiance rows the device cannot finish (on lavapipe: its loop budget) are recomputed on
+    the CPU reference, and the call says how many with a UserWarning, as ``luxeval`` prints a
+    ``note:``; the values are the CPU path's within the tolerance of each."""
+    (tmp_path / "dense.ies").write_text(dense_ies())
+    stage_path = tmp_path / "dense.usda"
+    stage_path.write_text('#usda 1.0\ndef RectLight "L" (\n    prepend apiSchemas = ["ShapingAPI"]\n)\n'
+                          '{\n    float inputs:width = 2\n    float inputs:height = 2\n'
+                          '    asset inputs:shaping:ies:file = @dense.ies@\n}\n')
+    info = json.loads(subprocess.run([str(cli), "info", "--json"], capture_output=True,
+                                     text=True, check=True).stdout)
+    software = all("llvmpipe" in a["name"] for a in info["adapters"]) and info["adapters"]
+    stage = luxeval.Stage(stage_path)
+    args = ([-0.5, -0.5, -0.1], [1, 0, 0], [0, 1, 0], (4, 2))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        gpu = stage.falloff(*args, device="gpu")
+    said = [str(w.message) for w in caught if "recomputed on the CPU reference" in str(w.message)]
+    if software:
+        assert len(said) == 1 and "of 8 irradiance rows" in said[0] and "dense.usda" in said[0], said
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cpu = stage.falloff(*args, device="cpu")
+    assert not [w for w in caught if "recomputed" in str(w.message)]
+    assert (cpu > 0).all()
+    np.testing.assert_allclose(gpu, cpu, rtol=2e-4)

@@ -41,7 +41,8 @@ pub struct PreparedScene {
     /// they would need, over the device's storage binding limit.
     pub(super) sampling_gpu:
         std::sync::OnceLock<std::result::Result<crate::gpu::sample::SampleLights, u64>>,
-    /// Irradiance rows the kernel gave up on and the host recomputed (`redo_spent_rows`).
+    /// Irradiance rows the kernel gave up on and the host recomputed (`redo_spent_rows`,
+    /// `host_recomputed_rows`).
     spent_rows: std::sync::atomic::AtomicUsize,
 }
 
@@ -313,10 +314,13 @@ impl PreparedScene {
         }
     }
 
-    /// How many rows the irradiance kernel gave up on and the CPU reference recomputed
-    /// (`redo_spent_rows`), over this scene's calls: the tests bound it.
-    #[cfg(any(test, feature = "testkit"))]
-    pub fn spent_rows(&self) -> usize {
+    /// How many irradiance rows (receivers, or receiver × light with `PerLight`) the device
+    /// could not finish and the CPU reference recomputed, over this scene's calls: a chart with
+    /// more outer breakpoints than the kernel holds, or on a software GPU (llvmpipe) a
+    /// quadrature cut short by its loop budget. Their values are the reference's at the
+    /// scene's tolerance, and they cost the CPU's time; 0 on the CPU backend. The command
+    /// line reports it after an irradiance query or a falloff map.
+    pub fn host_recomputed_rows(&self) -> usize {
         self.spent_rows.load(std::sync::atomic::Ordering::Relaxed)
     }
 

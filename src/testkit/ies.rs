@@ -147,3 +147,28 @@ pub fn with_random_ies(light: Light, rng: &mut Rng, shape: usize, continuous: bo
     s.ies = Some(ies);
     light.with_shaping(s)
 }
+
+/// A 1°-by-5° type C profile (181 × 73 angles) falling off smoothly: a receiver near a large
+/// light shaped by it crosses more of its grid surfaces than lavapipe's loop budget allows.
+pub fn dense_profile() -> Vec<u8> {
+    let v: Vec<f64> = (0..=180).map(f64::from).collect();
+    let h: Vec<f64> = (0..=72).map(|k| 5.0 * k as f64).collect();
+    let list = |xs: &[f64]| {
+        xs.iter()
+            .map(|x| format!("{x}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let mut s = String::from("IESNA:LM-63-2002\r\n[TEST] dense\r\nTILT=NONE\r\n");
+    s += &format!("1 -1 1 {} {} 1 2 0.1 0.1 0\r\n1 1 0\r\n", v.len(), h.len());
+    s += &format!("{}\r\n{}\r\n", list(&v), list(&h));
+    for hh in &h {
+        let row: Vec<f64> = v
+            .iter()
+            .map(|vv| 100.0 + 50.0 * (vv.to_radians() * 3.0).cos() * (hh.to_radians() * 2.0).sin())
+            .collect();
+        s += &list(&row);
+        s += "\r\n";
+    }
+    s.into_bytes()
+}
