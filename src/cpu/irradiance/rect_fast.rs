@@ -49,19 +49,23 @@
 //!   needed too: without them (in a variant that split only the kink-crossed cells) 4
 //!   one-texel textures of 16 × 8 of shaped rects were missed entirely (a lit cap between
 //!   two lines).
-//! - A cell over several pieces that the horizon cuts and no shaping kink may cross is not
-//!   sampled at all: the horizon's factor `max(0, n·w)` is bracketed on it by two parallel
-//!   planes of the chart ([`Kernel::bracket`]), so its rule is the moment rule of a smooth
-//!   kernel (every texel counted through the exact moments) and its error has an a-priori
-//!   bound `(D/2)·max|S·J/|w|⁴|·∫|t|`, D the band's height, which shrinks like the cell's
-//!   size cubed; the adaptive split refines such cells only as far as the tolerance needs,
-//!   and their bounds are held to half the tolerance ([`BOUND_SHARE`]; the estimates to
-//!   rel/16). History: while such cells of unshaped rects took the sampled clipped rule
+//! - A cell over several pieces that the horizon cuts, or that only a soft cone's kink cones
+//!   (softness > 0) may cross, is not sampled at all ([`Kernel::bracket`]): the horizon's
+//!   factor `max(0, n·w)` is bracketed on it by two parallel planes of the chart, and the cone
+//!   factor by its range over the cell's directions (of the square of the cell's angular size
+//!   astride a kink: the smoothstep's slope is 0 at both ends), so its rule is the moment rule
+//!   of a smooth kernel (every texel counted through the exact moments) and its error has an
+//!   a-priori bound (for the horizon alone `(D/2)·max|S·J/|w|⁴|·∫|t|`, D the band's height),
+//!   which shrinks like the cell's size cubed (to the fourth for a kink cone); the adaptive
+//!   split refines such cells only as far as the tolerance needs, and their bounds are held
+//!   to half the tolerance ([`BOUND_SHARE`]; the estimates to rel/16). Hard cones' edges, the
+//!   focus plane and a singular axis still split a crossed cell down to single pieces. History: while such cells of unshaped rects took the sampled clipped rule
 //!   trusted on its estimate, one-texel 16 × 8 textures (both filters, both transforms, the 9
 //!   receivers of the tests) were off by 1.2e-4 to 100 % at 1e-4 (random textures did not
 //!   show it); the bound of the whole contribution instead ([`Kernel::cut_bound`], still the
 //!   fallback where smaller) made visibleRect's 128² map take 28 s; the bracket takes it to
-//!   0.63 s and shaped rects' focus-only receivers from 20–39 ms to 1–4 ms (BENCHMARKS.md).
+//!   0.63 s and shaped rects' focus-only receivers from 20–39 ms to 1–4 ms; bracketing soft
+//!   cones' kinks took their receivers from up to 364 ms to up to ~60 ms (BENCHMARKS.md).
 //! - Guard against a peak no rule point sees: a cell is split without being trusted while its
 //!   world half-diagonal R exceeds half the lower bound `|w_c| − R` of its distance from x
 //!   (FMM's well-separated criterion), unless the receiver's horizon hides all of it.
@@ -82,12 +86,13 @@
 //! IES profiles are left to the exact path ([`applies`]: never tried here).
 
 use std::collections::BinaryHeap;
+use std::f64::consts::PI;
 
 use glam::DVec3;
 
 use super::chart::Chart;
 use crate::cpu::roots::{axis_approach, cone_roots_on_line};
-use crate::cpu::shaping::shaping;
+use crate::cpu::shaping::{cone_factor, focus_factor, shaping};
 use crate::prepare::Kink;
 use crate::prepare::Prepared;
 use tree::{Cell, GX, Moments, Rect, Tree};
@@ -151,6 +156,34 @@ struct Kernel<'a> {
     shaped: bool,
     /// A bound of the shaping factor's size, per channel (`ShapingConsts::factor_bound`).
     s_max: DVec3,
+    /// The cone factor is C¹ across its kink cones: softness > 0 (`1 − smoothstep` has zero
+    /// slope at both ends), so near them it differs from its value there by the square of
+    /// the distance in angle ([`Kernel::bracket`]).
+    soft_cone: bool,
+}
+
+/// How the shaping's kinks meet a cell ([`Kernel::kinks`]).
+#[derive(Clone, Copy, PartialEq, Debug)]
+enum Kinks {
+    None,
+    /// Only kink cones of a soft cone (the smoothstep's start or the cone's edge).
+    SoftCone,
+    /// A hard cone's edge, the focus plane, or the axis where the factor is singular.
+    Other,
+}
+
+impl<'a> Kernel<'a> {
+    fn new(p: &'a Prepared, chart: &'a Chart, n: DVec3) -> Self {
+        let s = p.shaping.as_ref();
+        Kernel {
+            p,
+            chart,
+            n,
+            shaped: s.is_some(),
+            s_max: s.map_or(DVec3::ONE, |s| s.factor_bound()),
+            soft_cone: s.is_some_and(|s| s.start < s.cone),
+        }
+    }
 }
 
 impl Kernel<'_> {
@@ -196,14 +229,14 @@ impl Kernel<'_> {
 
     /// The cell's rule (see [`Kernel::rule_kind`]) and a bound of its error where that is known
     /// a priori (the bracket rule's), else 0: a cell over several texel pieces that the horizon
-    /// cuts and no shaping kink may cross takes [`Kernel::bracket`], other cut cells
-    /// [`Kernel::clipped`].
+    /// cuts or a soft cone's kink cones may cross, and no other kink, takes
+    /// [`Kernel::bracket`], other cut or kinked cells [`Kernel::clipped`].
     fn cell_rule(&self, tree: &Tree, cell: &Cell) -> (DVec3, DVec3) {
         let r = tree.rect(cell);
         match self.rule_kind(r) {
             RuleKind::Zero => (DVec3::ZERO, DVec3::ZERO),
             RuleKind::Moments => (self.rule(r, &tree.moments(cell)), DVec3::ZERO),
-            RuleKind::Clipped if tree.pieces(cell) > 1 && !self.kinked(r) => {
+            RuleKind::Clipped if tree.pieces(cell) > 1 && self.kinks(r) != Kinks::Other => {
                 let w = tree.moments(cell);
                 self.bracket(r, &w, tree.abs_integral(cell, r, &w))
             }
@@ -211,18 +244,28 @@ impl Kernel<'_> {
         }
     }
 
-    /// The bracket rule of a cell `r` that the horizon cuts and no shaping kink may cross, with
-    /// the texture's exact moments `w` and `tabs ≥ ∫|t|` over it: its value and a bound of its
-    /// error. There `K = max(0, h)·g` with `h = n·w` affine on the chart (its range [h₋, h₊] on
-    /// the cell is that of the corners) and `g = S(−ŵ)·J/|w|⁴` smooth (`|S| ≤ s_max`, the
-    /// shaping factor is smooth where no kink crosses). `max(0, h)` is convex, so on
-    /// [h₋, h₊] it lies between the line `λh` (λ = h₊/(h₊ − h₋)) and the parallel chord through
-    /// the ends `λ(h − h₋)`, a band of height `D = λ·(−h₋) ≤ (h₊ − h₋)/4`: with
-    /// `q = λh + D/2`, `|max(0, h) − q| ≤ D/2` everywhere on the cell, and
-    /// `|∫ t·K − ∫ t·q·g| ≤ (D/2)·max |g|·∫|t|`, `max |g| ≤ s_max·J/(|w_c| − R)⁴`. `q·g` is smooth, so
-    /// `∫ t·q·g` is the moment rule's (no sampling of t: no texel goes unseen). The bound
-    /// shrinks like the cell's size cubed, as [`Kernel::cut_bound`] (the whole contribution's)
-    /// does, but with `D/2 ≤ h₊/4` against `h₊` and `∫|t|` against `t_max · area`.
+    /// The bracket rule of a cell `r` that the horizon cuts or a soft cone's kink cones may
+    /// cross (no other kink), with the texture's exact moments `w` and `tabs ≥ ∫|t|` over it:
+    /// its value and a bound of its error. There `K = c·max(0, h)·g`:
+    /// - `h = n·w` is affine on the chart (its range [h₋, h₊] on the cell is that of the
+    ///   corners). `max(0, h)` is convex, so on [h₋, h₊] it lies between the line `λh`
+    ///   (λ = h₊/(h₊ − h₋), h₋ taken ≤ 0) and the parallel chord through the ends `λ(h − h₋)`,
+    ///   a band of height `D = λ·(−h₋) ≤ (h₊ − h₋)/4` (0 when the horizon does not cut): with
+    ///   `q = λh + D/2`, `|max(0, h) − q| ≤ D/2` on the cell, and `|q| ≤ λh₊ + D/2`.
+    /// - `c` is the cone factor `1 − smoothstep(θ; start, cone)` where a soft cone's kink
+    ///   cones cross the cell (else 1, and the whole shaping factor is in g). It does not
+    ///   increase with θ, so over the cell's θ range [θc − α, θc + α] (`Kernel::angles`) it lies
+    ///   in [c₋, c₊] = [c(θc + α), c(θc − α)]; a cell astride a kink has a range of the square
+    ///   of its angular size (the smoothstep's slope is 0 at both ends).
+    /// - `g = F·J/|w|⁴` is smooth, F the rest of the shaping factor (focus, or all of it),
+    ///   `|F| ≤ s_max`, `J/|w|⁴ ≤ J/(|w_c| − R)⁴`.
+    ///
+    /// The rule is `c_m·∫ t·q·g` with `c_m = (c₋ + c₊)/2`, the moment rule of a smooth kernel
+    /// (no sampling of t: no texel goes unseen), and
+    /// `|c·max(0, h) − c_m·q| ≤ c₊·D/2 + |q|·(c₊ − c₋)/2`, so its error is at most that times
+    /// `max|g|·∫|t|`. For the horizon alone the bound shrinks like the cell's size cubed, as
+    /// [`Kernel::cut_bound`] (the whole contribution's) does, but with `D/2 ≤ h₊/4` against
+    /// `h₊` and `∫|t|` against `t_max · area`; for a kink cone like its size to the fourth.
     fn bracket(&self, r: Rect, w: &Moments, tabs: DVec3) -> (DVec3, DVec3) {
         let (c0, a, b) = self.horizon();
         let hs = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)]
@@ -234,6 +277,17 @@ impl Kernel<'_> {
         }
         let lambda = hmax / (hmax - hmin);
         let d = lambda * -hmin;
+        // The cone factor's range where a soft cone's kinks cross (`Kernel::kinks`).
+        let coned = self.kinks(r) == Kinks::SoftCone;
+        let (c_lo, c_hi) = match (coned, self.p.shaping.as_ref(), self.angles(r)) {
+            (true, Some(s), Some((theta, alpha))) => (
+                cone_factor((theta + alpha).min(PI), s.cone, s.start),
+                cone_factor((theta - alpha).max(0.0), s.cone, s.start),
+            ),
+            (true, ..) => return (DVec3::ZERO, DVec3::INFINITY),
+            (false, ..) => (1.0, 1.0),
+        };
+        let c_mid = 0.5 * (c_lo + c_hi);
         let ch = self.chart;
         let (cx, cy, hx, hy) = r.centre();
         let mut value = DVec3::ZERO;
@@ -249,51 +303,83 @@ impl Kernel<'_> {
                 let l2 = wv.length_squared();
                 let q = lambda * (c0 + a * x + b * y) + 0.5 * d;
                 let g = q * ch.jac / (l2 * l2);
-                value += if self.shaped {
-                    wab * shaping(self.p, -wv / l2.sqrt()) * g
-                } else {
-                    wab * g
+                let e = -wv / l2.sqrt();
+                value += match self.p.shaping.as_ref() {
+                    None => wab * g,
+                    Some(s) if coned => {
+                        wab * focus_factor(s.focus, s.focus_tint, e.dot(self.p.axis)) * g
+                    }
+                    Some(_) => wab * shaping(self.p, e) * g,
                 };
             }
         }
         let wc = ch.w0 + ch.e1 * cx + ch.e2 * cy;
         let dmin = wc.length() - ((ch.e1 * hx).length() + (ch.e2 * hy).length());
+        let band = c_hi * 0.5 * d + (lambda * hmax + 0.5 * d) * 0.5 * (c_hi - c_lo);
         let bound = if dmin > 0.0 {
-            tabs * self.s_max * (0.5 * d * ch.jac / (dmin * dmin * dmin * dmin))
+            tabs * self.s_max * (band * ch.jac / (dmin * dmin * dmin * dmin))
         } else {
             DVec3::INFINITY
         };
-        (value, bound)
+        (value * c_mid, bound)
     }
 
     /// Whether a kink of the shaping factor (`Prepared::profile`: the cone edge, the
-    /// smoothstep's start, the focus plane) may cross the cell: a cone whose angle lies within
-    /// α = asin(R/|w_c|) of the centre direction's, or a plane with corners on both sides.
+    /// smoothstep's start, the focus plane) may cross the cell ([`Kernel::kinks`]).
     fn kinked(&self, r: Rect) -> bool {
-        if !self.shaped {
-            return false;
-        }
+        self.kinks(r) != Kinks::None
+    }
+
+    /// The cell's directions: the centre direction's angle θ from the axis and a bound α of
+    /// the angle between it and any direction of the cell (`asin(R/|w_c|)`); None when the
+    /// cell may reach x.
+    fn angles(&self, r: Rect) -> Option<(f64, f64)> {
         let (cx, cy, hx, hy) = r.centre();
         let c = self.chart;
         let wc = c.w0 + c.e1 * cx + c.e2 * cy;
         let (d, rad) = (wc.length(), (c.e1 * hx).length() + (c.e2 * hy).length());
-        let cone = (rad < d).then(|| {
+        (rad < d).then(|| {
             (
-                (rad / d).asin() + 1e-9,
                 (-wc / d).dot(self.p.axis).clamp(-1.0, 1.0).acos(),
+                (rad / d).asin() + 1e-9,
             )
-        });
+        })
+    }
+
+    /// Which kinks of the shaping factor may cross the cell: a cone whose angle lies within α
+    /// of the centre direction's, or a plane with corners on both sides. Only the kink cones
+    /// of a soft cone ([`Kinks::SoftCone`]) can be bracketed.
+    fn kinks(&self, r: Rect) -> Kinks {
+        if !self.shaped {
+            return Kinks::None;
+        }
+        let c = self.chart;
+        let dirs = self.angles(r);
         let corners = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)];
-        self.p.profile.kinks.iter().any(|k| match *k {
-            Kink::Cone { cos } => match cone {
-                Some((alpha, theta)) => (cos.clamp(-1.0, 1.0).acos() - theta).abs() <= alpha,
-                None => true,
-            },
-            Kink::Plane { m, .. } => {
-                let sg = corners.map(|(x, y)| m.dot(c.w0 + c.e1 * x + c.e2 * y));
-                sg.iter().any(|&v| v > 0.0) && sg.iter().any(|&v| !(v > 0.0))
+        let mut out = Kinks::None;
+        for k in &self.p.profile.kinks {
+            let crosses = match *k {
+                Kink::Cone { cos } => match dirs {
+                    Some((theta, alpha)) => (cos.clamp(-1.0, 1.0).acos() - theta).abs() <= alpha,
+                    None => true,
+                },
+                Kink::Plane { m, .. } => {
+                    let sg = corners.map(|(x, y)| m.dot(c.w0 + c.e1 * x + c.e2 * y));
+                    sg.iter().any(|&v| v > 0.0) && sg.iter().any(|&v| !(v > 0.0))
+                }
+            };
+            if crosses {
+                if matches!(k, Kink::Cone { .. }) && self.soft_cone && dirs.is_some() {
+                    out = Kinks::SoftCone;
+                } else {
+                    return Kinks::Other;
+                }
             }
-        }) || (self.p.profile.axis_singular && cone.is_none_or(|(a, t)| t <= a))
+        }
+        if self.p.profile.axis_singular && dirs.is_none_or(|(t, a)| t <= a) {
+            return Kinks::Other;
+        }
+        out
     }
 
     /// `∫ t·K` over the part of `r` in front of the horizon (a line h = 0 of the chart, where K
@@ -550,13 +636,7 @@ impl Ord for Active {
 /// relative tolerance `rel` (module docs). None when `p` has no texture.
 pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option<DVec3> {
     let tree = tree(p.rect_texture()?)?;
-    let k = Kernel {
-        p,
-        chart,
-        n,
-        shaped: p.shaping.is_some(),
-        s_max: p.shaping.as_ref().map_or(DVec3::ONE, |s| s.factor_bound()),
-    };
+    let k = Kernel::new(p, chart, n);
     let activate = |cell: Cell, (own, own_bound): (DVec3, DVec3)| -> Active {
         let kids: Vec<(Cell, (DVec3, DVec3))> = tree
             .children(&cell)
@@ -593,7 +673,7 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         // its own share of the tolerance (`BOUND_SHARE`). One-texel textures were missed by up
         // to 100 % while such cells were trusted on their estimates (module docs).
         let cut = tree.pieces(&cell) > 1 && k.rule_kind(r) == RuleKind::Clipped;
-        let (key, err, bounded) = if k.near(r) || (cut && k.kinked(r)) {
+        let (key, err, bounded) = if k.near(r) || (cut && k.kinks(r) == Kinks::Other) {
             (f64::INFINITY, err, false)
         } else if cut {
             let b = (own_bound + err).min(k.cut_bound(tree.t_max(&cell), r));
