@@ -68,6 +68,22 @@ pub fn run(a: &FalloffArgs) -> CliResult {
         outputs.push(("--png", png.as_path()));
     }
     crate::io::check_outputs(&outputs, &[("SCENE", &a.scene.scene)])?;
+    // The formats are fixed; a name that says otherwise (`-o map.npy`) is likely a mistake.
+    for (flag, path, ext, format) in [
+        ("-o", Some(&a.output), "exr", "OpenEXR"),
+        ("--png", a.png.as_ref(), "png", "PNG"),
+    ] {
+        if let Some(path) = path
+            && !path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+        {
+            eprintln!(
+                "warning: {flag} {}: falloff writes {format} there whatever the file's name",
+                path.display()
+            );
+        }
+    }
     luxeval::Limits::from_env()?.check_samples("--res", u64::from(a.res.0) * u64::from(a.res.1))?;
     let plane = Plane::new(a.origin.into(), a.u.into(), a.v.into(), a.res.0, a.res.1)?;
     if a.png.is_some() {
