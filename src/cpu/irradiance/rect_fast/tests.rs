@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use glam::{DMat3, DMat4, DQuat};
 
+use super::tree::Tree;
 use super::*;
 use crate::cpu::irradiance::{Adaptive, Rule, irradiance, irradiance_with};
 use crate::model::{Light, Shaping};
@@ -410,16 +411,18 @@ fn the_bracket_rule_is_within_its_bound() {
                 let mut stack = vec![Cell::Node(0)];
                 while let Some(c) = stack.pop() {
                     let r = tree.rect(&c);
-                    if tree.pieces(&c) < 2 || k.rule_kind(r) != RuleKind::Clipped {
+                    let kinks = k.kinks(r);
+                    if tree.pieces(&c) < 2 || k.rule_kind(r, kinks) != RuleKind::Clipped {
                         continue;
                     }
                     stack.extend(tree.children(&c));
-                    if k.kinks(r) == Kinks::Other || k.near(r) {
+                    if kinks == Kinks::Other || k.near(r) {
                         continue;
                     }
-                    soft += usize::from(k.kinks(r) == Kinks::SoftCone);
+                    let coned = kinks == Kinks::SoftCone;
+                    soft += usize::from(coned);
                     let w = tree.moments(&c);
-                    let (value, bound) = k.bracket(r, &w, tree.abs_integral(&c, r, &w));
+                    let (value, bound) = k.bracket(r, &w, tree.abs_integral(&c, r, &w), coned);
                     let exact = fine_cell_integral(&k, &tree, c, 3);
                     let err = (value - exact).abs();
                     cells += 1;
