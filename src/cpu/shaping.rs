@@ -56,8 +56,20 @@ pub fn shaping(p: &Prepared, e: DVec3) -> DVec3 {
         return DVec3::ONE;
     };
     let cos = e.dot(p.axis);
-    let theta = off_axis_angle(p.axis, e);
-    let f = focus_factor(s.focus, s.focus_tint, cos) * cone_factor(theta, s.cone, s.start);
+    // θoff (an atan2: a third of a hard-coned textured rect's time) only where the cone
+    // factor is not 1 or 0 for certain: the cosine clearly above cos(start) means θoff < start
+    // (factor 1), clearly below cos(θcone) means θoff > θcone (factor 0). The margin, 1e-12,
+    // is far above the rounding of the cosine and of atan2 (~1e-16 for a unit e), so the
+    // factor is what θoff's own comparisons give, to the bit.
+    const MARGIN: f64 = 1e-12;
+    let cone = if cos > s.cos_start + MARGIN {
+        1.0
+    } else if cos < s.cos_cone - MARGIN {
+        0.0
+    } else {
+        cone_factor(off_axis_angle(p.axis, e), s.cone, s.start)
+    };
+    let f = focus_factor(s.focus, s.focus_tint, cos) * cone;
     // DESIGN.md §6 I7: the IES value multiplies as candela, like the other factors.
     match &p.ies {
         Some(_) => f * ies_of(p, e),
@@ -158,5 +170,58 @@ mod tests {
             assert_eq!(f, DVec3::ONE, "{e}");
             assert_eq!(crate::cpu::emission::emission(&p, e), p.base);
         }
+    }
+
+    /// `shaping` screens θoff by cosines (to skip the atan2): the factor must be what θoff's
+    /// own comparisons give, bit for bit, at the smoothstep's ends, just inside and outside
+    /// them, and for cones and starts outside [0, π] (cone angles over 180° or negative).
+    #[test]
+    fn the_cosine_screen_gives_the_angle_comparisons_factor() {
+        use crate::model::{Light, Shaping};
+        use crate::prepare::{Prepared, TemperatureMode};
+        use crate::synthetic::Rng;
+        let mut rng = Rng::new(11);
+        let mut checked = 0;
+        for (angle, softness) in [
+            (35.0, 0.0),
+            (30.0, 0.25),
+            (90.0, 0.0),
+            (120.0, 0.5),
+            (179.9, 0.0),
+            (200.0, 0.3),
+            (-20.0, 0.0),
+            (0.0, 0.0),
+            (45.0, 1.0),
+        ] {
+            let shaping = Shaping {
+                cone_angle: angle,
+                cone_softness: softness,
+                focus: 0.7,
+                focus_tint: DVec3::new(0.2, 0.5, 1.0),
+                ies: None,
+            };
+            let light = Light::rect(1.0, 1.0).with_shaping(shaping);
+            let p = Prepared::new(&light, TemperatureMode::Spec).unwrap();
+            let Some(s) = &p.shaping else { continue };
+            let (u, v) = p.axis.any_orthonormal_pair();
+            for _ in 0..2000 {
+                // θ at or near an end of the smoothstep (within ±1e-9, down to single ulps),
+                // or anywhere.
+                let end = [s.start, s.cone][rng.below(2)];
+                let theta = match rng.below(3) {
+                    0 => end + (rng.f64() - 0.5) * 2e-9,
+                    1 => end + (rng.below(9) as f64 - 4.0) * 1e-15,
+                    _ => rng.f64() * std::f64::consts::PI,
+                };
+                let phi = rng.f64() * std::f64::consts::TAU;
+                let e = (p.axis * theta.cos() + (u * phi.cos() + v * phi.sin()) * theta.sin())
+                    .normalize();
+                let exact = focus_factor(s.focus, s.focus_tint, e.dot(p.axis))
+                    * cone_factor(off_axis_angle(p.axis, e), s.cone, s.start);
+                assert_eq!(super::shaping(&p, e), exact, "cone {angle} softness {softness} at {theta}");
+                checked += 1;
+            }
+        }
+        assert!(checked >= 8 * 2000, "{checked}");
     }
 }

@@ -74,16 +74,26 @@ pub struct ShapingConsts {
     pub cone: f64,
     /// Where the smoothstep starts: `(1 − softness)·θcone`, softness clamped to [0, 1].
     pub start: f64,
+    /// `cos(start)` where start is in [0, π], else 2 (no direction is above it): a direction
+    /// whose cosine with the axis is clearly above it has the cone factor 1 (`cpu::shaping`).
+    pub cos_start: f64,
+    /// `cos(θcone)` where θcone is in [0, π), else −2: a direction whose cosine is clearly
+    /// below it has the cone factor 0.
+    pub cos_cone: f64,
 }
 
 impl ShapingConsts {
     pub fn new(s: &Shaping) -> Self {
         let cone = s.cone_angle.to_radians();
+        let start = (1.0 - s.cone_softness.clamp(0.0, 1.0)) * cone;
+        let pi = std::f64::consts::PI;
         ShapingConsts {
             focus: s.focus,
             focus_tint: s.focus_tint,
             cone,
-            start: (1.0 - s.cone_softness.clamp(0.0, 1.0)) * cone,
+            start,
+            cos_start: if (0.0..=pi).contains(&start) { start.cos() } else { 2.0 },
+            cos_cone: if (0.0..pi).contains(&cone) { cone.cos() } else { -2.0 },
         }
     }
 

@@ -91,7 +91,7 @@ use glam::DVec3;
 
 use super::chart::Chart;
 use crate::prepare::Prepared;
-use kernel::{Kernel, Kinks, RuleKind};
+use kernel::{Class, Kernel};
 use tree::Cell;
 
 /// The tightest tolerance the fast path takes: below it (`Adaptive::for_tolerance` of less
@@ -128,7 +128,8 @@ struct Active {
     value: DVec3,
     err: DVec3,
     bounded: bool,
-    kids: Vec<(Cell, (DVec3, DVec3))>,
+    /// The children, their classes and their rules (value, bound).
+    kids: Vec<(Cell, Class, (DVec3, DVec3))>,
 }
 
 impl PartialEq for Active {
@@ -153,13 +154,23 @@ impl Ord for Active {
 pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option<DVec3> {
     let tree = tree(p.rect_texture()?)?;
     let k = Kernel::new(p, chart, n);
-    let activate = |cell: Cell, (own, own_bound): (DVec3, DVec3)| -> Active {
-        let kids: Vec<(Cell, (DVec3, DVec3))> = tree
+    // A cell's rule serves only its parent's estimate and, until the cell is refined, the
+    // running sum; a forced cell is always refined before the sum is taken (the loop below
+    // does not stop while one is active) and a forced parent's estimate is not used. So a
+    // forced child of a forced parent takes no rule (it would be discarded: half the clipped
+    // rules of a hard cone's receivers were), unless it cannot be split.
+    let activate = |cell: Cell, class: Class, (own, own_bound): (DVec3, DVec3)| -> Active {
+        let kids: Vec<(Cell, Class, (DVec3, DVec3))> = tree
             .children(&cell)
             .into_iter()
             .map(|c| {
-                let v = k.cell_rule(&tree, &c);
-                (c, v)
+                let cc = k.class(&tree, &c);
+                let v = if class.forced && cc.forced && tree.splits(&c) {
+                    (DVec3::ZERO, DVec3::ZERO)
+                } else {
+                    k.cell_rule(&tree, &c, cc)
+                };
+                (c, cc, v)
             })
             .collect();
         if kids.is_empty() {
@@ -171,7 +182,7 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
                 kids,
             };
         }
-        let value: DVec3 = kids.iter().map(|c| c.1.0).sum();
+        let value: DVec3 = kids.iter().map(|c| c.2.0).sum();
         let err = (value - own).abs();
         let r = tree.rect(&cell);
         // A clipped rule samples t at its Gauss points; over more than one texel piece it
@@ -182,17 +193,15 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         // 256 × 128 rect off by 3.0e-4 at every tolerance, a one-texel texture found to 33 %.
         // So such a cell is not trusted on its estimate. Where a shaping kink may cross it, it
         // is split untrusted down to single pieces, where t is a polynomial and the clipped
-        // rule converges. Where only the horizon cuts it, its own rule is the bracket rule
-        // (`Kernel::bracket`: no sampling) whose error is at most `own_bound`, so the
-        // children's sum is off by at most `own_bound + |Σ children − own|` (or the whole
+        // rule converges (`Class::forced`). Where only the horizon cuts it, its own rule is the
+        // bracket rule (`Kernel::bracket`: no sampling) whose error is at most `own_bound`, so
+        // the children's sum is off by at most `own_bound + |Σ children − own|` (or the whole
         // contribution's `Kernel::cut_bound`, where smaller): a bound, not an estimate, held to
         // its own share of the tolerance (`BOUND_SHARE`). One-texel textures were missed by up
         // to 100 % while such cells were trusted on their estimates (module docs).
-        let kinks = k.kinks(r);
-        let cut = tree.pieces(&cell) > 1 && k.rule_kind(r, kinks) == RuleKind::Clipped;
-        let (key, err, bounded) = if k.near(r) || (cut && kinks == Kinks::Other) {
-            (f64::INFINITY, err, false)
-        } else if cut {
+        let (key, err, bounded) = if class.forced {
+            (f64::INFINITY, DVec3::ZERO, false)
+        } else if class.bracketed {
             let b = (own_bound + err).min(k.cut_bound(tree.t_max(&cell), r));
             (b.max_element() * (ESTIMATE_SHARE / BOUND_SHARE), b, true)
         } else {
@@ -207,8 +216,8 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         }
     };
     let root = Cell::Node(0);
-    let own = k.cell_rule(&tree, &root);
-    let first = activate(root, own);
+    let class = k.class(&tree, &root);
+    let first = activate(root, class, k.cell_rule(&tree, &root, class));
     // Estimated errors and a-priori bounds are summed apart, each held to its share of rel.
     let mut total = first.value;
     let mut err = [DVec3::ZERO; 2];
@@ -238,8 +247,8 @@ pub fn chart_integral(p: &Prepared, chart: &Chart, n: DVec3, rel: f64) -> Option
         }
         total -= top.value;
         err[usize::from(top.bounded)] -= top.err;
-        for (c, own) in top.kids {
-            let a = activate(c, own);
+        for (c, class, own) in top.kids {
+            let a = activate(c, class, own);
             total += a.value;
             err[usize::from(a.bounded)] += a.err;
             forced += usize::from(a.key == f64::INFINITY);

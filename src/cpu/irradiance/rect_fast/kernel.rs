@@ -29,7 +29,7 @@ const G5W: [f64; 5] = [
 ];
 
 /// The rule of a cell (see [`Kernel::rule_kind`]).
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy, PartialEq, Debug)]
 pub(super) enum RuleKind {
     Zero,
     Moments,
@@ -48,6 +48,20 @@ pub(super) struct Kernel<'a> {
     /// slope at both ends), so near them it differs from its value there by the square of
     /// the distance in angle ([`Kernel::bracket`]).
     soft_cone: bool,
+}
+
+/// How a cell is integrated and trusted ([`Kernel::class`]).
+#[derive(Clone, Copy, PartialEq, Debug)]
+pub(super) struct Class {
+    pub(super) kind: RuleKind,
+    pub(super) kinks: Kinks,
+    /// Over several texel pieces, cut by the horizon or crossed by a soft cone's kink cones
+    /// and no other kink: the rule is [`Kernel::bracket`], whose error has a bound.
+    pub(super) bracketed: bool,
+    /// Split without being trusted: not well separated from x ([`Kernel::near`]), or over
+    /// several texel pieces where a hard cone's edge, the focus plane or a singular axis may
+    /// cross it (the clipped rule samples t across its texel kinks there).
+    pub(super) forced: bool,
 }
 
 /// How the shaping's kinks meet a cell ([`Kernel::kinks`]).
@@ -116,22 +130,41 @@ impl Kernel<'_> {
         }
     }
 
+    /// How the cell is integrated and trusted, decided once per cell (the parent module's
+    /// `chart_integral` reads it when the cell is refined).
+    pub(super) fn class(&self, tree: &Tree, cell: &Cell) -> Class {
+        let r = tree.rect(cell);
+        let kinks = self.kinks(r);
+        let kind = self.rule_kind(r, kinks);
+        let cut = tree.pieces(cell) > 1 && kind == RuleKind::Clipped;
+        let forced = self.near(r) || (cut && kinks == Kinks::Other);
+        Class {
+            kind,
+            kinks,
+            bracketed: cut && kinks != Kinks::Other,
+            forced,
+        }
+    }
+
     /// The cell's rule (see [`Kernel::rule_kind`]) and a bound of its error where that is known
     /// a priori (the bracket rule's), else 0: a cell over several texel pieces that the horizon
     /// cuts or a soft cone's kink cones may cross, and no other kink, takes
-    /// [`Kernel::bracket`], other cut or kinked cells [`Kernel::clipped`].
-    pub(super) fn cell_rule(&self, tree: &Tree, cell: &Cell) -> (DVec3, DVec3) {
+    /// [`Kernel::bracket`], other cut or kinked cells [`Kernel::clipped`]. `class` is the
+    /// cell's [`Kernel::class`].
+    pub(super) fn cell_rule(&self, tree: &Tree, cell: &Cell, class: Class) -> (DVec3, DVec3) {
         let r = tree.rect(cell);
-        let kinks = self.kinks(r);
-        match self.rule_kind(r, kinks) {
+        match class.kind {
             RuleKind::Zero => (DVec3::ZERO, DVec3::ZERO),
             RuleKind::Moments => (self.rule(r, &tree.moments(cell)), DVec3::ZERO),
-            RuleKind::Clipped if tree.pieces(cell) > 1 && kinks != Kinks::Other => {
+            RuleKind::Clipped if class.bracketed => {
                 let w = tree.moments(cell);
-                let coned = kinks == Kinks::SoftCone;
+                let coned = class.kinks == Kinks::SoftCone;
                 self.bracket(r, &w, tree.abs_integral(cell, r, &w), coned)
             }
-            RuleKind::Clipped => (self.clipped(tree, r), DVec3::ZERO),
+            RuleKind::Clipped => (
+                self.clipped(r, |x, y| tree.value_in(cell, x, y)),
+                DVec3::ZERO,
+            ),
         }
     }
 
@@ -261,9 +294,9 @@ impl Kernel<'_> {
     /// (the roots of `line::line_integral`): that part is bounded by the line and the sides, so with the coordinate the
     /// line is a graph over (the one along which |∂h| is smaller) split where the line leaves
     /// through a side, it is a union of trapezoids mapped onto squares, each integrated by the
-    /// 5 × 5 Gauss–Legendre rule of `t·K` (K smooth there, t sampled). No rule point lies
+    /// 5 × 5 Gauss–Legendre rule of `t·K` (K smooth there, t sampled: `t(x, y)`). No rule point lies
     /// behind the horizon, so no sliver in front of it goes unseen.
-    pub(super) fn clipped(&self, tree: &Tree, r: Rect) -> DVec3 {
+    pub(super) fn clipped(&self, r: Rect, t: impl Fn(f64, f64) -> DVec3) -> DVec3 {
         let (c, a, b) = self.horizon();
         // Work in (u, v) with v the graph coordinate: v_line(u) = −(c + p·u)/q.
         let swap = b.abs() < a.abs();
@@ -350,7 +383,7 @@ impl Kernel<'_> {
                     for (gv, wv) in G5X.iter().zip(&G5W) {
                         let v = vm + vh * gv;
                         let (x, y) = if swap { (v, u) } else { (u, v) };
-                        sum += self.eval(x, y) * tree.value_at(x, y) * (wu * wv * uh * vh);
+                        sum += self.eval(x, y) * t(x, y) * (wu * wv * uh * vh);
                     }
                 }
             }

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use glam::{DMat3, DMat4, DQuat};
 
+use super::kernel::{Kinks, RuleKind};
 use super::tree::Tree;
 use super::*;
 use crate::cpu::irradiance::{Adaptive, Rule, irradiance, irradiance_with};
@@ -364,7 +365,7 @@ fn timing_2048_by_1024() {
 /// each integrated by the clipped rule (t a polynomial there, K smooth on the lit part).
 fn fine_cell_integral(k: &Kernel, tree: &Tree, cell: Cell, depth: u32) -> DVec3 {
     if tree.pieces(&cell) == 1 && depth == 0 {
-        return k.clipped(tree, tree.rect(&cell));
+        return k.clipped(tree.rect(&cell), |x, y| tree.value_in(&cell, x, y));
     }
     let d = if tree.pieces(&cell) == 1 {
         depth - 1
@@ -411,15 +412,15 @@ fn the_bracket_rule_is_within_its_bound() {
                 let mut stack = vec![Cell::Node(0)];
                 while let Some(c) = stack.pop() {
                     let r = tree.rect(&c);
-                    let kinks = k.kinks(r);
-                    if tree.pieces(&c) < 2 || k.rule_kind(r, kinks) != RuleKind::Clipped {
+                    let class = k.class(&tree, &c);
+                    if tree.pieces(&c) < 2 || class.kind != RuleKind::Clipped {
                         continue;
                     }
                     stack.extend(tree.children(&c));
-                    if kinks == Kinks::Other || k.near(r) {
+                    if !class.bracketed || class.forced {
                         continue;
                     }
-                    let coned = kinks == Kinks::SoftCone;
+                    let coned = class.kinks == Kinks::SoftCone;
                     soft += usize::from(coned);
                     let w = tree.moments(&c);
                     let (value, bound) = k.bracket(r, &w, tree.abs_integral(&c, r, &w), coned);

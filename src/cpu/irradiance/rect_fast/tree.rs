@@ -209,6 +209,18 @@ impl Tree {
         self.value(i, j, x, y)
     }
 
+    /// The filtered texture at a chart point of the cell: read from its piece directly where
+    /// the cell is one piece (or part of one), else found by [`Tree::value_at`].
+    #[inline]
+    pub(super) fn value_in(&self, c: &Cell, x: f64, y: f64) -> DVec3 {
+        match c {
+            Cell::Block(r, _) if r[1] - r[0] == 1 && r[3] - r[2] == 1 => {
+                self.value(r[0] as usize, r[2] as usize, x, y)
+            }
+            _ => self.value_at(x, y),
+        }
+    }
+
     /// `W_ab = ∫ t·ℓ_ab` over `rect` (inside the pieces `r`), exact: each piece's part of
     /// `rect` by its 3 × 3 Gauss–Legendre rule.
     fn block_moments(&self, r: [u32; 4], rect: Rect) -> Moments {
@@ -325,6 +337,17 @@ impl Tree {
         (r[1] - r[0]) * (r[3] - r[2])
     }
 
+    /// Whether [`Tree::children`] has any: all but sub-rects too small to split.
+    pub(super) fn splits(&self, c: &Cell) -> bool {
+        match *c {
+            Cell::Block(r, rect) if (r[1] - r[0]) * (r[3] - r[2]) == 1 => {
+                let (cx, cy, hx, hy) = rect.centre();
+                hx > 1e-12 * (1.0 + cx.abs()) && hy > 1e-12 * (1.0 + cy.abs())
+            }
+            _ => true,
+        }
+    }
+
     /// The cell's children; none when it is a sub-rect too small to split.
     pub(super) fn children(&self, c: &Cell) -> Vec<Cell> {
         match *c {
@@ -344,10 +367,10 @@ impl Tree {
                 .map(|r| Cell::Block(r, self.block_rect(r)))
                 .collect(),
             Cell::Block(r, rect) => {
-                let (cx, cy, hx, hy) = rect.centre();
-                if !(hx > 1e-12 * (1.0 + cx.abs()) && hy > 1e-12 * (1.0 + cy.abs())) {
+                if !self.splits(c) {
                     return Vec::new();
                 }
+                let (cx, cy, _, _) = rect.centre();
                 let xs = [(rect.x0, cx), (cx, rect.x1)];
                 let ys = [(rect.y0, cy), (cy, rect.y1)];
                 let mut v = Vec::with_capacity(4);
