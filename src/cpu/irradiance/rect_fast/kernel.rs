@@ -48,6 +48,10 @@ pub(super) struct Kernel<'a> {
     /// slope at both ends), so near them it differs from its value there by the square of
     /// the distance in angle ([`Kernel::bracket`]).
     soft_cone: bool,
+    /// The angle from the axis of each of the shaping's kinks that is a cone (NaN for a
+    /// plane), in the order of `Prepared::profile`: [`Kernel::kinks`] compares it with every
+    /// cell's directions.
+    kink_angles: Vec<f64>,
 }
 
 /// How a cell is integrated and trusted ([`Kernel::class`]).
@@ -84,6 +88,15 @@ impl<'a> Kernel<'a> {
             shaped: s.is_some(),
             s_max: s.map_or(DVec3::ONE, |s| s.factor_bound()),
             soft_cone: s.is_some_and(|s| s.start < s.cone),
+            kink_angles: p
+                .profile
+                .kinks
+                .iter()
+                .map(|k| match *k {
+                    Kink::Cone { cos } => cos.clamp(-1.0, 1.0).acos(),
+                    Kink::Plane { .. } => f64::NAN,
+                })
+                .collect(),
         }
     }
 }
@@ -264,10 +277,10 @@ impl Kernel<'_> {
         let dirs = self.angles(r);
         let corners = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)];
         let mut out = Kinks::None;
-        for k in &self.p.profile.kinks {
+        for (k, &angle) in self.p.profile.kinks.iter().zip(&self.kink_angles) {
             let crosses = match *k {
-                Kink::Cone { cos } => match dirs {
-                    Some((theta, alpha)) => (cos.clamp(-1.0, 1.0).acos() - theta).abs() <= alpha,
+                Kink::Cone { .. } => match dirs {
+                    Some((theta, alpha)) => (angle - theta).abs() <= alpha,
                     None => true,
                 },
                 Kink::Plane { m, .. } => {
@@ -332,6 +345,9 @@ impl Kernel<'_> {
             if q > 0.0 { (l, v1) } else { (v0, l) }
         };
         let mut sum = DVec3::ZERO;
+        // One buffer for every line's breakpoints (an allocation per line was ~5 % of a
+        // shaped receiver's time).
+        let mut bps = Vec::with_capacity(8);
         for w in cuts.windows(2) {
             let (ua, ub) = (w[0], w[1]);
             if !(ub > ua) {
@@ -354,7 +370,8 @@ impl Kernel<'_> {
                 } else {
                     (self.chart.w0 + self.chart.e1 * u, self.chart.e2)
                 };
-                let mut bps = vec![lo, hi];
+                bps.clear();
+                bps.extend([lo, hi]);
                 if self.shaped {
                     for k in &self.p.profile.kinks {
                         match *k {
