@@ -79,6 +79,25 @@ pub fn plane_cone_dirs(m: DVec3, axis: DVec3, cos: f64) -> Vec<DVec3> {
         .collect()
 }
 
+/// The planes through the origin that contain the direction `d` and are tangent to the cone of
+/// unit `axis` and cosine `cos`: unit normals m ⊥ d with |m·axis| = sin θ. None where no such
+/// plane exists (the line of d runs inside the cone). The CPU's rules split there: a pencil of
+/// lines along d meets the cone in two roots that appear together at these planes, so the
+/// integral across the lines has a square-root point there (`critical::pencil_tangent_ys`,
+/// `rect_fast`'s `kink_cuts`). CPU only: the WGSL `pencil_tangent_ys` inlines it.
+pub fn pencil_tangent_normals(d: DVec3, axis: DVec3, cos: f64) -> Option<[DVec3; 2]> {
+    let s = (1.0 - cos * cos).max(0.0).sqrt();
+    let (m1, m2) = d.normalize().any_orthonormal_pair();
+    let (pa, pb) = (m1.dot(axis), m2.dot(axis));
+    let ra = pa.hypot(pb);
+    if !(ra >= s && ra > 0.0) {
+        return None;
+    }
+    let t0 = pb.atan2(pa);
+    let dt = (s / ra).clamp(-1.0, 1.0).acos();
+    Some([t0 + dt, t0 - dt].map(|t| m1 * t.cos() + m2 * t.sin()))
+}
+
 /// X where w = a + X e1 makes its smallest (or largest) angle with the axis: the stationary
 /// point of ŵ·axis, `(e1·p)|w|² = (w·p)(w·e1)`, which is linear in X.
 pub fn axis_approach(axis: DVec3, a: DVec3, e1: DVec3) -> Option<f64> {

@@ -218,7 +218,11 @@ mod tests {
                     .normalize();
                 let exact = focus_factor(s.focus, s.focus_tint, e.dot(p.axis))
                     * cone_factor(off_axis_angle(p.axis, e), s.cone, s.start);
-                assert_eq!(super::shaping(&p, e), exact, "cone {angle} softness {softness} at {theta}");
+                assert_eq!(
+                    super::shaping(&p, e),
+                    exact,
+                    "cone {angle} softness {softness} at {theta}"
+                );
                 checked += 1;
             }
         }

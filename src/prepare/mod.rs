@@ -92,8 +92,16 @@ impl ShapingConsts {
             focus_tint: s.focus_tint,
             cone,
             start,
-            cos_start: if (0.0..=pi).contains(&start) { start.cos() } else { 2.0 },
-            cos_cone: if (0.0..pi).contains(&cone) { cone.cos() } else { -2.0 },
+            cos_start: if (0.0..=pi).contains(&start) {
+                start.cos()
+            } else {
+                2.0
+            },
+            cos_cone: if (0.0..pi).contains(&cone) {
+                cone.cos()
+            } else {
+                -2.0
+            },
         }
     }
 

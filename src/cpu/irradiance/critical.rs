@@ -24,7 +24,8 @@ use std::f64::consts::PI;
 
 use super::chart::{Arc, Chart, Region, arc_at, make_chart};
 use crate::cpu::roots::{
-    bracket_roots, cone_roots_on_line, lin_trig_roots, plane_cone_dirs, wrap_into,
+    bracket_roots, cone_roots_on_line, lin_trig_roots, pencil_tangent_normals, plane_cone_dirs,
+    wrap_into,
 };
 use crate::prepare::ies_kinks::IesKinks;
 use crate::prepare::{Kink, Prepared, PreparedIes, Profile};
@@ -53,10 +54,9 @@ fn push_dir(ys: &mut Vec<f64>, w: DVec3, chart: &Chart) {
     }
 }
 
-/// Crossings of the cone −ŵ·axis = cos with an elliptic arc (correct nappe).
 /// The lines where the planes of the pencil (through the receiver, containing the chart's
-/// `e1`) are tangent to the cone of `axis` and cosine `c`: unit normals m ⊥ e1 with
-/// |m·axis| = sin θ, each meeting the chart at Y = −m·w0 / m·e2.
+/// `e1`) are tangent to the cone of `axis` and cosine `c` (`roots::pencil_tangent_normals`),
+/// each meeting the chart at Y = −m·w0 / m·e2.
 fn pencil_tangent_ys(
     ys: &mut Vec<f64>,
     chart: &Chart,
@@ -64,23 +64,15 @@ fn pencil_tangent_ys(
     axis: DVec3,
     c: f64,
 ) {
-    let s = (1.0 - c * c).max(0.0).sqrt();
-    let (m1, m2) = e1.normalize().any_orthonormal_pair();
-    let (pa, pb) = (m1.dot(axis), m2.dot(axis));
-    let ra = pa.hypot(pb);
-    if ra >= s && ra > 0.0 {
-        let t0 = pb.atan2(pa);
-        let d = (s / ra).clamp(-1.0, 1.0).acos();
-        for t in [t0 + d, t0 - d] {
-            let mm = m1 * t.cos() + m2 * t.sin();
-            let me2 = mm.dot(e2);
-            if me2 != 0.0 {
-                push_y(ys, -mm.dot(w0) / me2, chart);
-            }
+    for m in pencil_tangent_normals(e1, axis, c).into_iter().flatten() {
+        let me2 = m.dot(e2);
+        if me2 != 0.0 {
+            push_y(ys, -m.dot(w0) / me2, chart);
         }
     }
 }
 
+/// Crossings of the cone −ŵ·axis = cos with an elliptic arc (correct nappe).
 fn arc_cone_crossings(
     ys: &mut Vec<f64>,
     chart: &Chart,

@@ -8,7 +8,7 @@ use glam::DVec3;
 
 use super::tree::{Cell, GX, Moments, Rect, Tree};
 use crate::cpu::irradiance::chart::Chart;
-use crate::cpu::roots::{axis_approach, cone_roots_on_line};
+use crate::cpu::roots::{axis_approach, cone_roots_on_line, pencil_tangent_normals};
 use crate::cpu::shaping::{cone_factor, focus_factor, shaping};
 use crate::prepare::{Kink, Prepared};
 
@@ -440,20 +440,11 @@ impl Kernel<'_> {
                         us.extend(cone_roots_on_line(axis, cos, a, d));
                     }
                     // Planes through x containing ev (the lines u = const) tangent to the
-                    // cone: normals m ⊥ ev with |m·axis| = sin θ (as `critical.rs`'s
-                    // pencil tangents, with the roles of the chart axes swapped or not).
-                    let s = (1.0 - cos * cos).max(0.0).sqrt();
-                    let (m1, m2) = ev.normalize().any_orthonormal_pair();
-                    let (pa, pb) = (m1.dot(axis), m2.dot(axis));
-                    let ra = pa.hypot(pb);
-                    if ra >= s && ra > 0.0 {
-                        let t0 = pb.atan2(pa);
-                        let d = (s / ra).clamp(-1.0, 1.0).acos();
-                        for t in [t0 + d, t0 - d] {
-                            let m = m1 * t.cos() + m2 * t.sin();
-                            if m.dot(eu) != 0.0 {
-                                us.push(-m.dot(ch.w0) / m.dot(eu));
-                            }
+                    // cone (as `critical.rs`'s pencil tangents, with the roles of the chart
+                    // axes swapped or not).
+                    for m in pencil_tangent_normals(ev, axis, cos).into_iter().flatten() {
+                        if m.dot(eu) != 0.0 {
+                            us.push(-m.dot(ch.w0) / m.dot(eu));
                         }
                     }
                 }

@@ -200,12 +200,16 @@ impl Tree {
     /// The texel weights of piece i along X at chart X (and of piece j along Y at chart Y).
     #[inline]
     fn weights_x(&self, i: usize, x: f64) -> (f64, f64) {
-        self.px[i].0.weights(0.5 * (1.0 - x) * self.img.width as f64)
+        self.px[i]
+            .0
+            .weights(0.5 * (1.0 - x) * self.img.width as f64)
     }
 
     #[inline]
     fn weights_y(&self, j: usize, y: f64) -> (f64, f64) {
-        self.py[j].0.weights(0.5 * (1.0 - y) * self.img.height as f64)
+        self.py[j]
+            .0
+            .weights(0.5 * (1.0 - y) * self.img.height as f64)
     }
 
     /// The filtered texture on piece (i, j) at chart (X, Y) (inside the piece).
