@@ -9,6 +9,7 @@ pub mod alias;
 pub mod assets;
 pub mod blackbody;
 pub mod env_table;
+mod fits_f32;
 pub mod gpu_path;
 pub mod ies;
 pub mod ies_kinks;
@@ -17,6 +18,7 @@ pub mod mesh_class;
 pub mod normalize;
 pub mod portal;
 pub mod profile;
+mod shaping;
 pub mod texture;
 pub mod zero_size;
 
@@ -25,10 +27,11 @@ use std::sync::Arc;
 use glam::{DMat3, DVec3};
 
 use crate::error::{AssetError, LuxError, Result};
-use crate::model::{Light, LightType, Shaping, Texture, UpAxis};
+use crate::model::{Light, LightType, Texture, UpAxis};
 use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
+use fits_f32::check_fits_f32;
 pub use gpu_path::{
     GpuPath, MESH_DEVICE_BYTES, MESH_FRONTS_ON_DEVICE, MESH_STACK, MESH_TRIANGLES_SUMMED,
     PORTALS_ON_DEVICE,
@@ -36,6 +39,7 @@ pub use gpu_path::{
 pub use mesh_class::MeshOcclusion;
 pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
+pub use shaping::{ShapingConsts, shaping_is_identity};
 
 /// A light's IES profile as both backends evaluate it (DESIGN.md §6 I7): the factor along a
 /// light-space emission direction e is `scale · Î(e)` with Î the profile's bilinear interpolant
@@ -60,55 +64,6 @@ impl PreparedIes {
     pub fn device_families(&self) -> Option<ies_kinks::KinkFamilies> {
         let bent = self.angle_scale != 0.0 && self.profile.kind != ies::PhotometricType::C;
         if bent { None } else { self.kinks.families() }
-    }
-}
-
-/// ShapingAPI's inputs as the evaluation uses them (DESIGN.md §2 "Shaping", spec/002).
-#[derive(Clone, Debug, PartialEq)]
-pub struct ShapingConsts {
-    /// `shaping:focus` (≤ 0: no focus).
-    pub focus: f64,
-    /// `shaping:focusTint`.
-    pub focus_tint: DVec3,
-    /// θcone in radians.
-    pub cone: f64,
-    /// Where the smoothstep starts: `(1 − softness)·θcone`, softness clamped to [0, 1].
-    pub start: f64,
-    /// `cos(start)` where start is in [0, π], else 2 (no direction is above it): a direction
-    /// whose cosine with the axis is clearly above it has the cone factor 1 (`cpu::shaping`).
-    pub cos_start: f64,
-    /// `cos(θcone)` where θcone is in [0, π), else −2: a direction whose cosine is clearly
-    /// below it has the cone factor 0.
-    pub cos_cone: f64,
-}
-
-impl ShapingConsts {
-    pub fn new(s: &Shaping) -> Self {
-        let cone = s.cone_angle.to_radians();
-        let start = (1.0 - s.cone_softness.clamp(0.0, 1.0)) * cone;
-        let pi = std::f64::consts::PI;
-        ShapingConsts {
-            focus: s.focus,
-            focus_tint: s.focus_tint,
-            cone,
-            start,
-            cos_start: if (0.0..=pi).contains(&start) {
-                start.cos()
-            } else {
-                2.0
-            },
-            cos_cone: if (0.0..pi).contains(&cone) {
-                cone.cos()
-            } else {
-                -2.0
-            },
-        }
-    }
-
-    /// A bound of the shaping factor's size per channel, IES aside: the cone factor lies in
-    /// [0, 1] and the focus factor `tint + f·(1 − tint)` (f in [0, 1]) between tint and 1.
-    pub fn factor_bound(&self) -> DVec3 {
-        DVec3::ONE.max(self.focus_tint.abs())
     }
 }
 
@@ -570,152 +525,6 @@ fn prepare_rect_texture(
     Ok(texture::RectTexture::new(image, t.filter))
 }
 
-/// The largest magnitude of a length (a position, a size, an entry of the world transform or
-/// its inverse) that luxeval evaluates: its square must fit float32 (3.4e38) with room to spare,
-/// since the kernels square lengths.
-pub const MAX_LENGTH: f64 = 1e18;
-
-/// Refuses a light whose constants do not fit the float32 the GPU record holds and every output
-/// is written in, naming the attribute that makes it so (docs/INPUTS.md "float32"). Both paths
-/// refuse the same lights, before any work. The radiance bound leaves room for what the queries
-/// multiply it by: the focus tint (emission, radiance) and π · diffuse (irradiance).
-fn check_fits_f32(
-    light: &Light,
-    base: DVec3,
-    size_factor: f64,
-    mode: TemperatureMode,
-) -> Result<()> {
-    let i = &light.inputs;
-    let tint = light
-        .shaping
-        .as_ref()
-        .map_or(1.0, |s| s.focus_tint.abs().max_element().max(1.0));
-    let gain = tint * (std::f64::consts::PI * i.diffuse.abs()).max(1.0);
-    let peak = base.abs().max_element() * gain;
-    if !(peak <= f32::MAX as f64) {
-        // Blame the factor that contributes most (in octaves) to the overflow.
-        let temp = if i.enable_color_temperature {
-            temperature_rgb(i.color_temperature, mode)
-                .abs()
-                .max_element()
-        } else {
-            1.0
-        };
-        let factors = [
-            (
-                "inputs:intensity",
-                i.intensity.to_string(),
-                i.intensity.abs(),
-            ),
-            (
-                "inputs:exposure",
-                i.exposure.to_string(),
-                2f64.powf(i.exposure),
-            ),
-            (
-                "inputs:color",
-                format!("{:?}", i.color.to_array()),
-                i.color.abs().max_element(),
-            ),
-            (
-                "inputs:colorTemperature",
-                i.color_temperature.to_string(),
-                temp,
-            ),
-            ("inputs:normalize", "true".to_string(), 1.0 / size_factor),
-            ("inputs:shaping:focusTint", format!("{tint}"), tint),
-            ("inputs:diffuse", i.diffuse.to_string(), i.diffuse.abs()),
-        ];
-        let (attr, value, _) = factors
-            .iter()
-            .max_by(|a, b| a.2.log2().total_cmp(&b.2.log2()))
-            .expect("non-empty");
-        return Err(LuxError::attr(
-            &light.path,
-            attr,
-            value,
-            format!(
-                "the light's radiance (intensity · 2^exposure · color / sizeFactor = {:e}, \
-                 times focusTint and π · diffuse for its results) does not fit float32 \
-                 (largest {:e}), which the GPU evaluates in and every output is written in",
-                base.abs().max_element(),
-                f32::MAX
-            ),
-        ));
-    }
-    let sizes: &[(&str, f64)] = match light.kind {
-        LightType::Sphere { radius, .. } | LightType::Disk { radius } => {
-            &[("inputs:radius", radius)]
-        }
-        LightType::Rect { width, height } => &[("inputs:width", width), ("inputs:height", height)],
-        LightType::Cylinder { length, radius, .. } => {
-            &[("inputs:length", length), ("inputs:radius", radius)]
-        }
-        LightType::Distant { .. } | LightType::Dome => &[],
-        LightType::Mesh { ref geometry, .. } => {
-            let far = geometry
-                .triangles
-                .iter()
-                .flat_map(|t| t.p)
-                .enumerate()
-                .find(|(_, v)| v.abs().max_element() > MAX_LENGTH);
-            if let Some((i, v)) = far {
-                return Err(LuxError::attr(
-                    &light.path,
-                    "points",
-                    format!(
-                        "({}, {}, {}) in world space (triangle {})",
-                        v.x,
-                        v.y,
-                        v.z,
-                        i / 3
-                    ),
-                    format!("beyond {MAX_LENGTH:e}, whose square would overflow float32"),
-                ));
-            }
-            // The triangles are in world space: the transform only orients shaping.
-            if light.shaping.is_none() {
-                return Ok(());
-            }
-            &[]
-        }
-    };
-    for (attr, v) in sizes {
-        if v.abs() > MAX_LENGTH {
-            return Err(LuxError::attr(
-                &light.path,
-                attr,
-                v,
-                format!("larger than {MAX_LENGTH:e}, whose square would overflow float32"),
-            ));
-        }
-    }
-    let linear = light.linear();
-    let to_local = linear.inverse();
-    let entries = linear
-        .to_cols_array()
-        .into_iter()
-        .chain(to_local.to_cols_array())
-        .chain(light.origin().to_array());
-    if let Some(v) = entries.into_iter().find(|v| v.abs() > MAX_LENGTH) {
-        return Err(LuxError::InvalidTransform {
-            light: light.path.clone(),
-            reason: format!(
-                "has an entry (or an entry of its inverse) of {v:e}, beyond {MAX_LENGTH:e}: \
-                 its square would overflow float32"
-            ),
-        });
-    }
-    let det = linear.determinant().abs();
-    if !(det >= f32::MIN_POSITIVE as f64 && det <= f32::MAX as f64) {
-        return Err(LuxError::InvalidTransform {
-            light: light.path.clone(),
-            reason: format!("scales volumes by {det:e}, outside float32's normal range"),
-        });
-    }
-    Ok(())
-}
-
 /// `intensity · 2^exposure · color ⊙ temperature(T)` (spec/001 intensity, exposure, color,
 /// colorTemperature), before normalize and shaping.
 pub fn base_radiance(light: &Light, mode: TemperatureMode) -> DVec3 {
@@ -750,16 +559,6 @@ fn distinct_fronts(triangles: &[crate::model::MeshTriangle]) -> Vec<DVec3> {
         .into_iter()
         .map(|(k, _)| DVec3::from_array(k.map(f64::from_bits)))
         .collect()
-}
-
-/// Whether ShapingAPI's factor is exactly 1 along every direction: no focus (or a white tint), a
-/// cone whose smoothstep starts at or beyond 180° (luxtest authors cone 180, softness 0, to mean
-/// "no cone") and no IES profile. Such a ShapingAPI is dropped from [`Prepared::light`]: the
-/// values are the same, and irradiance can use its closed forms.
-pub fn shaping_is_identity(s: &Shaping) -> bool {
-    let no_focus = s.focus <= 0.0 || s.focus_tint == DVec3::ONE;
-    let start_deg = (1.0 - s.cone_softness.clamp(0.0, 1.0)) * s.cone_angle;
-    no_focus && start_deg >= 180.0 && s.ies.is_none()
 }
 
 /// The tilt angle τ of DESIGN.md §6 I5 in degrees: between the light's world primary axis and
