@@ -153,6 +153,59 @@ fn arc_push_root(ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32
     }
 }
 
+// The Ys where a plane m·w = 0 through x meets the chart's inner structure: the line of the
+// pencil lying in it, its crossings with the square's sides and with the arcs (critical_ys's
+// planes and ies_ys's profile planes).
+fn plane_ys(ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32>, c: Chart, m: vec3<f32>) {
+    let me1 = dot(m, c.e1);
+    let me2 = dot(m, c.e2);
+    let mw0 = dot(m, c.w0);
+    if abs(me1) <= 1e-5 * length(m) * length(c.e1) && me2 != 0.0 {
+        push_y(ys, count, -mw0 / me2, c);
+    }
+    if c.region == REGION_SQUARE && me2 != 0.0 {
+        push_y(ys, count, -(mw0 - me1) / me2, c);
+        push_y(ys, count, -(mw0 + me1) / me2, c);
+    }
+    for (var ai = 0u; ai < c.n_arcs; ai++) {
+        let cc = select(c.arc_c0, c.arc_c1, ai == 1u);
+        let r = lin_trig_roots(dot(m, c.arc_u), dot(m, c.arc_v), -dot(m, cc));
+        if r.z > 0.0 {
+            let ta = wrap_into(r.x, c.t0);
+            if ta <= c.t1 {
+                push_dir(ys, count, arc_at(c, ai, ta), c);
+            }
+            let tb = wrap_into(r.y, c.t0);
+            if tb <= c.t1 {
+                push_dir(ys, count, arc_at(c, ai, tb), c);
+            }
+        }
+    }
+}
+
+// The Ys where the cone of `axis` and cosine cs meets the chart's inner structure: tangent to a
+// line of the pencil, crossing the square's sides and the arcs (critical_ys's kink cones and
+// ies_ys's profile cones).
+fn cone_ys(ys: ptr<function, array<f32, MAX_YS>>, count: ptr<function, u32>, c: Chart, axis: vec3<f32>, cs: f32) {
+    pencil_tangent_ys(ys, count, c, axis, cs);
+    if c.region == REGION_SQUARE {
+        for (var k = 0; k < 2; k++) {
+            let xs = select(1.0, -1.0, k == 0);
+            let r = cone_roots_on_line(axis, cs, c.w0 + c.e1 * xs, c.e2);
+            let mask = u32(r.z);
+            if (mask & 1u) != 0u {
+                push_y(ys, count, r.x, c);
+            }
+            if (mask & 2u) != 0u {
+                push_y(ys, count, r.y, c);
+            }
+        }
+    }
+    for (var ai = 0u; ai < c.n_arcs; ai++) {
+        arc_cone_crossings(ys, count, c, ai, axis, cs);
+    }
+}
+
 // The Y values where the inner structure of the chart integral changes, sorted and
 // de-duplicated, including the region's Y-range ends (see the CPU twin).
 fn critical_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f32, MAX_YS>>) -> u32 {
@@ -165,30 +218,7 @@ fn critical_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f3
     let n_cones = kink_count(light);
     for (var pi = 0u; pi < n_planes; pi++) {
         let m = select(n, axis, pi == 1u);
-        let me1 = dot(m, c.e1);
-        let me2 = dot(m, c.e2);
-        let mw0 = dot(m, c.w0);
-        if abs(me1) <= 1e-5 * length(m) * length(c.e1) && me2 != 0.0 {
-            push_y(ys, &count, -mw0 / me2, c);
-        }
-        if c.region == REGION_SQUARE && me2 != 0.0 {
-            push_y(ys, &count, -(mw0 - me1) / me2, c);
-            push_y(ys, &count, -(mw0 + me1) / me2, c);
-        }
-        for (var ai = 0u; ai < c.n_arcs; ai++) {
-            let cc = select(c.arc_c0, c.arc_c1, ai == 1u);
-            let r = lin_trig_roots(dot(m, c.arc_u), dot(m, c.arc_v), -dot(m, cc));
-            if r.z > 0.0 {
-                let ta = wrap_into(r.x, c.t0);
-                if ta <= c.t1 {
-                    push_dir(ys, &count, arc_at(c, ai, ta), c);
-                }
-                let tb = wrap_into(r.y, c.t0);
-                if tb <= c.t1 {
-                    push_dir(ys, &count, arc_at(c, ai, tb), c);
-                }
-            }
-        }
+        plane_ys(ys, &count, c, m);
         // Plane ∩ the other plane.
         if n_planes == 2u {
             let d = cross(n, axis);
@@ -206,24 +236,7 @@ fn critical_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f3
         }
     }
     for (var ci = 0u; ci < n_cones; ci++) {
-        let cs = kink_cos(light, ci);
-        pencil_tangent_ys(ys, &count, c, axis, cs);
-        if c.region == REGION_SQUARE {
-            for (var k = 0; k < 2; k++) {
-                let xs = select(1.0, -1.0, k == 0);
-                let r = cone_roots_on_line(axis, cs, c.w0 + c.e1 * xs, c.e2);
-                let mask = u32(r.z);
-                if (mask & 1u) != 0u {
-                    push_y(ys, &count, r.x, c);
-                }
-                if (mask & 2u) != 0u {
-                    push_y(ys, &count, r.y, c);
-                }
-            }
-        }
-        for (var ai = 0u; ai < c.n_arcs; ai++) {
-            arc_cone_crossings(ys, &count, c, ai, axis, cs);
-        }
+        cone_ys(ys, &count, c, axis, kink_cos(light, ci));
     }
     // The outer integrand peaks where a curve bounding the inner intervals (a region edge, a
     // cone edge, the focus line) comes nearest to x: split there too.
@@ -341,23 +354,7 @@ fn ies_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f32, MA
         if abs(theta_c - theta_k) > alpha {
             continue;
         }
-        pencil_tangent_ys(ys, count, lc, axis_c, cs);
-        if lc.region == REGION_SQUARE {
-            for (var side = 0u; side < 2u; side++) {
-                let xs = select(1.0, -1.0, side == 0u);
-                let rr = cone_roots_on_line(axis_c, cs, lc.w0 + lc.e1 * xs, lc.e2);
-                let mask = u32(rr.z);
-                if (mask & 1u) != 0u {
-                    push_y(ys, count, rr.x, lc);
-                }
-                if (mask & 2u) != 0u {
-                    push_y(ys, count, rr.y, lc);
-                }
-            }
-        }
-        for (var ai = 0u; ai < lc.n_arcs; ai++) {
-            arc_cone_crossings(ys, count, lc, ai, axis_c, cs);
-        }
+        cone_ys(ys, count, lc, axis_c, cs);
         for (var f = 0u; f < n_fixed; f++) {
             let dirs = plane_cone_dirs(select(fixed0, fixed1, f == 1u), axis_c, cs);
             if dirs.ok {
@@ -377,30 +374,7 @@ fn ies_ys(light: Record, c: Chart, n: vec3<f32>, ys: ptr<function, array<f32, MA
         if asin(min(abs(dot(normalize(m), cdir)), 1.0)) > alpha {
             continue;
         }
-        let me1 = dot(m, lc.e1);
-        let me2 = dot(m, lc.e2);
-        let mw0 = dot(m, lc.w0);
-        if abs(me1) <= 1e-5 * length(m) * length(lc.e1) && me2 != 0.0 {
-            push_y(ys, count, -mw0 / me2, lc);
-        }
-        if lc.region == REGION_SQUARE && me2 != 0.0 {
-            push_y(ys, count, -(mw0 - me1) / me2, lc);
-            push_y(ys, count, -(mw0 + me1) / me2, lc);
-        }
-        for (var ai = 0u; ai < lc.n_arcs; ai++) {
-            let cc = select(lc.arc_c0, lc.arc_c1, ai == 1u);
-            let rt = lin_trig_roots(dot(m, lc.arc_u), dot(m, lc.arc_v), -dot(m, cc));
-            if rt.z > 0.0 {
-                let ta = wrap_into(rt.x, lc.t0);
-                if ta <= lc.t1 {
-                    push_dir(ys, count, arc_at(lc, ai, ta), lc);
-                }
-                let tb = wrap_into(rt.y, lc.t0);
-                if tb <= lc.t1 {
-                    push_dir(ys, count, arc_at(lc, ai, tb), lc);
-                }
-            }
-        }
+        plane_ys(ys, count, lc, m);
         for (var f = 0u; f < n_fixed; f++) {
             let d = cross(m, select(fixed0, fixed1, f == 1u));
             if dot(d, d) > 0.0 {

@@ -119,6 +119,69 @@ fn arc_f(arc: &Arc, axis: DVec3, cos: f64, t: f64) -> (f64, f64) {
     )
 }
 
+/// The region's elliptic arcs (a disk's rim, a cylinder's), none for a square.
+fn region_arcs(region: &Region, (w0, e1, e2): (DVec3, DVec3, DVec3)) -> Vec<Arc> {
+    match region {
+        Region::Square => vec![],
+        Region::Disk => vec![Arc {
+            c: w0,
+            u: e1,
+            v: e2,
+            t0: 0.0,
+            t1: 2.0 * PI,
+        }],
+        Region::Cylinder(c) => c.arcs.to_vec(),
+    }
+}
+
+/// The Ys where a plane m·w = 0 through x meets the chart's inner structure: the line of the
+/// pencil lying in it, its crossings with the straight edges X = xs (`segs`) and with the arcs
+/// ([`critical_ys_with`]'s planes and [`ies_ys`]'s profile planes).
+fn plane_ys(ys: &mut Vec<f64>, chart: &Chart, segs: &[f64], arcs: &[Arc], m: DVec3) {
+    let (me1, me2, mw0) = (m.dot(chart.e1), m.dot(chart.e2), m.dot(chart.w0));
+    if me1.abs() <= 1e-12 * m.length() * chart.e1.length() && me2 != 0.0 {
+        // A plane of the pencil: one line Y = const lies in it.
+        push_y(ys, -mw0 / me2, chart);
+    }
+    if me2 != 0.0 {
+        for &xs in segs {
+            push_y(ys, -(mw0 + xs * me1) / me2, chart);
+        }
+    }
+    for arc in arcs {
+        for t in lin_trig_roots(m.dot(arc.u), m.dot(arc.v), -m.dot(arc.c)) {
+            let t = wrap_into(t, arc.t0);
+            if t <= arc.t1 {
+                push_dir(ys, arc_at(arc, t), chart);
+            }
+        }
+    }
+}
+
+/// The Ys where the cone of `axis` and cosine `c` meets the chart's inner structure: tangent
+/// to a line of the pencil, crossing the straight edges X = xs (a quadratic in Y) and the arcs
+/// ([`critical_ys_with`]'s kink cones and [`ies_ys`]'s profile cones).
+fn cone_ys(
+    ys: &mut Vec<f64>,
+    chart: &Chart,
+    segs: &[f64],
+    arcs: &[Arc],
+    axis: DVec3,
+    c: f64,
+    arc_samples: usize,
+) {
+    let (w0, e1, e2) = (chart.w0, chart.e1, chart.e2);
+    pencil_tangent_ys(ys, chart, (w0, e1, e2), axis, c);
+    for &xs in segs {
+        for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
+            push_y(ys, y, chart);
+        }
+    }
+    for arc in arcs {
+        arc_cone_crossings(ys, chart, arc, axis, c, arc_samples);
+    }
+}
+
 /// The Y values where the inner structure of the chart integral changes (see the module docs),
 /// sorted, within and including the region's Y-range.
 pub fn critical_ys(p: &Prepared, chart: &Chart, n: DVec3) -> Vec<f64> {
@@ -158,36 +221,9 @@ pub fn critical_ys_with(
     for y in super::rect_texture::texel_ys(p, chart) {
         push_y(&mut ys, y, chart);
     }
-    let arcs: Vec<Arc> = match &chart.region {
-        Region::Square => vec![],
-        Region::Disk => vec![Arc {
-            c: w0,
-            u: e1,
-            v: e2,
-            t0: 0.0,
-            t1: 2.0 * PI,
-        }],
-        Region::Cylinder(c) => c.arcs.to_vec(),
-    };
+    let arcs = region_arcs(&chart.region, (w0, e1, e2));
     for &m in &planes {
-        let (me1, me2, mw0) = (m.dot(e1), m.dot(e2), m.dot(w0));
-        if me1.abs() <= 1e-12 * m.length() * e1.length() && me2 != 0.0 {
-            // A plane of the pencil: one line Y = const lies in it.
-            push_y(&mut ys, -mw0 / me2, chart);
-        }
-        if me2 != 0.0 {
-            for &xs in &segs {
-                push_y(&mut ys, -(mw0 + xs * me1) / me2, chart);
-            }
-        }
-        for arc in &arcs {
-            for t in lin_trig_roots(m.dot(arc.u), m.dot(arc.v), -m.dot(arc.c)) {
-                let t = wrap_into(t, arc.t0);
-                if t <= arc.t1 {
-                    push_dir(&mut ys, arc_at(arc, t), chart);
-                }
-            }
-        }
+        plane_ys(&mut ys, chart, &segs, &arcs, m);
         // Plane ∩ plane: the line through x along m × m'.
         for &m2 in &planes {
             let d = m.cross(m2);
@@ -204,17 +240,7 @@ pub fn critical_ys_with(
         }
     }
     for &c in &cones {
-        pencil_tangent_ys(&mut ys, chart, (w0, e1, e2), axis, c);
-        // Cone ∩ straight edges X = xs: quadratic in Y.
-        for &xs in &segs {
-            for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
-                push_y(&mut ys, y, chart);
-            }
-        }
-        // Cone ∩ elliptic arcs.
-        for arc in &arcs {
-            arc_cone_crossings(&mut ys, chart, arc, axis, c, arc_samples);
-        }
+        cone_ys(&mut ys, chart, &segs, &arcs, axis, c, arc_samples);
     }
     // The outer integrand peaks where a curve bounding the inner intervals (a region edge, a
     // cone edge, the focus line) comes nearest to x: split there too.
@@ -314,36 +340,10 @@ pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f6
         Region::Square => vec![-1.0, 1.0],
         _ => vec![],
     };
-    let arcs: Vec<Arc> = match &lc.region {
-        Region::Square => vec![],
-        Region::Disk => vec![Arc {
-            c: w0,
-            u: e1,
-            v: e2,
-            t0: 0.0,
-            t1: 2.0 * PI,
-        }],
-        Region::Cylinder(c) => c.arcs.to_vec(),
-    };
+    let arcs = region_arcs(&lc.region, (w0, e1, e2));
     let mut ys = Vec::new();
     for &m in &kinks.planes {
-        let (me1, me2, mw0) = (m.dot(e1), m.dot(e2), m.dot(w0));
-        if me1.abs() <= 1e-12 * m.length() * e1.length() && me2 != 0.0 {
-            push_y(&mut ys, -mw0 / me2, &lc);
-        }
-        if me2 != 0.0 {
-            for &xs in &segs {
-                push_y(&mut ys, -(mw0 + xs * me1) / me2, &lc);
-            }
-        }
-        for arc in &arcs {
-            for t in lin_trig_roots(m.dot(arc.u), m.dot(arc.v), -m.dot(arc.c)) {
-                let t = wrap_into(t, arc.t0);
-                if t <= arc.t1 {
-                    push_dir(&mut ys, arc_at(arc, t), &lc);
-                }
-            }
-        }
+        plane_ys(&mut ys, &lc, &segs, &arcs, m);
         for &m2 in fixed.iter().chain(&kinks.planes) {
             let d = m.cross(m2);
             if d.length_squared() > 0.0 {
@@ -358,15 +358,7 @@ pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f6
         }
     }
     for &(axis, c) in &kinks.cones {
-        pencil_tangent_ys(&mut ys, &lc, (w0, e1, e2), axis, c);
-        for &xs in &segs {
-            for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
-                push_y(&mut ys, y, &lc);
-            }
-        }
-        for arc in &arcs {
-            arc_cone_crossings(&mut ys, &lc, arc, axis, c, LOOSE_ARC_SAMPLES);
-        }
+        cone_ys(&mut ys, &lc, &segs, &arcs, axis, c, LOOSE_ARC_SAMPLES);
         for &m in &fixed {
             for w in plane_cone_dirs(m, axis, c) {
                 push_dir(&mut ys, w, &lc);
