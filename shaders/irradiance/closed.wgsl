@@ -9,6 +9,8 @@
 // GPU-only rect_above_horizon: the kernel leaves a rect clipped by the receiver's horizon to
 //   the quadrature (a clipped sliver cancels like its thinness in f32), see irradiance.wgsl.
 // f32: rect_lambert is the CPU's rect_lambert and polygon_irradiance in one function.
+// f32: clip_above takes at most 4 vertices (a rect's, a triangle's) and returns at most 6 in a
+//   fixed array (ClippedPolygon); the CPU's takes a slice and returns a Vec.
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
@@ -115,28 +117,14 @@ fn rect_lambert(light: Record, x: vec3<f32>, n: vec3<f32>) -> f32 {
     let o = world_origin(light) - x;
     let a = light.world_x.xyz * light.size.x;
     let b = light.world_y.xyz * light.size.y;
-    var q = array<vec3<f32>, 4>(o - a - b, o + a - b, o + a + b, o - a + b);
+    let q = array<vec3<f32>, 4>(o - a - b, o + a - b, o + a + b, o - a + b);
     let sigma = sign(dot(cross(q[1] - q[0], q[2] - q[1]), q[0]));
-    var clipped: array<vec3<f32>, 6>;
-    var count = 0u;
-    for (var i = 0u; i < 4u; i++) {
-        let p0 = q[i];
-        let p1 = q[(i + 1u) % 4u];
-        let d0 = dot(n, p0);
-        let d1 = dot(n, p1);
-        if d0 >= 0.0 {
-            clipped[count] = p0;
-            count += 1u;
-        }
-        if (d0 >= 0.0) != (d1 >= 0.0) {
-            clipped[count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
-            count += 1u;
-        }
-    }
+    let clipped = clip_above(q, 4u, n);
+    let count = clipped.count;
     var sum = 0.0;
     for (var i = 0u; i < count; i++) {
-        let p0 = clipped[i];
-        let p1 = clipped[(i + 1u) % count];
+        let p0 = clipped.p[i];
+        let p1 = clipped.p[(i + 1u) % count];
         let c = cross(p0, p1);
         let len = length(c);
         if len > 0.0 {
@@ -144,6 +132,35 @@ fn rect_lambert(light: Record, x: vec3<f32>, n: vec3<f32>) -> f32 {
         }
     }
     return max(0.5 * sigma * sum, 0.0);
+}
+
+// A polygon of at most 6 vertices (vectors from x): what clip_above returns.
+struct ClippedPolygon {
+    p: array<vec3<f32>, 6>,
+    count: u32,
+}
+
+// The polygon q[0..k] (vectors from x, k ≤ 4) clipped to the receiver's upper half-space
+// n·ω ≥ 0 (Sutherland & Hodgman 1974): rect_lambert's and mesh/lambert.wgsl's
+// triangle_lambert's horizon.
+fn clip_above(q: array<vec3<f32>, 4>, k: u32, n: vec3<f32>) -> ClippedPolygon {
+    var out: ClippedPolygon;
+    out.count = 0u;
+    for (var i = 0u; i < k; i++) {
+        let p0 = q[i];
+        let p1 = q[(i + 1u) % k];
+        let d0 = dot(n, p0);
+        let d1 = dot(n, p1);
+        if d0 >= 0.0 {
+            out.p[out.count] = p0;
+            out.count += 1u;
+        }
+        if (d0 >= 0.0) != (d1 >= 0.0) {
+            out.p[out.count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
+            out.count += 1u;
+        }
+    }
+    return out;
 }
 
 // Whether the whole rect lies above the receiver's horizon (Lambert's sum is then a sum of

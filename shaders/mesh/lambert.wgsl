@@ -26,30 +26,19 @@
 
 // #import shared/record.wgsl
 // #import shared/math.wgsl
+// #import irradiance/closed.wgsl
 
 // The sine of the highest elevation of a clipped arc for which sliver_lambert is used.
 const SLIVER_SIN: f32 = 0.3;
 
 // Unit-radiance irradiance of the triangle q0 q1 q2 (vectors from x) clipped to n·ω ≥ 0.
 fn triangle_lambert(q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, n: vec3<f32>) -> f32 {
-    let q = array<vec3<f32>, 3>(q0, q1, q2);
     let sigma = sign(dot(cross(q1 - q0, q2 - q1), q0));
-    var clipped: array<vec3<f32>, 4>;
-    var count = 0u;
-    for (var i = 0u; i < 3u; i++) {
-        let p0 = q[i];
-        let p1 = q[(i + 1u) % 3u];
-        let d0 = dot(n, p0);
-        let d1 = dot(n, p1);
-        if d0 >= 0.0 {
-            clipped[count] = p0;
-            count += 1u;
-        }
-        if (d0 >= 0.0) != (d1 >= 0.0) {
-            clipped[count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
-            count += 1u;
-        }
-    }
+    // The last entry is unused (3 vertices).
+    let cp = clip_above(array<vec3<f32>, 4>(q0, q1, q2, q0), 3u, n);
+    let count = cp.count;
+    // A triangle clipped by a plane keeps at most 4 vertices.
+    let clipped = array<vec3<f32>, 4>(cp.p[0], cp.p[1], cp.p[2], cp.p[3]);
     var sum = 0.0;
     // Every arc low: the sliver form (see the header).
     var low = true;
