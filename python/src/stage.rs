@@ -3,24 +3,21 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
 
 use luxeval::{
-    Accumulate, FalloffPlane as Plane, PreparedScene, RowKind, SampleOptions, Selection,
-    Stage as ReadStage, TemperatureMode, TextureFilter, TimeRule,
+    PreparedScene, SampleOptions, Stage as ReadStage, TemperatureMode, TextureFilter, TimeRule,
 };
-use numpy::prelude::*;
-use numpy::{PyArray1, PyReadonlyArray2};
-use pyo3::exceptions::PyUserWarning;
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple, PyType};
 
-use crate::args::{self, Options, parse_lights, resolution, vec3};
-use crate::arrays;
-use crate::chunks::{Chunks, zeros};
+use crate::args::{self, Options, parse_lights};
 use crate::device;
 use crate::errors::{self, no_panic};
+
+mod prepared;
+mod queries;
+mod sampling;
 
 /// A USD stage (``.usda``, ``.usdc``, ``.usdz``) and its lights, read once at one time.
 ///
@@ -78,208 +75,6 @@ enum Query {
 impl Stage {
     fn file(&self) -> &Path {
         &self.path
-    }
-
-    /// The prepared scene for these options, from the cache or prepared now.
-    fn prepare_for(&self, py: Python<'_>, o: &Options) -> PyResult<Arc<PreparedScene>> {
-        // Selection and attribute errors first: they cost nothing to find, a device does.
-        let mut lights = self
-            .scene
-            .evaluable(&o.select)
-            .map_err(|e| errors::lux(e, Some(self.file())))?;
-        for l in &mut lights {
-            l.validate()
-                .map_err(|e| errors::lux(e, Some(self.file())))?;
-            if let Some(t) = &mut l.texture {
-                t.filter = o.filter;
-            }
-        }
-        let eval = device::evaluator(py, o.device, o.mode)?.with_portal_mode(o.portal);
-        let mut select = o.select.clone();
-        select.sort();
-        select.dedup();
-        let key = Key {
-            select,
-            gpu: eval.is_gpu(),
-            mode: o.mode,
-            filter: o.filter,
-            portal: o.portal,
-        };
-        if let Some(p) = self.cache().get(&key) {
-            return Ok(p.clone());
-        }
-        if lights.is_empty() {
-            let msg = format!(
-                "{}: no light to evaluate; the result is all zeros",
-                self.path.display()
-            );
-            let msg = std::ffi::CString::new(msg.replace('\0', " ")).expect("no NUL");
-            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &msg, 2)?;
-        }
-        let file = self.file();
-        let scene = py.detach(|| {
-            no_panic(|| {
-                eval.prepare(&lights)
-                    .map_err(|e| errors::lux(e, Some(file)))
-            })
-        })?;
-        let scene = Arc::new(scene);
-        Ok(self.cache().entry(key).or_insert(scene).clone())
-    }
-
-    /// The options of `sample` and `pdf`, checked as every query's (sampling runs where
-    /// `device` says, as the other queries).
-    fn sampling_options(
-        &self,
-        _py: Python<'_>,
-        lights: Option<&Bound<'_, PyAny>>,
-        device: &str,
-        mode: &str,
-        filter: &str,
-        portal: &str,
-    ) -> PyResult<Options> {
-        Options::parse(lights, device, mode, filter, portal)
-    }
-
-    /// `sample`'s and `pdf`'s points and optional normals, checked (rows, pairing, and the
-    /// normals that `selection="exact"` needs).
-    #[allow(clippy::type_complexity)]
-    fn sampling_rows<'py>(
-        &self,
-        py: Python<'py>,
-        points: &Bound<'py, PyAny>,
-        normals: Option<&Bound<'py, PyAny>>,
-        selection: Selection,
-    ) -> PyResult<(
-        PyReadonlyArray2<'py, f32>,
-        Option<PyReadonlyArray2<'py, f32>>,
-    )> {
-        let normals = normals.filter(|n| !n.is_none());
-        if normals.is_none() && selection == Selection::Exact {
-            return Err(errors::input(
-                "normals: selection=\"exact\" needs a receiver normal per point (it weighs each \
-                 light by its irradiance on the receiver)",
-            ));
-        }
-        let p = arrays::rows(py, points, "points", RowKind::Points)?;
-        let n = match normals {
-            Some(n) => Some(arrays::rows(py, n, "normals", RowKind::Directions)?),
-            None => None,
-        };
-        if let Some(n) = &n {
-            paired("points", p.shape()[0], "normals", n.shape()[0])?;
-        }
-        Ok((p, n))
-    }
-
-    fn cache(&self) -> std::sync::MutexGuard<'_, HashMap<Key, Arc<PreparedScene>>> {
-        self.prepared
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn query<'py>(
-        &self,
-        py: Python<'py>,
-        q: Query,
-        a: &Bound<'py, PyAny>,
-        b: Option<&Bound<'py, PyAny>>,
-        per_light: bool,
-        o: Options,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let (a_name, a_kind, b_name) = match q {
-            Query::Emission | Query::Intensity => ("dirs", RowKind::Directions, ""),
-            Query::Radiance => ("points", RowKind::Points, "dirs"),
-            Query::Irradiance => ("points", RowKind::Points, "normals"),
-        };
-        let a_arr = arrays::rows(py, a, a_name, a_kind)?;
-        let b_arr: Option<PyReadonlyArray2<'py, f32>> = match b {
-            Some(b) => Some(arrays::rows(py, b, b_name, RowKind::Directions)?),
-            None => None,
-        };
-        let a_rows = arrays::as_vec3(&a_arr)?;
-        // Radiance and irradiance pair every row of `a` with one of `b` (a missing `b` counts
-        // as an empty array and is refused here).
-        let b_rows: &[[f32; 3]] = match &b_arr {
-            Some(b) => arrays::as_vec3(b)?,
-            None => &[],
-        };
-        if !matches!(q, Query::Emission | Query::Intensity) {
-            paired(a_name, a_rows.len(), b_name, b_rows.len())?;
-        }
-        let scene = self.prepare_for(py, &o)?;
-        let recomputed = scene.host_recomputed_rows();
-        let n = a_rows.len();
-        let l = scene.len();
-        let (acc, width) = if per_light {
-            (Accumulate::PerLight, l)
-        } else {
-            (Accumulate::Sum, 1)
-        };
-        let mut out = zeros::<f32>(width.checked_mul(n).and_then(|x| x.checked_mul(3)))?;
-        let mut chunks = Chunks::new(
-            match q {
-                Query::Irradiance => 256,
-                _ => 1 << 14,
-            },
-            l,
-        );
-        let file = self.file();
-        let mut start = 0;
-        while start < n {
-            let end = (start + chunks.rows).min(n);
-            let scene = &*scene;
-            let out = &mut out;
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let a = &a_rows[start..end];
-                    let rows = match q {
-                        Query::Emission => scene.emission(a, acc),
-                        Query::Intensity => scene.intensity(a, acc),
-                        Query::Radiance => scene.radiance(a, &b_rows[start..end], acc),
-                        Query::Irradiance => o.irradiance(scene, a, &b_rows[start..end], acc),
-                    }
-                    .map_err(|e| errors::lux(e, Some(file)))?;
-                    let m = end - start;
-                    for li in 0..width {
-                        let dst = &mut out[(li * n + start) * 3..(li * n + end) * 3];
-                        dst.copy_from_slice(rows[li * m..(li + 1) * m].as_flattened());
-                    }
-                    Ok(())
-                })
-            })?;
-            if end < n {
-                chunks.update(end - start, t0.elapsed().as_secs_f64());
-            }
-            py.check_signals()?;
-            start = end;
-        }
-        if matches!(q, Query::Irradiance) {
-            self.warn_host_recomputed(py, scene.host_recomputed_rows() - recomputed, width * n)?;
-        }
-        let shape: Vec<usize> = if per_light { vec![l, n, 3] } else { vec![n, 3] };
-        Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
-    }
-}
-
-impl Stage {
-    /// A `UserWarning` when `k` of a call's `rows` irradiance rows were recomputed on the CPU
-    /// reference because the device could not finish them
-    /// (`PreparedScene::host_recomputed_rows`; the command line's `note:` line).
-    fn warn_host_recomputed(&self, py: Python<'_>, k: usize, rows: usize) -> PyResult<()> {
-        if k == 0 {
-            return Ok(());
-        }
-        let msg = format!(
-            "{}: {k} of {rows} irradiance rows were recomputed on the CPU reference: the device \
-             could not finish their quadrature (more breakpoints than the kernel holds, or a \
-             software GPU's loop budget)",
-            self.path.display()
-        );
-        let msg = std::ffi::CString::new(msg.replace('\0', " ")).expect("no NUL");
-        PyErr::warn(py, &py.get_type::<PyUserWarning>(), &msg, 2)
     }
 }
 
@@ -626,58 +421,7 @@ impl Stage {
             portal_mode,
         )?
         .with_tolerance(tolerance)?;
-        let origin = vec3(py, origin, "origin")?;
-        let u = vec3(py, u, "u")?;
-        let v = vec3(py, v, "v")?;
-        let (w, h) = resolution(res)?;
-        // Refuses a NaN length too (huge finite vectors can overflow to one).
-        if u.cross(v).length().partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return Err(errors::input(format!(
-                "u/v: u = {u} and v = {v} are parallel or zero: they span no plane"
-            )));
-        }
-        let plane = Plane::new(origin, u, v, w, h).map_err(|e| errors::lux(e, None))?;
-        let scene = self.prepare_for(py, &o)?;
-        let recomputed = scene.host_recomputed_rows();
-        let normal = plane.normal().as_vec3().to_array();
-        let pixels = plane.pixels();
-        let mut out = zeros::<f32>(pixels.checked_mul(3))?;
-        // Whole rows of pixels per call, sized like the queries' chunks.
-        let mut chunks = Chunks::new(256, scene.len());
-        let file = self.file();
-        let mut j0 = 0u32;
-        while j0 < h {
-            let rows = (chunks.rows / w as usize).clamp(1, h as usize) as u32;
-            let j1 = (j0 + rows).min(h);
-            let scene = &*scene;
-            let plane = &plane;
-            let out = &mut out;
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let points: Vec<[f32; 3]> = (j0..j1)
-                        .flat_map(|j| (0..w).map(move |i| (i, j)))
-                        .map(|(i, j)| plane.pixel_centre(i, j).as_vec3().to_array())
-                        .collect();
-                    let normals = vec![normal; points.len()];
-                    let rgb = o
-                        .irradiance(scene, &points, &normals, Accumulate::Sum)
-                        .map_err(|e| errors::lux(e, Some(file)))?;
-                    let at = j0 as usize * w as usize * 3;
-                    out[at..at + rgb.len() * 3].copy_from_slice(rgb.as_flattened());
-                    Ok(())
-                })
-            })?;
-            if j1 < h {
-                chunks.update((j1 - j0) as usize * w as usize, t0.elapsed().as_secs_f64());
-            }
-            py.check_signals()?;
-            j0 = j1;
-        }
-        self.warn_host_recomputed(py, scene.host_recomputed_rows() - recomputed, pixels)?;
-        Ok(PyArray1::from_vec(py, out)
-            .reshape([h as usize, w as usize, 3])?
-            .into_any())
+        self.falloff_map(py, o, (origin, u, v), res)
     }
 
     /// Draws ``count`` directions per point toward the lights, with their densities, as
@@ -752,74 +496,12 @@ impl Stage {
             None => 0,
         };
         let selection = args::parse_selection(selection)?;
-        let (p_arr, n_arr) = self.sampling_rows(py, points, normals, selection)?;
-        let pts = arrays::as_vec3(&p_arr)?;
-        let nrm = match &n_arr {
-            Some(a) => Some(arrays::as_vec3(a)?),
-            None => None,
+        let opts = SampleOptions {
+            seed,
+            selection,
+            first_point,
         };
-        let scene = self.prepare_for(py, &o)?;
-        let n = pts.len();
-        let total = n.checked_mul(k);
-        let times3 = total.and_then(|t| t.checked_mul(3));
-        let mut dirs = zeros::<f32>(times3)?;
-        let mut pdf = zeros::<f32>(total)?;
-        let mut radiance = zeros::<f32>(times3)?;
-        let mut light_pdf = zeros::<f32>(total)?;
-        let mut light = zeros::<i32>(total)?;
-        // Points per call: a point costs K samples (at most 2²² samples per call).
-        let mut chunks = Chunks::new(((1usize << 12) / k).max(1), k);
-        let file = self.file();
-        let mut start = 0;
-        while start < n {
-            let end = (start + chunks.rows).min(n);
-            let scene = &*scene;
-            let (dirs, pdf, radiance, light_pdf, light) = (
-                &mut dirs,
-                &mut pdf,
-                &mut radiance,
-                &mut light_pdf,
-                &mut light,
-            );
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let opts = SampleOptions {
-                        seed,
-                        selection,
-                        first_point: first_point + start as u64,
-                    };
-                    let s = scene
-                        .sample(&pts[start..end], nrm.map(|v| &v[start..end]), k, &opts)
-                        .map_err(|e| errors::lux(e, Some(file)))?;
-                    let (a, b) = (start * k, end * k);
-                    dirs[a * 3..b * 3].copy_from_slice(s.dirs.as_flattened());
-                    pdf[a..b].copy_from_slice(&s.pdf);
-                    radiance[a * 3..b * 3].copy_from_slice(s.radiance.as_flattened());
-                    light_pdf[a..b].copy_from_slice(&s.light_pdf);
-                    light[a..b].copy_from_slice(&s.light);
-                    Ok(())
-                })
-            })?;
-            if end < n {
-                chunks.update(end - start, t0.elapsed().as_secs_f64());
-            }
-            py.check_signals()?;
-            start = end;
-        }
-        let out = PyDict::new(py);
-        out.set_item("dirs", PyArray1::from_vec(py, dirs).reshape([n, k, 3])?)?;
-        out.set_item("pdf", PyArray1::from_vec(py, pdf).reshape([n, k])?)?;
-        out.set_item(
-            "radiance",
-            PyArray1::from_vec(py, radiance).reshape([n, k, 3])?,
-        )?;
-        out.set_item(
-            "light_pdf",
-            PyArray1::from_vec(py, light_pdf).reshape([n, k])?,
-        )?;
-        out.set_item("light", PyArray1::from_vec(py, light).reshape([n, k])?)?;
-        Ok(out)
+        self.sample_rows(py, points, normals, k, &opts, o)
     }
 
     /// The density ``sample`` draws each direction with: for each (point, direction) pair,
@@ -857,58 +539,7 @@ impl Stage {
             portal_mode,
         )?;
         let selection = args::parse_selection(selection)?;
-        let (p_arr, n_arr) = self.sampling_rows(py, points, normals, selection)?;
-        let d_arr = arrays::rows(py, dirs, "dirs", RowKind::Directions)?;
-        let pts = arrays::as_vec3(&p_arr)?;
-        let d = arrays::as_vec3(&d_arr)?;
-        let nrm = match &n_arr {
-            Some(a) => Some(arrays::as_vec3(a)?),
-            None => None,
-        };
-        paired("points", pts.len(), "dirs", d.len())?;
-        let scene = self.prepare_for(py, &o)?;
-        let m = pts.len();
-        let l = scene.len();
-        let (acc, width) = if per_light {
-            (Accumulate::PerLight, l)
-        } else {
-            (Accumulate::Sum, 1)
-        };
-        let mut out = zeros::<f32>(width.checked_mul(m))?;
-        let mut chunks = Chunks::new(1 << 10, l);
-        let file = self.file();
-        let mut start = 0;
-        while start < m {
-            let end = (start + chunks.rows).min(m);
-            let scene = &*scene;
-            let out = &mut out;
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let v = scene
-                        .pdf(
-                            &pts[start..end],
-                            nrm.map(|x| &x[start..end]),
-                            &d[start..end],
-                            selection,
-                            acc,
-                        )
-                        .map_err(|e| errors::lux(e, Some(file)))?;
-                    let c = end - start;
-                    for li in 0..width {
-                        out[li * m + start..li * m + end].copy_from_slice(&v[li * c..(li + 1) * c]);
-                    }
-                    Ok(())
-                })
-            })?;
-            if end < m {
-                chunks.update(end - start, t0.elapsed().as_secs_f64());
-            }
-            py.check_signals()?;
-            start = end;
-        }
-        let shape: Vec<usize> = if per_light { vec![l, m] } else { vec![m] };
-        Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
+        self.pdf_rows(py, (points, dirs, normals), per_light, selection, o)
     }
 
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyType>, StageArgs)> {
