@@ -1,8 +1,12 @@
 //! Chunked queries: how many rows each call into the library evaluates ([`Chunks`]), and the
 //! zeroed result buffer the chunks are written into.
 
+use std::time::Instant;
+
 use pyo3::exceptions::PyMemoryError;
 use pyo3::prelude::*;
+
+use crate::errors::no_panic;
 
 /// How many rows each call into the library evaluates. Between two calls the GIL is taken back
 /// and Ctrl-C is checked, so a call should take about [`Chunks::TARGET_S`] whatever the device
@@ -26,6 +30,29 @@ impl Chunks {
             rows: first.min(max).max(1),
             max,
         }
+    }
+
+    /// Runs `f(start, end)` on consecutive ranges of the rows `0..n`, each as long as the last
+    /// one's time says ([`Chunks::update`]), with the GIL released and a panic turned into an
+    /// error; Ctrl-C raises `KeyboardInterrupt` between two ranges.
+    pub(crate) fn run(
+        &mut self,
+        py: Python<'_>,
+        n: usize,
+        mut f: impl FnMut(usize, usize) -> PyResult<()> + Send,
+    ) -> PyResult<()> {
+        let mut start = 0;
+        while start < n {
+            let end = (start + self.rows).min(n);
+            let t0 = Instant::now();
+            py.detach(|| no_panic(|| f(start, end)))?;
+            if end < n {
+                self.update(end - start, t0.elapsed().as_secs_f64());
+            }
+            py.check_signals()?;
+            start = end;
+        }
+        Ok(())
     }
 
     /// After a chunk of `rows` rows took `secs`: the size of the next one, within 4× of it.

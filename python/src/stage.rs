@@ -475,8 +475,7 @@ impl Stage {
         portal_mode: &str,
         first_point: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = self.sampling_options(
-            py,
+        let o = Options::parse(
             lights,
             device,
             temperature_mode,
@@ -530,8 +529,7 @@ impl Stage {
         texture_filter: &str,
         portal_mode: &str,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let o = self.sampling_options(
-            py,
+        let o = Options::parse(
             lights,
             device,
             temperature_mode,

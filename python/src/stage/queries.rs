@@ -63,36 +63,23 @@ impl Stage {
             l,
         );
         let file = self.file();
-        let mut start = 0;
-        while start < n {
-            let end = (start + chunks.rows).min(n);
-            let scene = &*scene;
-            let out = &mut out;
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let a = &a_rows[start..end];
-                    let rows = match q {
-                        Query::Emission => scene.emission(a, acc),
-                        Query::Intensity => scene.intensity(a, acc),
-                        Query::Radiance => scene.radiance(a, &b_rows[start..end], acc),
-                        Query::Irradiance => o.irradiance(scene, a, &b_rows[start..end], acc),
-                    }
-                    .map_err(|e| errors::lux(e, Some(file)))?;
-                    let m = end - start;
-                    for li in 0..width {
-                        let dst = &mut out[(li * n + start) * 3..(li * n + end) * 3];
-                        dst.copy_from_slice(rows[li * m..(li + 1) * m].as_flattened());
-                    }
-                    Ok(())
-                })
-            })?;
-            if end < n {
-                chunks.update(end - start, t0.elapsed().as_secs_f64());
+        let scene = &*scene;
+        chunks.run(py, n, |start, end| {
+            let a = &a_rows[start..end];
+            let rows = match q {
+                Query::Emission => scene.emission(a, acc),
+                Query::Intensity => scene.intensity(a, acc),
+                Query::Radiance => scene.radiance(a, &b_rows[start..end], acc),
+                Query::Irradiance => o.irradiance(scene, a, &b_rows[start..end], acc),
             }
-            py.check_signals()?;
-            start = end;
-        }
+            .map_err(|e| errors::lux(e, Some(file)))?;
+            let m = end - start;
+            for li in 0..width {
+                let dst = &mut out[(li * n + start) * 3..(li * n + end) * 3];
+                dst.copy_from_slice(rows[li * m..(li + 1) * m].as_flattened());
+            }
+            Ok(())
+        })?;
         if matches!(q, Query::Irradiance) {
             self.warn_host_recomputed(py, scene.host_recomputed_rows() - recomputed, width * n)?;
         }

@@ -1,7 +1,5 @@
 //! `Stage.sample` and `Stage.pdf`: their rows checked and evaluated in chunks.
 
-use std::time::Instant;
-
 use luxeval::{Accumulate, RowKind, SampleOptions, Selection};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
@@ -12,23 +10,9 @@ use super::{Stage, paired};
 use crate::args::Options;
 use crate::arrays;
 use crate::chunks::{Chunks, zeros};
-use crate::errors::{self, no_panic};
+use crate::errors;
 
 impl Stage {
-    /// The options of `sample` and `pdf`, checked as every query's (sampling runs where
-    /// `device` says, as the other queries).
-    pub(super) fn sampling_options(
-        &self,
-        _py: Python<'_>,
-        lights: Option<&Bound<'_, PyAny>>,
-        device: &str,
-        mode: &str,
-        filter: &str,
-        portal: &str,
-    ) -> PyResult<Options> {
-        Options::parse(lights, device, mode, filter, portal)
-    }
-
     /// `sample`'s and `pdf`'s points and optional normals, checked (rows, pairing, and the
     /// normals that `selection="exact"` needs).
     #[allow(clippy::type_complexity)]
@@ -89,43 +73,24 @@ impl Stage {
         // Points per call: a point costs K samples (at most 2²² samples per call).
         let mut chunks = Chunks::new(((1usize << 12) / k).max(1), k);
         let file = self.file();
-        let mut start = 0;
-        while start < n {
-            let end = (start + chunks.rows).min(n);
-            let scene = &*scene;
-            let (dirs, pdf, radiance, light_pdf, light) = (
-                &mut dirs,
-                &mut pdf,
-                &mut radiance,
-                &mut light_pdf,
-                &mut light,
-            );
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let opts = SampleOptions {
-                        seed: opts.seed,
-                        selection: opts.selection,
-                        first_point: opts.first_point + start as u64,
-                    };
-                    let s = scene
-                        .sample(&pts[start..end], nrm.map(|v| &v[start..end]), k, &opts)
-                        .map_err(|e| errors::lux(e, Some(file)))?;
-                    let (a, b) = (start * k, end * k);
-                    dirs[a * 3..b * 3].copy_from_slice(s.dirs.as_flattened());
-                    pdf[a..b].copy_from_slice(&s.pdf);
-                    radiance[a * 3..b * 3].copy_from_slice(s.radiance.as_flattened());
-                    light_pdf[a..b].copy_from_slice(&s.light_pdf);
-                    light[a..b].copy_from_slice(&s.light);
-                    Ok(())
-                })
-            })?;
-            if end < n {
-                chunks.update(end - start, t0.elapsed().as_secs_f64());
-            }
-            py.check_signals()?;
-            start = end;
-        }
+        let scene = &*scene;
+        chunks.run(py, n, |start, end| {
+            let opts = SampleOptions {
+                seed: opts.seed,
+                selection: opts.selection,
+                first_point: opts.first_point + start as u64,
+            };
+            let s = scene
+                .sample(&pts[start..end], nrm.map(|v| &v[start..end]), k, &opts)
+                .map_err(|e| errors::lux(e, Some(file)))?;
+            let (a, b) = (start * k, end * k);
+            dirs[a * 3..b * 3].copy_from_slice(s.dirs.as_flattened());
+            pdf[a..b].copy_from_slice(&s.pdf);
+            radiance[a * 3..b * 3].copy_from_slice(s.radiance.as_flattened());
+            light_pdf[a..b].copy_from_slice(&s.light_pdf);
+            light[a..b].copy_from_slice(&s.light);
+            Ok(())
+        })?;
         let out = PyDict::new(py);
         out.set_item("dirs", PyArray1::from_vec(py, dirs).reshape([n, k, 3])?)?;
         out.set_item("pdf", PyArray1::from_vec(py, pdf).reshape([n, k])?)?;
@@ -175,36 +140,23 @@ impl Stage {
         let mut out = zeros::<f32>(width.checked_mul(m))?;
         let mut chunks = Chunks::new(1 << 10, l);
         let file = self.file();
-        let mut start = 0;
-        while start < m {
-            let end = (start + chunks.rows).min(m);
-            let scene = &*scene;
-            let out = &mut out;
-            let t0 = Instant::now();
-            py.detach(|| {
-                no_panic(|| {
-                    let v = scene
-                        .pdf(
-                            &pts[start..end],
-                            nrm.map(|x| &x[start..end]),
-                            &d[start..end],
-                            selection,
-                            acc,
-                        )
-                        .map_err(|e| errors::lux(e, Some(file)))?;
-                    let c = end - start;
-                    for li in 0..width {
-                        out[li * m + start..li * m + end].copy_from_slice(&v[li * c..(li + 1) * c]);
-                    }
-                    Ok(())
-                })
-            })?;
-            if end < m {
-                chunks.update(end - start, t0.elapsed().as_secs_f64());
+        let scene = &*scene;
+        chunks.run(py, m, |start, end| {
+            let v = scene
+                .pdf(
+                    &pts[start..end],
+                    nrm.map(|x| &x[start..end]),
+                    &d[start..end],
+                    selection,
+                    acc,
+                )
+                .map_err(|e| errors::lux(e, Some(file)))?;
+            let c = end - start;
+            for li in 0..width {
+                out[li * m + start..li * m + end].copy_from_slice(&v[li * c..(li + 1) * c]);
             }
-            py.check_signals()?;
-            start = end;
-        }
+            Ok(())
+        })?;
         let shape: Vec<usize> = if per_light { vec![l, m] } else { vec![m] };
         Ok(PyArray1::from_vec(py, out).reshape(shape)?.into_any())
     }
