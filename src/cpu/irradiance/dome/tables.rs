@@ -90,9 +90,11 @@ impl DomeIrradiance {
             return [0.0; 9];
         }
         let mut f = |d: DVec3, tex: DVec3, j: f64| outer(tex, d * (self.weight(d) * j));
-        let cap = self.geom.cap(&p);
-        match (cap, self.conformal) {
-            (Some(_), Some(w)) if self.format == DomeFormat::LatLong => {
+        // A latlong piece always has a cap (`Geometry::cap`); its moment comes from the axis
+        // tables, and its cap (two sin_cos per piece, once a quarter of a dome map's time)
+        // is not needed for that.
+        match self.conformal {
+            Some(w) if self.format == DomeFormat::LatLong => {
                 let (cx, ry) = (&t.cols[ix], &t.rows[iy]);
                 let k = w
                     * (2.0 * std::f64::consts::PI / self.geom.w)
