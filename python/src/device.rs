@@ -140,10 +140,7 @@ pub fn evaluator(py: Python<'_>, device: Device, mode: TemperatureMode) -> PyRes
         Device::Auto => {
             let (eval, why) = auto(py)?;
             if !eval.is_gpu() && !WARNED.swap(true, Ordering::SeqCst) {
-                let msg = format!("device=\"auto\": {why}");
-                let msg =
-                    std::ffi::CString::new(msg.replace('\0', " ")).expect("NULs replaced above");
-                PyErr::warn(py, &py.get_type::<DeviceWarning>(), &msg, 2)?;
+                errors::warn::<DeviceWarning>(py, &format!("device=\"auto\": {why}"))?;
             }
             eval
         }

@@ -56,6 +56,14 @@ pub fn lux(e: LuxError, file: Option<&Path>) -> PyErr {
     }
 }
 
+/// Warns with the warning class `W` (`UserWarning`, `DeviceWarning`), attributed to the
+/// caller of the luxeval method (stack level 2). A NUL in the message (from a file name) is
+/// replaced so that it can be given to Python.
+pub fn warn<W: pyo3::PyTypeInfo>(py: Python<'_>, message: &str) -> PyResult<()> {
+    let msg = std::ffi::CString::new(message.replace('\0', " ")).expect("NULs replaced above");
+    PyErr::warn(py, &py.get_type::<W>(), &msg, 2)
+}
+
 pub fn input(message: impl Into<String>) -> PyErr {
     InputError::new_err(message.into())
 }

@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use luxeval::{
-    PreparedScene, SampleOptions, Stage as ReadStage, TemperatureMode, TextureFilter, TimeRule,
+    Accumulate, PreparedScene, SampleOptions, Stage as ReadStage, TemperatureMode, TextureFilter,
+    TimeRule,
 };
 use pyo3::intern;
 use pyo3::prelude::*;
@@ -564,6 +565,16 @@ impl Stage {
             self.scene.lights.len(),
             evaluated
         )
+    }
+}
+
+/// The accumulation a query asks for and the rows it returns per input row: one per light
+/// (`per_light`, `lights` of them) or their sum.
+fn accumulate(per_light: bool, lights: usize) -> (Accumulate, usize) {
+    if per_light {
+        (Accumulate::PerLight, lights)
+    } else {
+        (Accumulate::Sum, 1)
     }
 }
 

@@ -37,8 +37,7 @@ fn triangle_lambert(q0: vec3<f32>, q1: vec3<f32>, q2: vec3<f32>, n: vec3<f32>) -
     // The last entry is unused (3 vertices).
     let cp = clip_above(array<vec3<f32>, 4>(q0, q1, q2, q0), 3u, n);
     let count = cp.count;
-    // A triangle clipped by a plane keeps at most 4 vertices.
-    let clipped = array<vec3<f32>, 4>(cp.p[0], cp.p[1], cp.p[2], cp.p[3]);
+    let clipped = cp.p;
     var sum = 0.0;
     // Every arc low: the sliver form (see the header).
     var low = true;
@@ -108,7 +107,7 @@ fn arc_half(m: vec3<f32>, n: vec3<f32>, h0: vec3<f32>, h1: vec3<f32>) -> f32 {
 // boundary: |Σ| when the zenith is outside (the azimuth turns by 0 around it), π − |Σ| when it
 // is inside (by ±2π). Each arc is integrated in two halves, split at its ends' mean
 // horizontal direction.
-fn sliver_lambert(clipped: array<vec3<f32>, 4>, count: u32, n: vec3<f32>) -> f32 {
+fn sliver_lambert(clipped: array<vec3<f32>, 6>, count: u32, n: vec3<f32>) -> f32 {
     var sum = 0.0;
     var turn = 0.0;
     for (var i = 0u; i < count; i++) {

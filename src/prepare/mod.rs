@@ -20,6 +20,7 @@ pub mod portal;
 pub mod profile;
 mod shaping;
 pub mod texture;
+mod transform;
 pub mod zero_size;
 
 use std::sync::Arc;
@@ -27,7 +28,7 @@ use std::sync::Arc;
 use glam::{DMat3, DVec3};
 
 use crate::error::{AssetError, LuxError, Result};
-use crate::model::{Light, LightType, Texture, UpAxis};
+use crate::model::{Light, LightType, Texture};
 use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
@@ -40,6 +41,7 @@ pub use mesh_class::MeshOcclusion;
 pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
 pub use shaping::{ShapingConsts, shaping_is_identity};
+pub use transform::{is_sheared, similarity_scale, tilt_angle};
 
 /// A light's IES profile as both backends evaluate it (DESIGN.md §6 I7): the factor along a
 /// light-space emission direction e is `scale · Î(e)` with Î the profile's bilinear interpolant
@@ -561,16 +563,6 @@ fn distinct_fronts(triangles: &[crate::model::MeshTriangle]) -> Vec<DVec3> {
         .collect()
 }
 
-/// The tilt angle τ of DESIGN.md §6 I5 in degrees: between the light's world primary axis and
-/// the stage's world down (−Y for `upAxis` Y, −Z for Z).
-pub fn tilt_angle(axis: DVec3, up: UpAxis) -> f64 {
-    let down = match up {
-        UpAxis::Y => DVec3::NEG_Y,
-        UpAxis::Z => DVec3::NEG_Z,
-    };
-    axis.cross(down).length().atan2(axis.dot(down)).to_degrees()
-}
-
 /// Prepares every light, failing on the first invalid one; a file referenced by several lights
 /// is loaded once.
 pub fn prepare(
@@ -587,23 +579,4 @@ pub fn prepare(
             Ok(p)
         })
         .collect()
-}
-
-/// Whether the parallelogram of world edges `e1`, `e2` (both non-zero) is sheared, i.e. not a
-/// rectangle: the rect sampler's choice between Ureña's spherical rectangle and Arvo's two
-/// triangles (`cpu::sample::rect::RectSampler`), made once in f64 for both paths.
-pub fn is_sheared(e1: DVec3, e2: DVec3) -> bool {
-    e1.dot(e2).abs() > 1e-12 * e1.length() * e2.length()
-}
-
-/// The scale s when `m` is a similarity (s times an orthogonal matrix) to 1e-12, else None.
-pub fn similarity_scale(m: DMat3) -> Option<f64> {
-    let g = m.transpose() * m;
-    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
-    let dev = (g - DMat3::from_diagonal(DVec3::splat(s2))).to_cols_array();
-    if s2 > 0.0 && dev.iter().all(|d| d.abs() <= 1e-12 * s2) {
-        Some(s2.sqrt())
-    } else {
-        None
-    }
 }

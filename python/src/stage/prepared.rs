@@ -46,8 +46,7 @@ impl Stage {
                 "{}: no light to evaluate; the result is all zeros",
                 self.path.display()
             );
-            let msg = std::ffi::CString::new(msg.replace('\0', " ")).expect("no NUL");
-            PyErr::warn(py, &py.get_type::<PyUserWarning>(), &msg, 2)?;
+            errors::warn::<PyUserWarning>(py, &msg)?;
         }
         let file = self.file();
         let scene = py.detach(|| {
@@ -84,7 +83,6 @@ impl Stage {
              software GPU's loop budget)",
             self.path.display()
         );
-        let msg = std::ffi::CString::new(msg.replace('\0', " ")).expect("no NUL");
-        PyErr::warn(py, &py.get_type::<PyUserWarning>(), &msg, 2)
+        errors::warn::<PyUserWarning>(py, &msg)
     }
 }

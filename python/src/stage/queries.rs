@@ -8,7 +8,7 @@ use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::{Query, Stage, paired};
+use super::{Query, Stage, accumulate, paired};
 use crate::args::{Options, resolution, vec3};
 use crate::arrays;
 use crate::chunks::{Chunks, zeros};
@@ -49,11 +49,7 @@ impl Stage {
         let recomputed = scene.host_recomputed_rows();
         let n = a_rows.len();
         let l = scene.len();
-        let (acc, width) = if per_light {
-            (Accumulate::PerLight, l)
-        } else {
-            (Accumulate::Sum, 1)
-        };
+        let (acc, width) = accumulate(per_light, l);
         let mut out = zeros::<f32>(width.checked_mul(n).and_then(|x| x.checked_mul(3)))?;
         let mut chunks = Chunks::new(
             match q {

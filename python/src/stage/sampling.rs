@@ -1,12 +1,12 @@
 //! `Stage.sample` and `Stage.pdf`: their rows checked and evaluated in chunks.
 
-use luxeval::{Accumulate, RowKind, SampleOptions, Selection};
+use luxeval::{RowKind, SampleOptions, Selection};
 use numpy::prelude::*;
 use numpy::{PyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::{Stage, paired};
+use super::{Stage, accumulate, paired};
 use crate::args::Options;
 use crate::arrays;
 use crate::chunks::{Chunks, zeros};
@@ -57,10 +57,7 @@ impl Stage {
     ) -> PyResult<Bound<'py, PyDict>> {
         let (p_arr, n_arr) = self.sampling_rows(py, points, normals, opts.selection)?;
         let pts = arrays::as_vec3(&p_arr)?;
-        let nrm = match &n_arr {
-            Some(a) => Some(arrays::as_vec3(a)?),
-            None => None,
-        };
+        let nrm = n_arr.as_ref().map(arrays::as_vec3).transpose()?;
         let scene = self.prepare_for(py, &o)?;
         let n = pts.len();
         let total = n.checked_mul(k);
@@ -124,19 +121,12 @@ impl Stage {
         let d_arr = arrays::rows(py, dirs, "dirs", RowKind::Directions)?;
         let pts = arrays::as_vec3(&p_arr)?;
         let d = arrays::as_vec3(&d_arr)?;
-        let nrm = match &n_arr {
-            Some(a) => Some(arrays::as_vec3(a)?),
-            None => None,
-        };
+        let nrm = n_arr.as_ref().map(arrays::as_vec3).transpose()?;
         paired("points", pts.len(), "dirs", d.len())?;
         let scene = self.prepare_for(py, &o)?;
         let m = pts.len();
         let l = scene.len();
-        let (acc, width) = if per_light {
-            (Accumulate::PerLight, l)
-        } else {
-            (Accumulate::Sum, 1)
-        };
+        let (acc, width) = accumulate(per_light, l);
         let mut out = zeros::<f32>(width.checked_mul(m))?;
         let mut chunks = Chunks::new(1 << 10, l);
         let file = self.file();

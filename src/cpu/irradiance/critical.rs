@@ -57,17 +57,14 @@ fn push_dir(ys: &mut Vec<f64>, w: DVec3, chart: &Chart) {
 /// The lines where the planes of the pencil (through the receiver, containing the chart's
 /// `e1`) are tangent to the cone of `axis` and cosine `c` (`roots::pencil_tangent_normals`),
 /// each meeting the chart at Y = −m·w0 / m·e2.
-fn pencil_tangent_ys(
-    ys: &mut Vec<f64>,
-    chart: &Chart,
-    (w0, e1, e2): (DVec3, DVec3, DVec3),
-    axis: DVec3,
-    c: f64,
-) {
-    for m in pencil_tangent_normals(e1, axis, c).into_iter().flatten() {
-        let me2 = m.dot(e2);
+fn pencil_tangent_ys(ys: &mut Vec<f64>, chart: &Chart, axis: DVec3, c: f64) {
+    for m in pencil_tangent_normals(chart.e1, axis, c)
+        .into_iter()
+        .flatten()
+    {
+        let me2 = m.dot(chart.e2);
         if me2 != 0.0 {
-            push_y(ys, -m.dot(w0) / me2, chart);
+            push_y(ys, -m.dot(chart.w0) / me2, chart);
         }
     }
 }
@@ -119,18 +116,22 @@ fn arc_f(arc: &Arc, axis: DVec3, cos: f64, t: f64) -> (f64, f64) {
     )
 }
 
-/// The region's elliptic arcs (a disk's rim, a cylinder's), none for a square.
-fn region_arcs(region: &Region, (w0, e1, e2): (DVec3, DVec3, DVec3)) -> Vec<Arc> {
-    match region {
-        Region::Square => vec![],
-        Region::Disk => vec![Arc {
-            c: w0,
-            u: e1,
-            v: e2,
-            t0: 0.0,
-            t1: 2.0 * PI,
-        }],
-        Region::Cylinder(c) => c.arcs.to_vec(),
+/// The chart region's straight edges X = const (the square's sides) and its elliptic arcs (a
+/// disk's rim, a cylinder's).
+fn region_edges(chart: &Chart) -> (Vec<f64>, Vec<Arc>) {
+    match &chart.region {
+        Region::Square => (vec![-1.0, 1.0], vec![]),
+        Region::Disk => (
+            vec![],
+            vec![Arc {
+                c: chart.w0,
+                u: chart.e1,
+                v: chart.e2,
+                t0: 0.0,
+                t1: 2.0 * PI,
+            }],
+        ),
+        Region::Cylinder(c) => (vec![], c.arcs.to_vec()),
     }
 }
 
@@ -171,7 +172,7 @@ fn cone_ys(
     arc_samples: usize,
 ) {
     let (w0, e1, e2) = (chart.w0, chart.e1, chart.e2);
-    pencil_tangent_ys(ys, chart, (w0, e1, e2), axis, c);
+    pencil_tangent_ys(ys, chart, axis, c);
     for &xs in segs {
         for y in cone_roots_on_line(axis, c, w0 + e1 * xs, e2) {
             push_y(ys, y, chart);
@@ -210,18 +211,13 @@ pub fn critical_ys_with(
         }
     }
     let (w0, e1, e2) = (chart.w0, chart.e1, chart.e2);
-    // Straight region edges X = const (the square's sides), and elliptic arcs.
-    let mut segs: Vec<f64> = match &chart.region {
-        Region::Square => vec![-1.0, 1.0],
-        _ => vec![],
-    };
+    let (mut segs, arcs) = region_edges(chart);
     // A textured rect: the texture's vertical break lines are straight edges too, and its
     // horizontal ones are breaks (DESIGN.md §6 "what 'exact' means", rect_texture.rs).
     segs.extend(super::rect_texture::texel_xs(p, chart));
     for y in super::rect_texture::texel_ys(p, chart) {
         push_y(&mut ys, y, chart);
     }
-    let arcs = region_arcs(&chart.region, (w0, e1, e2));
     for &m in &planes {
         plane_ys(&mut ys, chart, &segs, &arcs, m);
         // Plane ∩ plane: the line through x along m × m'.
@@ -327,7 +323,6 @@ pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f6
         r => r.clone(),
     };
     let lc = make_chart(l * chart.w0, l * chart.e1, l * chart.e2, region);
-    let (w0, e1, e2) = (lc.w0, lc.e1, lc.e2);
     // Planes through x in the light's frame: a world normal m becomes Mᵀm.
     let mt = p.linear.transpose();
     let mut fixed: Vec<DVec3> = vec![mt * n];
@@ -336,11 +331,7 @@ pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f6
             fixed.push(mt * m);
         }
     }
-    let segs: Vec<f64> = match &lc.region {
-        Region::Square => vec![-1.0, 1.0],
-        _ => vec![],
-    };
-    let arcs = region_arcs(&lc.region, (w0, e1, e2));
+    let (segs, arcs) = region_edges(&lc);
     let mut ys = Vec::new();
     for &m in &kinks.planes {
         plane_ys(&mut ys, &lc, &segs, &arcs, m);

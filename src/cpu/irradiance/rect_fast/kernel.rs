@@ -130,7 +130,7 @@ impl Kernel<'_> {
     /// Which rule a cell takes: none behind the horizon, the moment rule where neither the
     /// horizon nor a shaping kink may cross it (K smooth on it), else [`Kernel::clipped`].
     /// `kinks` is the cell's [`Kernel::kinks`], computed once per cell by the caller.
-    pub(super) fn rule_kind(&self, r: Rect, kinks: Kinks) -> RuleKind {
+    fn rule_kind(&self, r: Rect, kinks: Kinks) -> RuleKind {
         let (c, a, b) = self.horizon();
         let hs = [(r.x0, r.y0), (r.x1, r.y0), (r.x0, r.y1), (r.x1, r.y1)]
             .map(|(x, y)| c + a * x + b * y);
@@ -269,7 +269,7 @@ impl Kernel<'_> {
     /// Which kinks of the shaping factor may cross the cell: a cone whose angle lies within α
     /// of the centre direction's, or a plane with corners on both sides. Only the kink cones
     /// of a soft cone ([`Kinks::SoftCone`]) can be bracketed.
-    pub(super) fn kinks(&self, r: Rect) -> Kinks {
+    fn kinks(&self, r: Rect) -> Kinks {
         if !self.shaped {
             return Kinks::None;
         }
@@ -511,7 +511,7 @@ impl Kernel<'_> {
 
     /// Whether the cell must be split before its rule is trusted: it is not well separated
     /// from x (half-diagonal R > ½ (|w_c| − R)) and the horizon does not hide all of it.
-    pub(super) fn near(&self, r: Rect) -> bool {
+    fn near(&self, r: Rect) -> bool {
         let (cx, cy, hx, hy) = r.centre();
         let c = self.chart;
         let wc = c.w0 + c.e1 * cx + c.e2 * cy;
