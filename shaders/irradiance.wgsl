@@ -6,12 +6,13 @@
 //   formula when (d / smaller half-extent)·(d / height above its plane) exceeds
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
-// On the host: lights flagged FLAG_HOST_IRRADIANCE (textured domes and textured rects, masked
-//   domes, mesh lights whose triangles may hide one another, IES profiles bent by angleScale)
-//   give 0 here and the host adds the CPU reference's value (prepare::Prepared::irradiance_on_host
-//   gives the reasons): a textured dome's exact integral splits at texel-centre lines (a textured
-//   rect's, texel lines on its surface). The pipeline is built without the optional part
-//   TEXTURE, and without IES unless an IES-shaped light is integrated here
+// On the host: lights flagged FLAG_HOST_IRRADIANCE (textured rects, textured domes other than
+//   latlong ones under a conformal frame with tables the device holds, masked domes, mesh
+//   lights whose triangles may hide one another, IES profiles bent by angleScale) give 0 here
+//   and the host adds the CPU reference's value (prepare::Prepared::irradiance_on_host gives the
+//   reasons). A textured latlong dome is integrated by rows of its texture
+//   (irradiance/latlong_rows.wgsl), the optional part TEXTURE, compiled in only when such a
+//   dome is integrated here; IES likewise only when an IES-shaped light is
 //   (gpu::shaders::Features). An IES-shaped light's lines split at its profile's grid surfaces
 //   (irradiance/line.wgsl) and its outer integral at their critical Ys (irradiance/critical.wgsl).
 // Optional parts: the chart quadrature (CHART) and treatAsLine (LINE) are compiled in only for
@@ -36,6 +37,7 @@
 // #import irradiance/chart.wgsl
 // #import irradiance/outer.wgsl
 // #import mesh/lambert.wgsl
+// #import irradiance/latlong_rows.wgsl
 
 fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let base = light.base.xyz;
@@ -51,6 +53,14 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     switch light.kind {
         case KIND_DOME: {
             e = base * PI;
+            // #if TEXTURE
+            if has_flag(light, FLAG_DOME_TEXTURE) {
+                // A latlong dome under a conformal frame (prepare::gpu_path): the dome-space
+                // normal is A_eff⁻¹ n normalised (src/cpu/irradiance/latlong_rows.rs).
+                let inv = mat3x3<f32>(light.tex_inv0.xyz, light.tex_inv1.xyz, light.tex_inv2.xyz);
+                e = base * latlong_irradiance(rows_info(light.tex.z), normalize(inv * n));
+            }
+            // #endif
         }
         case KIND_DISTANT: {
             let c = -light.axis.xyz;

@@ -224,6 +224,12 @@ pub const IRR_INNER_DEPTH: usize = 6;
 /// holds the whole rule to 1e-5.)
 pub const IRR_OUTER_TOL: f64 = 1e-3;
 pub const IRR_OUTER_DEPTH: usize = 5;
+/// Irradiance kernel: Gauss–Legendre points per θ interval of a textured latlong dome's row
+/// integral (`shaders/irradiance/latlong_rows.wgsl`; the intervals end at every kink).
+pub const IRR_GL_ROWS: usize = 6;
+/// Irradiance kernel: the longest θ interval of that integral (coarse textures' intervals are
+/// cut in equal parts no longer than this).
+pub const IRR_ROWS_MAX_SPAN: f64 = 0.2;
 /// Irradiance kernel: samples per elliptic arc when bracketing cone crossings.
 pub const IRR_ARC_SAMPLES: u32 = 24;
 /// Irradiance kernel: an unshaped rect uses Lambert's formula only where its edge terms cannot
@@ -254,6 +260,7 @@ pub fn wgsl_u32_constants() -> Vec<(&'static str, u32)> {
         ("IRR_INNER_DEPTH", IRR_INNER_DEPTH as u32),
         ("IRR_OUTER_DEPTH", IRR_OUTER_DEPTH as u32),
         ("IRR_ARC_SAMPLES", IRR_ARC_SAMPLES),
+        ("IRR_GL_ROWS", IRR_GL_ROWS as u32),
     ]
 }
 
@@ -265,6 +272,7 @@ pub fn wgsl_f32_constants() -> Vec<(&'static str, f64)> {
         ("IRR_OUTER_TOL", IRR_OUTER_TOL),
         ("IRR_TAN_MAP_RHO", TAN_MAP_RHO),
         ("IRR_MAX_U_SPAN", MAX_U_SPAN),
+        ("IRR_ROWS_MAX_SPAN", IRR_ROWS_MAX_SPAN),
     ]
 }
 
@@ -274,7 +282,10 @@ pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     let (xo, wo) = gauss_legendre(IRR_GL_CAP);
     let (xi, wi) = gauss_legendre(IRR_GL_INNER);
     let gk = gk15_unit();
+    let (xr, wr) = gauss_legendre(IRR_GL_ROWS);
     vec![
+        ("IRR_GL_ROWS_X", xr),
+        ("IRR_GL_ROWS_W", wr),
         ("IRR_GL_CAP_X", xo),
         ("IRR_GL_CAP_W", wo),
         ("IRR_GL_INNER_X", xi),

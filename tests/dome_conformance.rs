@@ -2,7 +2,8 @@
 //! textures of every format (latlong, mirroredBall, angular, cubeMapVerticalCross) at several
 //! sizes, both filters, plain DomeLight and DomeLight_1 with poleAxis Y and Z, with and without
 //! a rotated transform; emission and radiance within a relative 1e-4 per channel. Irradiance:
-//! the GPU path gives the reference's value (see the last test).
+//! a latlong dome's within 1e-4 too (the kernel's row integral), the other domes' the
+//! reference's value (the last two tests).
 //!
 //! Excluded directions (documented divergence 1 of shaders/shared/texture.wgsl): with the nearest
 //! filter, those within 1e-3 px of a texel edge (f32 pixel coordinates carry ~W·2⁻²⁴ px of
@@ -16,7 +17,9 @@ use crate::common;
 use glam::{DMat4, DVec3};
 use luxeval::testkit::Rng;
 use luxeval::testkit::dome::{near_discontinuity, prepare_with_filter};
-use luxeval::{Accumulate, Asset, Evaluator, Light, PoleAxis, Texture, TextureFormat, UpAxis};
+use luxeval::{
+    Accumulate, Asset, Evaluator, Light, PoleAxis, Texture, TextureFilter, TextureFormat, UpAxis,
+};
 
 const TOL: f64 = 1e-4;
 
@@ -173,53 +176,110 @@ fn untextured_domes_are_unchanged_beside_textured_ones() {
     }
 }
 
-/// The GPU path takes a textured dome's irradiance from the CPU reference (query's
-/// `irradiance_on_host`): exactly the reference's value rounded to f32, summed with the kernel's
-/// value for the other lights (here an untextured dome, π · its radiance, and a sphere light
-/// whose irradiance the kernel computes), and per light in light-major order.
+/// A textured latlong dome's irradiance is the kernel's (irradiance/latlong_rows.wgsl) under a
+/// rotation, a rotation times a uniform scale and DomeLight_1's Z pole, with either filter and
+/// at sizes from 1 × 1 to 64 × 32 (13 × 5: not 2:1): within 1e-4 of the reference per channel,
+/// summed with the other lights' (an untextured dome, π · its radiance) and per light in
+/// light-major order. Normals include the poles and the horizon's tangency cases (±Y, X, Z).
 #[test]
-fn gpu_irradiance_of_a_textured_dome_is_the_reference() {
+fn gpu_irradiance_of_a_textured_latlong_dome_matches_the_reference() {
     let Some(gpu) = common::gpu() else { return };
     let mut rng = Rng::new(8);
-    let tex = Light::dome()
-        .with_path("/Tex")
-        .with_texture(Texture::new(png(8, 4, &mut rng)).with_format(TextureFormat::LatLong));
-    let plain = Light::dome().with_path("/Plain").with_intensity(0.5);
-    let normals: Vec<[f32; 3]> = (0..40).map(|_| unit(&mut rng)).collect();
-    // Some receivers share a normal (the host evaluates a dome once per distinct normal).
-    let normals: Vec<[f32; 3]> = normals.iter().chain(&normals[..10]).copied().collect();
+    let axis = DVec3::new(0.3, -0.5, 0.8).normalize();
+    let mut normals: Vec<[f32; 3]> = vec![
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0],
+        [1e-4, 1.0, 0.0],
+    ];
+    normals.extend((0..40).map(|_| unit(&mut rng)));
     let points: Vec<[f32; 3]> = (0..normals.len())
         .map(|i| [i as f32, -(i as f32), 3.0])
         .collect();
-    let lights = vec![tex.clone(), plain];
-    let cpu = Evaluator::cpu();
-    let want = cpu
-        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
-        .unwrap();
-    let got = gpu
-        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
-        .unwrap();
     let n = normals.len();
-    // The textured dome's rows are the reference's, bit for bit.
-    assert_eq!(&got[..n], &want[..n]);
-    for i in 0..n {
-        assert!(
-            rel(got[n + i], want[n + i]) < TOL,
-            "{i}: {:?} {:?}",
-            got[n + i],
-            want[n + i]
-        );
-        // A dome's irradiance depends on the normal only.
-        if i >= 40 {
-            assert_eq!(got[i], got[i - 40]);
+    let cpu = Evaluator::cpu();
+    let mut checked = 0;
+    for (w, h, filter, frame) in [
+        (1, 1, TextureFilter::Bilinear, 0),
+        (8, 4, TextureFilter::Bilinear, 1),
+        (8, 4, TextureFilter::Nearest, 0),
+        (13, 5, TextureFilter::Bilinear, 2),
+        (64, 32, TextureFilter::Bilinear, 3),
+        (64, 32, TextureFilter::Nearest, 1),
+    ] {
+        let mut texture = Texture::new(png(w, h, &mut rng))
+            .with_format(TextureFormat::LatLong)
+            .with_filter(filter);
+        if frame == 3 {
+            texture = texture.with_pole_axis(PoleAxis::Z);
         }
+        let mut tex = Light::dome().with_path("/Tex").with_texture(texture);
+        tex = match frame {
+            1 => tex.with_transform(DMat4::from_axis_angle(axis, 0.9)),
+            2 => tex.with_transform(
+                DMat4::from_axis_angle(axis, 0.4) * DMat4::from_scale(DVec3::splat(2.5)),
+            ),
+            _ => tex,
+        };
+        let plain = Light::dome().with_path("/Plain").with_intensity(0.5);
+        let lights = vec![tex, plain];
+        let want = cpu
+            .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+            .unwrap();
+        let got = gpu
+            .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+            .unwrap();
+        for i in 0..2 * n {
+            assert!(
+                rel(got[i], want[i]) < TOL,
+                "{w}x{h} {filter:?} frame {frame} row {i} (normal {:?}): {:?} vs {:?}",
+                normals[i % n],
+                got[i],
+                want[i]
+            );
+            checked += 1;
+        }
+        let sum = gpu
+            .irradiance(&lights, &points, &normals, Accumulate::Sum)
+            .unwrap();
+        for i in 0..n {
+            let expect = [0, 1, 2].map(|c| want[i][c] + want[n + i][c]);
+            assert!(rel(sum[i], expect) < TOL, "{i}: {:?} {:?}", sum[i], expect);
+        }
+        assert!(got[..n].iter().any(|v| v[0] > 0.0));
+        // The kernel integrated them: the host's rows would be the reference's bit for bit.
+        assert!(got[..n] != want[..n], "{w}x{h}: the reference's rows");
+        let worst = (0..n).map(|i| rel(got[i], want[i])).fold(0.0, f64::max);
+        eprintln!("{w}x{h} {filter:?} frame {frame}: worst relative difference {worst:.1e}");
     }
-    let sum = gpu
-        .irradiance(&lights, &points, &normals, Accumulate::Sum)
-        .unwrap();
-    for i in 0..n {
-        let expect = [0, 1, 2].map(|c| want[i][c] + want[n + i][c]);
-        assert!(rel(sum[i], expect) < TOL, "{i}: {:?} {:?}", sum[i], expect);
+    assert_eq!(checked, 6 * 2 * n);
+}
+
+/// The domes the kernel does not integrate (other formats; a frame that is not a rotation times
+/// a uniform scale) take their irradiance from the CPU reference (query's
+/// `irradiance_on_host`): exactly the reference's value rounded to f32.
+#[test]
+fn gpu_irradiance_of_other_textured_domes_is_the_reference() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(9);
+    let normals: Vec<[f32; 3]> = (0..24).map(|_| unit(&mut rng)).collect();
+    let points: Vec<[f32; 3]> = (0..normals.len()).map(|i| [i as f32, 0.0, 1.0]).collect();
+    let cpu = Evaluator::cpu();
+    let angular = Light::dome()
+        .with_texture(Texture::new(png(8, 8, &mut rng)).with_format(TextureFormat::Angular));
+    let sheared = Light::dome()
+        .with_texture(Texture::new(png(8, 4, &mut rng)).with_format(TextureFormat::LatLong))
+        .with_transform(DMat4::from_scale(DVec3::new(1.0, 2.0, 0.7)));
+    for light in [angular, sheared] {
+        let lights = vec![light];
+        let want = cpu
+            .irradiance(&lights, &points, &normals, Accumulate::Sum)
+            .unwrap();
+        let got = gpu
+            .irradiance(&lights, &points, &normals, Accumulate::Sum)
+            .unwrap();
+        assert_eq!(got, want);
+        assert!(got.iter().any(|v| v[0] > 0.0));
     }
-    assert!(got[..n].iter().any(|v| v[0] > 0.0));
 }

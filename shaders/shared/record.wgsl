@@ -42,7 +42,8 @@ struct Record {
     tex_inv0: vec4<f32>,
     tex_inv1: vec4<f32>,
     tex_inv2: vec4<f32>,
-    // Textured dome or rect: (atlas offset of the texture's header, filter code, 0, 0); in the
+    // Textured dome or rect: (atlas offset of the texture's header, filter code, offset of a
+    // dome's row tables when its irradiance is the device's (irradiance/latlong_rows.wgsl), 0); in the
     // sample and pdf kernels' copy a textured dome's z is its sampling table's offset (0: none;
     // gpu::sample::SampleLights).
     // A masked dome (FLAG_PORTALS): w is its portals' offset in the mesh atlas. A mesh light:

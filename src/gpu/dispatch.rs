@@ -24,12 +24,16 @@ pub(crate) struct GpuLights {
     /// kernels' copy with textured domes' sampling tables appended starts from them
     /// (`GpuContext::sample_lights`).
     pub(super) records: Vec<Record>,
+    /// The texture atlas's textures (the row tables after them are the irradiance kernel's
+    /// only; the sampling copy leaves them out).
     pub(super) tex_words: usize,
     count: usize,
     /// The optional kernel parts any of the lights needs (`Record::features`).
     features: Features,
     /// Whether some IES-shaped light's irradiance is the device's (not FLAG_HOST_IRRADIANCE).
     irradiance_ies: bool,
+    /// Whether some textured dome's irradiance is the device's (irradiance/latlong_rows.wgsl).
+    irradiance_texture: bool,
 }
 
 impl GpuLights {
@@ -41,14 +45,16 @@ impl GpuLights {
 
     /// The pipeline variant `kernel` needs for these lights: the optional parts some light
     /// needs (`GpuContext::pipeline` drops those the kernel's source lacks). The irradiance
-    /// kernel integrates no textured light (the host does, see
-    /// prepare::Prepared::irradiance_on_host), so it never needs the texture lookup; it needs
-    /// the IES lookup only for IES-shaped lights it integrates.
+    /// kernel looks up no texture (a textured rect's irradiance is the host's, see
+    /// prepare::Prepared::irradiance_on_host); it needs
+    /// the IES lookup only for IES-shaped lights it integrates, and its TEXTURE part (the row
+    /// integral of a textured latlong dome, irradiance/latlong_rows.wgsl) only for domes it
+    /// integrates.
     pub(super) fn variant(&self, kernel: Kernel) -> Features {
         let mut f = self.features;
         if kernel == Kernel::Irradiance {
             f.ies = self.irradiance_ies;
-            f.texture = false;
+            f.texture = self.irradiance_texture;
         }
         f
     }
@@ -217,13 +223,17 @@ impl GpuContext {
             tex_atlas: tex_atlas_buffer,
             mesh_atlas: mesh_atlas_buffer,
             records: records.to_vec(),
-            tex_words: tex_atlas.len(),
+            tex_words: tex_atlas.textures_len(),
             count: records.len(),
             features: records
                 .iter()
                 .fold(Features::default(), |f, r| f.union(r.features())),
             irradiance_ies: records.iter().any(|r| {
                 r.flags & super::record::FLAG_IES != 0
+                    && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
+            }),
+            irradiance_texture: records.iter().any(|r| {
+                r.flags & super::record::FLAG_DOME_TEXTURE != 0
                     && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
             }),
         }))

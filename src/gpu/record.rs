@@ -203,13 +203,13 @@ fn v4(v: glam::DVec3, w: f64) -> [f32; 4] {
 }
 
 /// Rounds a prepared light's f64 constants to its GPU record; `ies_base` is where its IES
-/// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture
-/// starts in the scene's texture atlas (`gpu::texture_atlas`), `atlas` its `tex` words in the
+/// profile starts in the scene's atlas (`gpu::ies_atlas`), `tex_offset` where its texture (and
+/// a dome's row tables) start in the scene's texture atlas (`gpu::texture_atlas`), `atlas` its `tex` words in the
 /// scene's mesh atlas (`gpu::mesh_atlas`: a mesh light's, a masked dome's).
 pub fn pack(
     p: &Prepared,
     ies_base: Option<super::ies_atlas::IesBases>,
-    tex_offset: Option<u32>,
+    tex_offset: Option<super::texture_atlas::LightTex>,
     atlas: Option<[u32; 4]>,
 ) -> Record {
     if p.radiance_on_host() {
@@ -274,7 +274,7 @@ pub fn pack(
             base.kinks as f32,
         ];
     }
-    if let (Some(t), Some(offset)) = (p.dome_texture(), tex_offset) {
+    if let (Some(t), Some(at)) = (p.dome_texture(), tex_offset) {
         r.flags |= FLAG_DOME_TEXTURE;
         let inv = t.frame.inv;
         r.tex_inv = [
@@ -282,12 +282,14 @@ pub fn pack(
             v4(inv.y_axis, 0.0),
             v4(inv.z_axis, 0.0),
         ];
-        r.tex = [offset, t.filter.code(), 0, 0];
+        // The row tables of a dome whose irradiance the kernel integrates
+        // (irradiance/latlong_rows.wgsl).
+        r.tex = [at.texture, t.filter.code(), at.rows.unwrap_or(0), 0];
     }
-    if let (Some(t), Some(offset)) = (p.rect_texture(), tex_offset) {
+    if let (Some(t), Some(at)) = (p.rect_texture(), tex_offset) {
         r.flags |= FLAG_RECT_TEXTURE;
         r.tex_inv[0] = v4(t.mean(), 0.0);
-        r.tex = [offset, t.filter().code(), 0, 0];
+        r.tex = [at.texture, t.filter().code(), 0, 0];
     }
     if p.irradiance_on_host() {
         r.flags |= FLAG_HOST_IRRADIANCE;

@@ -20,6 +20,8 @@ use std::sync::Arc;
 
 use crate::prepare::Prepared;
 use crate::prepare::env_table::EnvTable;
+use crate::prepare::latlong_rows;
+use crate::prepare::texture::Filter;
 use crate::prepare::texture::{
     CROSS_FACES, FILTER_BILINEAR, FILTER_NEAREST, FORMAT_ANGULAR, FORMAT_CROSS, FORMAT_LATLONG,
     FORMAT_MIRRORED_BALL, FORMAT_RECT, Image,
@@ -51,7 +53,12 @@ pub struct AtlasEntry {
 #[derive(Default, Debug, Clone)]
 pub struct Atlas {
     pub entries: Vec<AtlasEntry>,
+    /// Row tables of textured latlong domes whose irradiance the device integrates
+    /// (`prepare::latlong_rows`), after every texture: (offset, words).
+    pub rows: Vec<(u32, Arc<Vec<f32>>)>,
     len: usize,
+    /// Where the textures end (the sampling kernels copy only them, `gpu::sample`).
+    textures_len: usize,
 }
 
 impl Atlas {
@@ -78,6 +85,24 @@ impl Atlas {
             image: img,
         });
         self.len = end;
+        self.textures_len = end;
+        Ok(offset as u32)
+    }
+
+    /// Appends a latlong dome's row tables (after every texture: push them last) and returns
+    /// their offset (a record's `tex.z`).
+    pub fn push_rows(&mut self, words: Arc<Vec<f32>>, source: &Image) -> Result<u32, AtlasFull> {
+        let offset = self.len.next_multiple_of(4);
+        let end = offset + words.len();
+        if end > u32::MAX as usize {
+            return Err(AtlasFull {
+                path: source.source.display().to_string(),
+                width: source.width,
+                height: source.height,
+            });
+        }
+        self.rows.push((offset as u32, words));
+        self.len = end;
         Ok(offset as u32)
     }
 
@@ -86,16 +111,24 @@ impl Atlas {
         self.len
     }
 
+    /// Length of the textures' part (the row tables follow it).
+    pub fn textures_len(&self) -> usize {
+        self.textures_len
+    }
+
     /// What to upload where: (offset in f32 units, data), headers and texels, in order. Gaps
     /// (alignment padding) are never read.
     pub fn chunks(&self) -> impl Iterator<Item = (usize, &[f32])> {
-        self.entries.iter().flat_map(|e| {
-            let o = e.offset as usize;
-            [
-                (o, &e.header[..]),
-                (o + HEADER_WORDS, e.image.rgb.as_flattened()),
-            ]
-        })
+        self.entries
+            .iter()
+            .flat_map(|e| {
+                let o = e.offset as usize;
+                [
+                    (o, &e.header[..]),
+                    (o + HEADER_WORDS, e.image.rgb.as_flattened()),
+                ]
+            })
+            .chain(self.rows.iter().map(|(o, w)| (*o as usize, &w[..])))
     }
 
     /// Writes the whole buffer into `dst` (at least [`Self::len`] floats); padding words are
@@ -134,6 +167,11 @@ pub fn wgsl_constants() -> Vec<(&'static str, u32)> {
         ("ENV_TILE_WORDS", ENV_TILE_WORDS as u32),
         ("ENV_INNER_WORDS", ENV_INNER_WORDS as u32),
         ("ENV_NO_INNER", ENV_NO_INNER),
+        (
+            "LATLONG_ROWS_HEADER_WORDS",
+            latlong_rows::HEADER_WORDS as u32,
+        ),
+        ("LATLONG_ROWS_ENTRY_WORDS", latlong_rows::ENTRY_WORDS as u32),
     ]
 }
 
@@ -246,8 +284,17 @@ pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     vec![("CROSS_FACE_TABLE", table)]
 }
 
-/// The atlas, each light's texture offset, and the textures reduced to fit.
-pub type SceneAtlas = (Atlas, Vec<Option<u32>>, Vec<Reduced>);
+/// The atlas, each light's offsets in it, and the textures reduced to fit.
+pub type SceneAtlas = (Atlas, Vec<Option<LightTex>>, Vec<Reduced>);
+
+/// Where a light's texture, and a textured latlong dome's row tables, lie in the atlas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LightTex {
+    pub texture: u32,
+    /// Present for a dome whose irradiance the device integrates
+    /// (`prepare::Prepared::irradiance_on_host` false).
+    pub rows: Option<u32>,
+}
 
 /// A texture the GPU holds at a lower resolution than the file (see [`scene_atlas`]).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -271,7 +318,24 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
     // The distinct (image, format) pairs, and each light's index into them.
     let mut distinct: Vec<(Arc<Image>, u32)> = Vec::new();
     let mut which = Vec::with_capacity(lights.len());
+    // The distinct (image, filter) pairs of the domes whose irradiance the device integrates,
+    // with their row tables (prepare::latlong_rows), and each light's index into them.
+    let mut row_tables: Vec<(Arc<Image>, Filter, Arc<Vec<f32>>)> = Vec::new();
+    let mut which_rows = Vec::with_capacity(lights.len());
     for p in lights {
+        which_rows.push(match p.dome_texture() {
+            Some(t) if !p.irradiance_on_host() => {
+                let found = row_tables
+                    .iter()
+                    .position(|(img, f, _)| Arc::ptr_eq(img, &t.image) && *f == t.filter);
+                Some(found.unwrap_or_else(|| {
+                    let words = latlong_rows::device_words(&t.image, t.filter);
+                    row_tables.push((Arc::clone(&t.image), t.filter, Arc::new(words)));
+                    row_tables.len() - 1
+                }))
+            }
+            _ => None,
+        });
         // A dome's texture with its format's code; a rect's with FORMAT_RECT.
         let (image, code) = match (p.dome_texture(), p.rect_texture()) {
             (Some(t), _) => (&t.image, t.format.code()),
@@ -293,21 +357,36 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
         };
         which.push(Some(k));
     }
-    let reduced = fit(&mut distinct, limit_bytes);
+    // The row tables are exact and never reduced; the textures make room for them.
+    let rows_words: usize = row_tables.iter().map(|(_, _, w)| w.len() + 3).sum();
+    let reduced = fit(&mut distinct, limit_bytes, rows_words);
     let mut atlas = Atlas::new();
     let offsets: Vec<u32> = distinct
         .iter()
         .map(|(img, code)| atlas.push(Arc::clone(img), *code))
         .collect::<Result<_, _>>()?;
-    let per_light = which.into_iter().map(|k| k.map(|k| offsets[k])).collect();
+    let rows_offsets: Vec<u32> = row_tables
+        .iter()
+        .map(|(img, _, words)| atlas.push_rows(Arc::clone(words), img))
+        .collect::<Result<_, _>>()?;
+    let per_light = which
+        .into_iter()
+        .zip(which_rows)
+        .map(|(k, r)| {
+            k.map(|k| LightTex {
+                texture: offsets[k],
+                rows: r.map(|r| rows_offsets[r]),
+            })
+        })
+        .collect();
     Ok((atlas, per_light, reduced))
 }
 
 /// Halves the largest reducible texture of `distinct` until the packed atlas needs at most
 /// `limit_bytes` (or none is reducible); returns what was reduced (see [`scene_atlas`]).
-fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64) -> Vec<Reduced> {
+fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64, extra_words: usize) -> Vec<Reduced> {
     let words = |d: &[(Arc<Image>, u32)]| {
-        d.iter().fold(0usize, |n, (img, _)| {
+        d.iter().fold(extra_words, |n, (img, _)| {
             n.next_multiple_of(4) + HEADER_WORDS + 3 * img.width * img.height
         })
     };
@@ -397,9 +476,9 @@ mod tests {
         };
         // Room for everything: nothing reduced.
         let all = 4 * words(&d) as u64;
-        assert!(fit(&mut d, all).is_empty());
+        assert!(fit(&mut d, all, 0).is_empty());
         // One word short: the largest reducible texture (the latlong) is halved once.
-        let r = fit(&mut d, all - 4);
+        let r = fit(&mut d, all - 4, 0);
         assert_eq!(
             r,
             vec![Reduced {
@@ -413,7 +492,7 @@ mod tests {
         assert_eq!(d[0].0.rgb[8 + 1], [42.5, 1.0, 2.0]);
         // Far too little room: the 6 × 8 cross (N = 2) halves to 3 × 4 (N = 1, not halvable
         // again), the latlong down to 2 × 1; the odd 3 × 3 is never touched.
-        let r = fit(&mut d, 4);
+        let r = fit(&mut d, 4, 0);
         let sizes: Vec<(usize, usize)> = d.iter().map(|(i, _)| (i.width, i.height)).collect();
         assert_eq!(sizes, [(2, 1), (3, 4), (3, 3)]);
         assert_eq!(r.len(), 2, "{r:?}");

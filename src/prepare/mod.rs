@@ -13,6 +13,7 @@ mod fits_f32;
 pub mod gpu_path;
 pub mod ies;
 pub mod ies_kinks;
+pub mod latlong_rows;
 pub mod mesh_bvh;
 pub mod mesh_class;
 pub mod normalize;
@@ -438,9 +439,7 @@ impl Prepared {
             )
         } else {
             match &kind {
-                KindData::Dome { texture: Some(_) } => {
-                    GpuPath::HostIrradiance("it is a textured dome")
-                }
+                KindData::Dome { texture: Some(t) } => latlong_rows::gpu_path(t),
                 KindData::Rect { texture: Some(_) } => {
                     GpuPath::HostIrradiance("it is a textured rect")
                 }

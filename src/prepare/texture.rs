@@ -177,6 +177,19 @@ pub struct DomeFrame {
 }
 
 impl DomeFrame {
+    /// `w = |det A| / |A_eff d|⁴` (§6 D1's Jacobian over the normalisation's length, the
+    /// irradiance integrand's weight in dome space) when it is the same for every `d`: a
+    /// conformal frame, `A_effᵀ A_eff = s² I` (rotation × uniform scale) to 1e-13.
+    pub fn conformal_weight(&self) -> Option<f64> {
+        let gram = self.a_eff.transpose() * self.a_eff;
+        let s2 = self.det_abs.powf(2.0 / 3.0);
+        ((gram - DMat3::IDENTITY * s2)
+            .to_cols_array()
+            .iter()
+            .all(|v| v.abs() <= 1e-13 * s2))
+        .then(|| self.det_abs / (s2 * s2))
+    }
+
     /// `world` is the dome's world 3×3 (parents included) as glam's column-vector matrix
     /// ([`crate::model::Light::linear`]). Returns `None` for a singular matrix, which has no
     /// dome direction.

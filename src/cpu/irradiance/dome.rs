@@ -106,13 +106,7 @@ impl DomeIrradiance {
         let geom = Geometry::new(format, img.width, img.height);
         let grids = geom.grids(filter);
         let a = frame.a_eff;
-        let gram = a.transpose() * a;
-        let s2 = frame.det_abs.powf(2.0 / 3.0);
-        let conformal = ((gram - glam::DMat3::IDENTITY * s2)
-            .to_cols_array()
-            .iter()
-            .all(|v| v.abs() <= 1e-13 * s2))
-        .then(|| frame.det_abs / (s2 * s2));
+        let conformal = frame.conformal_weight();
         let kappa = (a.to_cols_array().iter().map(|v| v * v).sum::<f64>()
             * frame.inv.to_cols_array().iter().map(|v| v * v).sum::<f64>())
         .sqrt()

@@ -1,0 +1,180 @@
+//! A latlong dome texture's row tables: what the device needs to integrate the dome's exact
+//! irradiance (DESIGN.md §6 "Dome and texture irradiance: what 'exact' means") by rows of the
+//! texture, `shaders/irradiance/latlong_rows.wgsl` and its f64 twin
+//! `src/cpu/irradiance/latlong_rows.rs`, which carry the derivation.
+//!
+//! In the texture's column angle `u = 2π·px/W` (§6 D2: `d = (sin θ sin u, cos θ, −sin θ cos u)`,
+//! `θ = π·py/H`), one row `j` of the filtered texture at a fixed `y` is a periodic function
+//! `R_j(u)`, piecewise linear between column centres (bilinear) or constant on each column
+//! (nearest). A receiver's clamped cosine at a fixed θ is positive on one arc of `u`, and its
+//! integral over that arc needs only `∫ R_j {1, sin u, cos u} du` up to the arc's ends: the
+//! prefix sums over whole pieces stored here, and the ends' partial pieces in closed form.
+//!
+//! Layout (words, f32 or u32 bit patterns, from the table's offset):
+//! - `[W, H, filter code, 0]` ([`HEADER_WORDS`]);
+//! - `W` column phases `(cos u_k, sin u_k)` of piece `k`'s start `u_k = u₀ + k·h`, `h = 2π/W`,
+//!   `u₀ = h/2` (bilinear: pieces run between column centres) or 0 (nearest);
+//! - per row `j` (top first), `W + 1` entries of [`ENTRY_WORDS`]: the prefix
+//!   `∫ R_j {1, sin u, cos u} du` over pieces `0..k` (RGB each, exclusive, accumulated in f64),
+//!   then the row's value at piece `k`'s start (texel `k`; entry `W` repeats texel 0, the end of
+//!   the last bilinear piece under the columns' wrap).
+//!
+//! The device holds the tables only for textures of at most [`MAX_TEXELS`] texels and
+//! `W + H ≤` [`MAX_SIDES`] (`prepare::gpu_path`'s choice): the tables take four times the
+//! texture's memory, and the kernel's loop runs `W + H + 4` intervals (lavapipe's budget).
+
+use std::f64::consts::PI;
+
+use super::gpu_path::GpuPath;
+use super::texture::{DomeFormat, Filter, Image, PreparedTexture};
+
+/// Words before the column phases.
+pub const HEADER_WORDS: usize = 4;
+/// Words per row entry: prefix ∫R, ∫R sin u, ∫R cos u (RGB each), then the value.
+pub const ENTRY_WORDS: usize = 12;
+/// The most texels whose tables the device holds: a 2048 × 1024 map's tables take 101 MB
+/// (with its texels, 126 MB: under the 128 MiB storage binding every wgpu device offers).
+pub const MAX_TEXELS: usize = 2048 * 1024;
+/// The most `W + H` the kernel walks: its loop runs `W + H + 4` intervals of
+/// `rules::IRR_GL_ROWS` nodes each, well inside lavapipe's 65,535 loop iterations.
+pub const MAX_SIDES: usize = 4096;
+
+/// Whether the device can hold and walk the tables of a `width × height` texture.
+pub fn fits_device(width: usize, height: usize) -> bool {
+    width >= 1 && height >= 1 && width * height <= MAX_TEXELS && width + height <= MAX_SIDES
+}
+
+/// Where a textured dome's irradiance is integrated: on the device by rows for a latlong
+/// texture under a conformal frame (rotation × uniform scale, where the dome-space integral is
+/// the world one) whose tables fit; by the CPU reference otherwise, with the reason.
+pub fn gpu_path(t: &PreparedTexture) -> GpuPath {
+    if t.format != DomeFormat::LatLong {
+        GpuPath::HostIrradiance("it is a textured dome in a format other than latlong")
+    } else if t.frame.conformal_weight().is_none() {
+        GpuPath::HostIrradiance(
+            "it is a textured dome whose transform is not a rotation times a uniform scale",
+        )
+    } else if !fits_device(t.image.width, t.image.height) {
+        GpuPath::HostIrradiance(
+            "it is a textured dome over 2048 × 1024 texels, whose row tables the device does not hold",
+        )
+    } else {
+        GpuPath::Device
+    }
+}
+
+/// The tables' length in words.
+pub fn words_len(width: usize, height: usize) -> usize {
+    HEADER_WORDS + 2 * width + ENTRY_WORDS * height * (width + 1)
+}
+
+/// The tables as the device reads them: the header, then [`tables`] in f32.
+pub fn device_words(img: &Image, filter: Filter) -> Vec<f32> {
+    let mut out = Vec::with_capacity(words_len(img.width, img.height));
+    let header = [img.width as u32, img.height as u32, filter.code(), 0];
+    out.extend(header.map(f32::from_bits));
+    tables(img, filter, |v| v as f32, &mut out);
+    debug_assert_eq!(out.len(), words_len(img.width, img.height));
+    out
+}
+
+/// The row tables of `img` under `filter` after the header (the column phases, then the rows),
+/// each number converted by `conv` (f32 for the device, f64 for the twin), appended to `out`.
+pub fn tables<T: Copy>(img: &Image, filter: Filter, conv: impl Fn(f64) -> T, out: &mut Vec<T>) {
+    let (w, h) = (img.width, img.height);
+    let bilinear = filter == Filter::Bilinear;
+    let step = 2.0 * PI / w as f64;
+    let start = if bilinear { 0.5 * step } else { 0.0 };
+    let phases: Vec<(f64, f64)> = (0..w)
+        .map(|k| {
+            let (s, c) = (start + k as f64 * step).sin_cos();
+            (c, s)
+        })
+        .collect();
+    for &(c, s) in &phases {
+        out.push(conv(c));
+        out.push(conv(s));
+    }
+    for j in 0..h {
+        let row = &img.rgb[j * w..(j + 1) * w];
+        let mut acc = [[0.0f64; 3]; 3];
+        for k in 0..=w {
+            let v0 = row[k % w];
+            for m in acc.iter().flatten() {
+                out.push(conv(*m));
+            }
+            for c in v0 {
+                out.push(conv(f64::from(c)));
+            }
+            if k == w {
+                break;
+            }
+            let v1 = if bilinear { row[(k + 1) % w] } else { v0 };
+            let (cs, sn) = phases[k];
+            for ch in 0..3 {
+                let m = piece_moments(f64::from(v0[ch]), f64::from(v1[ch]), step, step, cs, sn);
+                for (a, q) in acc.iter_mut().zip(m) {
+                    a[ch] += q;
+                }
+            }
+        }
+    }
+}
+
+/// `∫₀^τ R(u_k + t) {1, sin, cos}(u_k + t) dt` for the piece starting at `u_k` (phase
+/// `(cos u_k, sin u_k)`) of length `len`, on which `R` runs linearly from `v0` to `v1`:
+/// with `β = (v1 − v0)/len`, `∫ (v0 + βt) e^{i(u_k + t)} dt = e^{iu_k} (v0 J₀ + β J₁)` where
+/// `J₀ = (sin τ, 2 sin²(τ/2))` and `J₁ = (τ sin τ − 2 sin²(τ/2), sin τ − τ cos τ)` (real, imaginary
+/// parts), written without differences of nearly equal sines so that a short piece keeps its
+/// absolute accuracy. The WGSL twin's `piece_moments` is the same formula in f32.
+pub fn piece_moments(v0: f64, v1: f64, len: f64, tau: f64, cos_k: f64, sin_k: f64) -> [f64; 3] {
+    let beta = (v1 - v0) / len;
+    let (s, c) = tau.sin_cos();
+    let half = (0.5 * tau).sin();
+    let vers = 2.0 * half * half;
+    let j0 = (s, vers);
+    let j1 = (tau * s - vers, s - tau * c);
+    let re = v0 * j0.0 + beta * j1.0;
+    let im = v0 * j0.1 + beta * j1.1;
+    [
+        v0 * tau + 0.5 * beta * tau * tau,
+        sin_k * re + cos_k * im,
+        cos_k * re - sin_k * im,
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The closed form against a fine midpoint rule, for short and long pieces.
+    #[test]
+    fn piece_moments_match_a_midpoint_rule() {
+        for &(v0, v1, len, tau, u) in &[
+            (1.0, 3.0, 0.5, 0.3, 0.2),
+            (2.0, -1.0, 2.0, 1.7, 4.0),
+            (0.5, 0.5, 1e-3, 7e-4, 2.5),
+            (1.0, 2.0, 6.283, 6.283, 0.0),
+        ] {
+            let n = 200_000;
+            let mut q = [0.0f64; 3];
+            for i in 0..n {
+                let t = (i as f64 + 0.5) * tau / n as f64;
+                let r = v0 + (v1 - v0) * t / len;
+                let a = u + t;
+                q[0] += r;
+                q[1] += r * a.sin();
+                q[2] += r * a.cos();
+            }
+            let got = piece_moments(v0, v1, len, tau, u.cos(), u.sin());
+            for k in 0..3 {
+                let want = q[k] * tau / n as f64;
+                assert!(
+                    (got[k] - want).abs() <= 1e-9 * (v0.abs() + v1.abs()) * tau,
+                    "{k}: {} vs {want}",
+                    got[k]
+                );
+            }
+        }
+    }
+}
