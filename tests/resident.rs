@@ -8,7 +8,7 @@ use crate::common;
 
 use luxeval::testkit::{Rng, ies::with_random_ies, random_light, synthetic_lights};
 use luxeval::wgpu;
-use luxeval::{Accumulate, Evaluator, Light, LuxError};
+use luxeval::{Accumulate, Asset, Evaluator, Light, LuxError, Texture, TextureFormat};
 
 /// What a renderer holds: its own device and queue.
 pub(crate) struct Renderer {
@@ -309,8 +309,19 @@ fn irradiance_matches_the_host_path_over_several_light_groups() {
     let n = 1_003;
     let pts = points(&mut rng, n);
     let normals = unit_rows(&mut rng, n);
-    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
-    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    assert_resident_irradiance_is_the_host_paths(&r, &scene, &pts, &normals);
+}
+
+/// `encode_irradiance` of `scene` gives the host path's rows, summed and per light.
+fn assert_resident_irradiance_is_the_host_paths(
+    r: &Renderer,
+    scene: &luxeval::PreparedScene,
+    pts: &[[f32; 3]],
+    normals: &[[f32; 3]],
+) {
+    let n = pts.len();
+    let pts_buf = r.buffer(pts, wgpu::BufferUsages::STORAGE);
+    let nrm_buf = r.buffer(normals, wgpu::BufferUsages::STORAGE);
     for (acc, rows) in [
         (Accumulate::Sum, n),
         (Accumulate::PerLight, scene.len() * n),
@@ -322,8 +333,67 @@ fn irradiance_matches_the_host_path_over_several_light_groups() {
             .encode_irradiance(&mut enc, &pts_buf, &nrm_buf, &out, n as u32, acc)
             .unwrap();
         let got = r.finish(enc, &out, rows);
-        let host = scene.irradiance(&pts, &normals, acc).unwrap();
+        let host = scene.irradiance(pts, normals, acc).unwrap();
         assert_same(&format!("irradiance {acc:?}"), &got, &host);
+    }
+}
+
+/// A textured latlong dome's irradiance is the kernel's (irradiance/latlong_rows.wgsl), so the
+/// GPU-resident call accepts it and gives the host path's rows; a mirroredBall dome's is the
+/// host's, and the call refuses it by name.
+#[test]
+fn textured_latlong_dome_irradiance_is_resident() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let mut rng = Rng::new(21);
+    let png = |format: TextureFormat, w: u32, h: u32, rng: &mut Rng| {
+        let img = image::RgbImage::from_fn(w, h, |_, _| {
+            image::Rgb([0, 1, 2].map(|_| 40 + rng.below(200) as u8))
+        });
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+        Texture::new(Asset::from_bytes(
+            format!("gen-{w}x{h}.png"),
+            bytes.into_inner(),
+        ))
+        .with_format(format)
+    };
+    let mut lights = synthetic_lights(2);
+    lights.push(Light::dome().with_path("/Env").with_texture(png(
+        TextureFormat::LatLong,
+        32,
+        16,
+        &mut rng,
+    )));
+    let scene = eval.prepare(&lights).unwrap();
+    let n = 257;
+    let pts = points(&mut rng, n);
+    let normals = unit_rows(&mut rng, n);
+    assert_resident_irradiance_is_the_host_paths(&r, &scene, &pts, &normals);
+    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
+    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    lights[2] = Light::dome().with_path("/Ball").with_texture(png(
+        TextureFormat::MirroredBall,
+        16,
+        16,
+        &mut rng,
+    ));
+    let scene = eval.prepare(&lights).unwrap();
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    match scene.encode_irradiance(
+        &mut enc,
+        &pts_buf,
+        &nrm_buf,
+        &out,
+        n as u32,
+        Accumulate::Sum,
+    ) {
+        Err(LuxError::NotOnDevice { light, reason, .. }) => {
+            assert_eq!(light, "/Ball");
+            assert!(reason.contains("latlong"), "{reason}");
+        }
+        other => panic!("expected NotOnDevice, got {other:?}"),
     }
 }
 

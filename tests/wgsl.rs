@@ -47,7 +47,8 @@ fn every_kernel_parses_and_validates() {
 
 /// Each kernel has the optional parts the pipelines select ([`Features`]), and a variant drops
 /// the code of a part that is off: the IES lookup and the texture lookups from emission and
-/// radiance, the chart quadrature and treatAsLine from irradiance.
+/// radiance, the chart quadrature, treatAsLine and the textured latlong dome's row integral from
+/// irradiance.
 #[test]
 fn optional_parts_are_dropped_from_the_source() {
     let lookups = Features {
@@ -59,17 +60,18 @@ fn optional_parts_are_dropped_from_the_source() {
     for k in [Kernel::Emission, Kernel::Radiance] {
         assert_eq!(Features::used_by(k), lookups, "{k:?}");
     }
-    // The irradiance kernel imports the IES lookup (through shaping) but no texture lookup.
+    // The irradiance kernel imports the IES lookup (through shaping) and no texture lookup; its
+    // TEXTURE part is the textured latlong dome's row integral.
     assert_eq!(
         Features::used_by(Kernel::Irradiance),
         Features {
             ies: true,
-            texture: false,
+            texture: true,
             chart: true,
             line: true
         }
     );
-    assert_eq!(Features::variants(Kernel::Irradiance).len(), 8);
+    assert_eq!(Features::variants(Kernel::Irradiance).len(), 16);
     assert_eq!(Features::variants(Kernel::Emission).len(), 4);
     let calls = |k, f, call: &str| {
         compose(k, f)
@@ -98,6 +100,8 @@ fn optional_parts_are_dropped_from_the_source() {
     assert_eq!(calls(irr, none, "chart_integral("), 1);
     assert_eq!(calls(irr, Features::ALL, "line_irradiance("), 2);
     assert_eq!(calls(irr, none, "line_irradiance("), 1);
+    assert_eq!(calls(irr, Features::ALL, "latlong_irradiance("), 2);
+    assert_eq!(calls(irr, none, "latlong_irradiance("), 1);
     // The inner rule (ten shaping calls written out) is applied from one place: each call site
     // is a copy for Mesa's compiler (shaders/irradiance/line.wgsl, inner_adaptive).
     assert_eq!(calls(irr, Features::ALL, "inner_rule("), 2);

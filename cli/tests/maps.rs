@@ -226,11 +226,11 @@ fn texture_filter_selects_the_reconstruction() {
     assert_eq!(outputs[0], outputs[2]);
 }
 
-/// `falloff` works with a textured dome on the default (GPU) path: the map equals the CPU
-/// reference's irradiance (the GPU path takes a textured dome's irradiance from it), and every
-/// pixel of a plane receives the same value (a dome is at infinity).
+/// `falloff` works with luxtest's textured latlong dome (2048 × 1024) on the default (GPU) path:
+/// the kernel's map is within 1e-4 of the CPU reference's irradiance (irradiance/latlong_rows.wgsl),
+/// and every pixel of a plane receives the same value (a dome is at infinity).
 #[test]
-fn falloff_of_a_textured_dome_is_the_reference() {
+fn falloff_of_a_textured_dome_matches_the_reference() {
     let Some(_) = common::gpu() else { return };
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("f.exr");
@@ -259,7 +259,11 @@ fn falloff_of_a_textured_dome_is_the_reference() {
         .unwrap()[0];
     let map = luxeval_cli::io::exr::read_exr(&out).unwrap();
     let px = &map.rgb;
-    assert!(px.iter().all(|p| *p == want), "{:?} vs {want:?}", &px[..2]);
+    assert!(px.iter().all(|p| *p == px[0]), "{:?}", &px[..2]);
+    for c in 0..3 {
+        let rel = (f64::from(px[0][c]) - f64::from(want[c])).abs() / f64::from(want[c]);
+        assert!(rel < 1e-4, "{:?} vs {want:?}", px[0]);
+    }
     assert!(want[0] > 0.0);
 }
 

@@ -153,7 +153,7 @@ fn every_scene_command_takes_portal_mode() {
 
 /// `check` on the window room in mask mode compares the masked dome's emission and radiance
 /// (on the device since the portal kernel, shaders/portal.wgsl) and lists it as not compared for
-/// nothing: its irradiance is the host's (nothing to compare), as for a textured dome.
+/// nothing: its irradiance is the host's (nothing to compare), as for a textured rect.
 #[test]
 fn check_compares_a_masked_domes_radiance() {
     if crate::common::gpu().is_none() {

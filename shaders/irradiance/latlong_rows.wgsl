@@ -1,6 +1,6 @@
-// A textured latlong dome's exact irradiance by rows of its texture. Twin of
-// src/cpu/irradiance/latlong_rows.rs, which carries the derivation (DESIGN.md §6 D1, D2 and
-// "what 'exact' means"); the tables are prepare::latlong_rows's, packed into the texture atlas
+// A textured latlong dome's exact irradiance by rows of its texture.
+// Twin of src/cpu/irradiance/latlong_rows.rs, which carries the derivation (DESIGN.md §6 D1, D2
+// and "what 'exact' means"); the tables are prepare::latlong_rows's, packed into the texture atlas
 // (tex_atlas, binding 6) after the textures by gpu::texture_atlas; a record's tex.z is their offset.
 //
 // f32 divergences from the f64 twin, and why:

@@ -282,8 +282,9 @@ pub fn check_with(
             )
         }));
         // Irradiance: the CPU values (quadratures) are computed in parallel. Not for the lights
-        // whose irradiance the GPU path takes from the CPU reference (textured domes and rects,
-        // bent IES profiles: Prepared::irradiance_on_host), so there is nothing to compare.
+        // whose irradiance the GPU path takes from the CPU reference (textured rects, textured
+        // domes but the latlong ones the kernel integrates, bent IES profiles:
+        // Prepared::irradiance_on_host), so there is nothing to compare.
         let ni = if p.irradiance_on_host() {
             0
         } else {

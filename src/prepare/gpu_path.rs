@@ -11,15 +11,17 @@ pub enum GpuPath {
     /// Every query on the device.
     Device,
     /// Every query on the device but irradiance, which is the CPU reference's until the f32
-    /// quadrature can match it; the reason is a phrase ("it is a textured dome"):
+    /// quadrature can match it; the reason is a phrase ("it is a textured rect"):
     /// - IES profiles of types A and B under angleScale: it bends their grid lines into
     ///   surfaces that are neither cones nor planes, which the kernel cannot split at
     ///   (`PreparedIes::device_families`; every other IES-shaped light is integrated on the
     ///   device, its lines split at the profile's grid cones and planes).
-    /// - Textured domes: the exact integral of the filtered texture (DESIGN.md §6 "what 'exact'
-    ///   means", src/cpu/irradiance/dome.rs) splits at texel-centre lines and the horizon; a
-    ///   dome's irradiance depends on the normal only, so the reference evaluates it once per
-    ///   distinct normal (one for a whole falloff map).
+    /// - Textured domes the kernel does not integrate by rows (`prepare::latlong_rows::gpu_path`:
+    ///   mirroredBall, angular and cross maps, frames that are not a rotation times a uniform
+    ///   scale, maps over 2048 × 1024 texels): the exact integral of the filtered texture
+    ///   (DESIGN.md §6 "what 'exact' means", src/cpu/irradiance/dome.rs) splits at texel-centre
+    ///   lines and the horizon; a dome's irradiance depends on the normal only, so the reference
+    ///   evaluates it once per distinct normal (one for a whole falloff map).
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).

@@ -147,6 +147,39 @@ pub fn piece_moments(v0: f64, v1: f64, len: f64, tau: f64, cos_k: f64, sin_k: f6
 mod tests {
     use super::*;
 
+    /// The device's limits: 2048 × 1024 (luxtest's dome) fits, one more row or column does not,
+    /// nor a strip whose walk would be too long; the packed length is `words_len`, and the
+    /// last entry of a row holds its total.
+    #[test]
+    fn tables_fit_the_device_up_to_2048_by_1024() {
+        assert!(fits_device(2048, 1024));
+        assert!(fits_device(1, 1));
+        assert!(!fits_device(2048, 1025));
+        assert!(!fits_device(2049, 1024));
+        assert!(!fits_device(4096, 1));
+        assert!(fits_device(4095, 1));
+        assert!(!fits_device(0, 4));
+        let img = Image {
+            width: 3,
+            height: 2,
+            rgb: vec![[1.0, 2.0, 0.5]; 6],
+            envmap: None,
+            source: "flat.exr".into(),
+        };
+        for filter in [Filter::Bilinear, Filter::Nearest] {
+            let words = device_words(&img, filter);
+            assert_eq!(words.len(), words_len(3, 2));
+            assert_eq!(words[0].to_bits(), 3);
+            assert_eq!(words[2].to_bits(), filter.code());
+            // Row 1's total of ∫R du: 2π × the constant value, per channel.
+            let total = HEADER_WORDS + 2 * 3 + ENTRY_WORDS * (4 + 3);
+            for (c, v) in [1.0, 2.0, 0.5].iter().enumerate() {
+                let want = 2.0 * PI * v;
+                assert!((f64::from(words[total + c]) - want).abs() < 1e-6 * want);
+            }
+        }
+    }
+
     /// The closed form against a fine midpoint rule, for short and long pieces.
     #[test]
     fn piece_moments_match_a_midpoint_rule() {
@@ -154,7 +187,7 @@ mod tests {
             (1.0, 3.0, 0.5, 0.3, 0.2),
             (2.0, -1.0, 2.0, 1.7, 4.0),
             (0.5, 0.5, 1e-3, 7e-4, 2.5),
-            (1.0, 2.0, 6.283, 6.283, 0.0),
+            (1.0, 2.0, 2.0 * PI, 2.0 * PI, 0.0),
         ] {
             let n = 200_000;
             let mut q = [0.0f64; 3];
