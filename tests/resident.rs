@@ -583,6 +583,42 @@ fn host_irradiance_lights_are_refused_by_name() {
         .unwrap();
 }
 
+/// A textured latlong dome's irradiance tables are exact and never halved: on a device with a
+/// 1 MiB storage binding the textures are halved to make room, and a dome whose tables alone
+/// (1.6 MB for 256 × 128) exceed it is refused by name, with the size and `--device cpu`.
+#[test]
+fn irradiance_tables_over_the_binding_limit_are_refused() {
+    let Some(r) = renderer_with(Some(wgpu::Limits {
+        max_storage_buffer_binding_size: 1 << 20,
+        ..wgpu::Limits::default()
+    })) else {
+        return;
+    };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let png = |w: u32, h: u32| {
+        let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb([x as u8, y as u8, 9]));
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+        Texture::new(Asset::from_bytes(
+            format!("big-{w}x{h}.png"),
+            bytes.into_inner(),
+        ))
+        .with_format(TextureFormat::LatLong)
+    };
+    // 64 × 32: its tables (101 KB) fit.
+    let small = Light::dome().with_path("/Small").with_texture(png(64, 32));
+    assert!(eval.prepare(&[small]).is_ok());
+    let big = Light::dome().with_path("/Big").with_texture(png(256, 128));
+    let e = eval.prepare(&[big]).err().expect("refused");
+    let msg = e.to_string();
+    assert!(matches!(e, LuxError::InvalidInput { .. }), "{e:?}");
+    assert!(
+        msg.contains("big-256x128.png") && msg.contains("irradiance tables"),
+        "{msg}"
+    );
+    assert!(msg.contains("--device cpu"), "{msg}");
+}
+
 #[test]
 fn counts_over_the_binding_limit_are_refused_with_the_most_one_call_takes() {
     // A renderer whose device has a 1 MiB storage binding limit (its buffers may be larger).

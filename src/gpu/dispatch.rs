@@ -170,8 +170,9 @@ impl GpuContext {
             return Err(LuxError::input(
                 "dome textures",
                 format!(
-                    "the scene's textures ({}) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes, and cannot be halved further (odd sizes); use smaller textures or --device cpu",
+                    "the scene's textures ({}) and latlong domes' irradiance tables ({} bytes, never halved) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes, and cannot be halved further (odd sizes); use smaller textures or --device cpu",
                     files.join(", "),
+                    (tex_atlas.len() - tex_atlas.textures_len()) * 4,
                     self.limits.max_storage_buffer_binding_size
                 ),
             ));

@@ -5,7 +5,10 @@
 //! Layout: textures one after another; a texture at offset `o` (f32 units, a multiple of 4) is
 //! `[width, height, format, 0]` as u32 bit patterns ([`HEADER_WORDS`] words), then
 //! `width × height` RGB f32 triplets, row-major, row 0 at the top: texel (i, j) at
-//! `o + 4 + 3(j·width + i)`. A light record stores its texture's offset as a u32 (exact, unlike
+//! `o + 4 + 3(j·width + i)`. After every texture, the row tables of each textured latlong dome
+//! whose irradiance the device integrates (`prepare::latlong_rows`, read by
+//! `shaders/irradiance/latlong_rows.wgsl`; the sampling kernels' copy of the atlas stops before
+//! them, [`Atlas::textures_len`]). A light record stores its texture's offset as a u32 (exact, unlike
 //! the IES atlas's f32 bases), so the atlas holds at most 2³² − 1 floats; the device's storage
 //! binding limit is usually far lower and is checked at upload
 //! (`GpuContext::upload`). An atlas without textures uploads one word (a storage binding cannot
@@ -382,8 +385,9 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
     Ok((atlas, per_light, reduced))
 }
 
-/// Halves the largest reducible texture of `distinct` until the packed atlas needs at most
-/// `limit_bytes` (or none is reducible); returns what was reduced (see [`scene_atlas`]).
+/// Halves the largest reducible texture of `distinct` until the packed atlas, with
+/// `extra_words` of row tables after it, needs at most `limit_bytes` (or none is reducible);
+/// returns what was reduced (see [`scene_atlas`]).
 fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64, extra_words: usize) -> Vec<Reduced> {
     let words = |d: &[(Arc<Image>, u32)]| {
         d.iter().fold(extra_words, |n, (img, _)| {
@@ -391,6 +395,10 @@ fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64, extra_words: usize)
         })
     };
     let mut reduced: Vec<Reduced> = Vec::new();
+    // Tables that alone exceed the limit: nothing to gain from halving (the upload refuses).
+    if (extra_words as u64).saturating_mul(4) > limit_bytes {
+        return reduced;
+    }
     while (words(distinct) as u64).saturating_mul(4) > limit_bytes {
         let largest = distinct
             .iter()
@@ -496,6 +504,21 @@ mod tests {
         let sizes: Vec<(usize, usize)> = d.iter().map(|(i, _)| (i.width, i.height)).collect();
         assert_eq!(sizes, [(2, 1), (3, 4), (3, 3)]);
         assert_eq!(r.len(), 2, "{r:?}");
+    }
+
+    /// Row tables after the textures count toward the limit (the textures are halved to make
+    /// room for them); tables that alone exceed it halve nothing.
+    #[test]
+    fn row_tables_are_made_room_for_and_never_halved() {
+        let mut d = vec![(img(16, 8, 1.0), FORMAT_LATLONG)];
+        let texture = 4 * (HEADER_WORDS + 3 * 16 * 8) as u64;
+        assert!(fit(&mut d, texture + 400, 100).is_empty());
+        let r = fit(&mut d, texture + 400, 101);
+        assert_eq!(r.len(), 1);
+        assert_eq!((d[0].0.width, d[0].0.height), (8, 4));
+        let mut d = vec![(img(16, 8, 1.0), FORMAT_LATLONG)];
+        assert!(fit(&mut d, 400, 101).is_empty());
+        assert_eq!((d[0].0.width, d[0].0.height), (16, 8));
     }
 
     #[test]

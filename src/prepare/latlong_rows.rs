@@ -25,6 +25,8 @@
 
 use std::f64::consts::PI;
 
+use rayon::prelude::*;
+
 use super::gpu_path::GpuPath;
 use super::texture::{DomeFormat, Filter, Image, PreparedTexture};
 
@@ -78,9 +80,15 @@ pub fn device_words(img: &Image, filter: Filter) -> Vec<f32> {
     out
 }
 
-/// The row tables of `img` under `filter` after the header (the column phases, then the rows),
-/// each number converted by `conv` (f32 for the device, f64 for the twin), appended to `out`.
-pub fn tables<T: Copy>(img: &Image, filter: Filter, conv: impl Fn(f64) -> T, out: &mut Vec<T>) {
+/// The row tables of `img` under `filter` after the header (the column phases, then the rows,
+/// built in parallel), each number converted by `conv` (f32 for the device, f64 for the twin),
+/// appended to `out`.
+pub fn tables<T: Copy + Default + Send + Sync>(
+    img: &Image,
+    filter: Filter,
+    conv: impl Fn(f64) -> T + Sync,
+    out: &mut Vec<T>,
+) {
     let (w, h) = (img.width, img.height);
     let bilinear = filter == Filter::Bilinear;
     let step = 2.0 * PI / w as f64;
@@ -95,29 +103,70 @@ pub fn tables<T: Copy>(img: &Image, filter: Filter, conv: impl Fn(f64) -> T, out
         out.push(conv(c));
         out.push(conv(s));
     }
-    for j in 0..h {
-        let row = &img.rgb[j * w..(j + 1) * w];
-        let mut acc = [[0.0f64; 3]; 3];
-        for k in 0..=w {
-            let v0 = row[k % w];
-            for m in acc.iter().flatten() {
-                out.push(conv(*m));
-            }
-            for c in v0 {
-                out.push(conv(f64::from(c)));
-            }
-            if k == w {
-                break;
-            }
-            let v1 = if bilinear { row[(k + 1) % w] } else { v0 };
-            let (cs, sn) = phases[k];
-            for ch in 0..3 {
-                let m = piece_moments(f64::from(v0[ch]), f64::from(v1[ch]), step, step, cs, sn);
-                for (a, q) in acc.iter_mut().zip(m) {
-                    a[ch] += q;
+    // Every whole piece has τ = h: its J₀, J₁ once.
+    let whole = PhaseIntegrals::new(step);
+    let row_words = ENTRY_WORDS * (w + 1);
+    let first = out.len();
+    out.resize(first + h * row_words, T::default());
+    out[first..]
+        .par_chunks_mut(row_words)
+        .zip(img.rgb.par_chunks(w))
+        .for_each(|(dst, row)| {
+            let mut acc = [[0.0f64; 3]; 3];
+            for (k, entry) in dst.chunks_exact_mut(ENTRY_WORDS).enumerate() {
+                let v0 = row[k % w];
+                for (d, m) in entry.iter_mut().zip(acc.iter().flatten()) {
+                    *d = conv(*m);
+                }
+                for (d, c) in entry[9..].iter_mut().zip(v0) {
+                    *d = conv(f64::from(c));
+                }
+                if k == w {
+                    break;
+                }
+                let v1 = if bilinear { row[(k + 1) % w] } else { v0 };
+                let (cs, sn) = phases[k];
+                for ch in 0..3 {
+                    let m = whole.moments(f64::from(v0[ch]), f64::from(v1[ch]), step, cs, sn);
+                    for (a, q) in acc.iter_mut().zip(m) {
+                        a[ch] += q;
+                    }
                 }
             }
+        });
+}
+
+/// `J₀ = ∫₀^τ e^{it} dt` and `J₁ = ∫₀^τ t e^{it} dt` as (real, imaginary) parts (see
+/// [`piece_moments`]).
+struct PhaseIntegrals {
+    tau: f64,
+    j0: (f64, f64),
+    j1: (f64, f64),
+}
+
+impl PhaseIntegrals {
+    fn new(tau: f64) -> PhaseIntegrals {
+        let (s, c) = tau.sin_cos();
+        let half = (0.5 * tau).sin();
+        let vers = 2.0 * half * half;
+        PhaseIntegrals {
+            tau,
+            j0: (s, vers),
+            j1: (tau * s - vers, s - tau * c),
         }
+    }
+
+    /// [`piece_moments`] over this τ.
+    fn moments(&self, v0: f64, v1: f64, len: f64, cos_k: f64, sin_k: f64) -> [f64; 3] {
+        let (tau, j0, j1) = (self.tau, self.j0, self.j1);
+        let beta = (v1 - v0) / len;
+        let re = v0 * j0.0 + beta * j1.0;
+        let im = v0 * j0.1 + beta * j1.1;
+        [
+            v0 * tau + 0.5 * beta * tau * tau,
+            sin_k * re + cos_k * im,
+            cos_k * re - sin_k * im,
+        ]
     }
 }
 
@@ -128,19 +177,7 @@ pub fn tables<T: Copy>(img: &Image, filter: Filter, conv: impl Fn(f64) -> T, out
 /// parts), written without differences of nearly equal sines so that a short piece keeps its
 /// absolute accuracy. The WGSL twin's `piece_moments` is the same formula in f32.
 pub fn piece_moments(v0: f64, v1: f64, len: f64, tau: f64, cos_k: f64, sin_k: f64) -> [f64; 3] {
-    let beta = (v1 - v0) / len;
-    let (s, c) = tau.sin_cos();
-    let half = (0.5 * tau).sin();
-    let vers = 2.0 * half * half;
-    let j0 = (s, vers);
-    let j1 = (tau * s - vers, s - tau * c);
-    let re = v0 * j0.0 + beta * j1.0;
-    let im = v0 * j0.1 + beta * j1.1;
-    [
-        v0 * tau + 0.5 * beta * tau * tau,
-        sin_k * re + cos_k * im,
-        cos_k * re - sin_k * im,
-    ]
+    PhaseIntegrals::new(tau).moments(v0, v1, len, cos_k, sin_k)
 }
 
 #[cfg(test)]

@@ -27,10 +27,17 @@
 //! (`a + b cos(u_k − ψ) = 0`, i.e. `θ_k = atan2(|n_y|, −ρ cos(u_k − ψ) sgn n_y)`; there the
 //! integrand's second derivative jumps), and the two tangencies `cos(u − ψ) = ±1` (the
 //! horizon's highest and lowest latitudes, where the arc appears or closes and `α` has a
-//! square-root branch point; an interval ending there is integrated in `s` with
-//! `θ = end ∓ (hi − lo) s²`, which makes the integrand smooth). The boundaries of each half of
-//! the circle (`u_k − ψ ∈ [0, π)` and `[−π, 0)`) give monotone θ's, so the breakpoints are a
-//! merge of four sorted sequences: `W + H + 4` intervals in all.
+//! square-root branch point: the integrand behaves like `|θ − θ_t|^{3/2}`). Every interval is
+//! integrated in `σ = √|θ − θ_t|` about the tangency nearest it, in which the integrand is
+//! smooth however close the interval comes to θ_t (crossings cluster there: one just past a
+//! tangency left the next interval nearly singular in θ, 2.7e-8 off on a 1 × 1 map), and
+//! intervals longer than [`crate::rules::IRR_ROWS_MAX_SPAN`] (coarse maps) in equal parts. The
+//! boundaries of each half of the circle (`u_k − ψ ∈ [0, π)` and `[−π, 0)`) give monotone θ's,
+//! so the breakpoints are a merge of four sorted sequences: `W + H + 4` intervals in all.
+//!
+//! With [`crate::rules::IRR_GL_ROWS`] = 6 the method agrees with the reference within 4e-11 on
+//! 1 × 1 … 64 × 32 maps (4 nodes: 5e-8, 8 nodes: 5e-13); the kernel's f32 tables and
+//! arithmetic, not the rule, set its error.
 
 use glam::DVec3;
 use std::f64::consts::PI;
