@@ -256,6 +256,39 @@ fn gpu_irradiance_of_a_textured_latlong_dome_matches_the_reference() {
     assert_eq!(checked, 6 * 2 * n);
 }
 
+/// A scene whose lights depend on the normal only (a textured latlong dome, a distant light)
+/// is integrated once per distinct normal on the GPU path: a falloff-like batch of 300
+/// receivers sharing 3 normals gives, bit for bit, the rows of those 3 normals evaluated alone
+/// (at other points), summed and per light, within 1e-4 of the reference.
+#[test]
+fn normal_only_scenes_are_integrated_once_per_distinct_normal() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(10);
+    let lights = vec![
+        Light::dome()
+            .with_path("/Env")
+            .with_texture(Texture::new(png(16, 8, &mut rng)).with_format(TextureFormat::LatLong)),
+        Light::distant(0.53).with_path("/Sun").with_intensity(3.0),
+    ];
+    let three: Vec<[f32; 3]> = (0..3).map(|_| unit(&mut rng)).collect();
+    let normals: Vec<[f32; 3]> = (0..300).map(|i| three[(i * 7) % 3]).collect();
+    let points: Vec<[f32; 3]> = (0..300).map(|i| [i as f32, 0.5, -(i as f32)]).collect();
+    let alone_points = vec![[-4.0f32, 2.0, 1.0]; 3];
+    let cpu = Evaluator::cpu();
+    for acc in [Accumulate::Sum, Accumulate::PerLight] {
+        let got = gpu.irradiance(&lights, &points, &normals, acc).unwrap();
+        let alone = gpu.irradiance(&lights, &alone_points, &three, acc).unwrap();
+        let want = cpu.irradiance(&lights, &points, &normals, acc).unwrap();
+        let rows = if acc == Accumulate::PerLight { 2 } else { 1 };
+        assert_eq!(got.len(), rows * 300);
+        for r in 0..rows * 300 {
+            let (l, i) = (r / 300, r % 300);
+            assert_eq!(got[r], alone[l * 3 + (i * 7) % 3], "{acc:?} row {r}");
+            assert!(rel(got[r], want[r]) < TOL, "{acc:?} row {r}");
+        }
+    }
+}
+
 /// The domes the kernel does not integrate (other formats; a frame that is not a rotation times
 /// a uniform scale) take their irradiance from the CPU reference (query's
 /// `irradiance_on_host`): exactly the reference's value rounded to f32.

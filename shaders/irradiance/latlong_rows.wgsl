@@ -8,10 +8,11 @@
 //    within ~1e-7 of the row's total, not of the arc's part of it.
 // 2. A partial piece's τ comes from the arc's end in units of pieces (x = (u − u₀)/h, ~2W at most):
 //    its rounding moves the end by ~W·2⁻²⁴ pieces, about 2e-7 of the row's total for W = 2048.
-// 3. sin and cos are the builtins (WGSL bounds them only to 2⁻¹¹ absolute; real devices and
-//    lavapipe are within ~1e-7 on [−2π, 2π]): in piece_moments, of τ ∈ [0, h]; for the nodes'
-//    θ; for the crossing θ's cos δ (a breakpoint moved by that much costs nothing: the
-//    integrand is C¹ there). The phases cos u_k, sin u_k are the tables' (f64, rounded once).
+// 3. sin and cos are the builtins (WGSL bounds them only to 2⁻¹¹ absolute; lavapipe's keep the
+//    kernel within 6.2e-7 of the reference, tests/dome_conformance.rs): in piece_moments, of
+//    τ ∈ [0, h]; for the nodes' θ; for the crossing θ's cos δ (a breakpoint moved a little costs
+//    nothing: the integrand is C¹ there). The phases cos u_k, sin u_k are the tables' (f64,
+//    rounded once), as irradiance/pieces.wgsl and closed.wgsl use the builtins too.
 // 4. Every loop checks its condition after it ends and sets irr_cut when the device's loop
 //    budget cut it short (shared/record.wgsl): W + H + 4 intervals, at most MAX_SIDES + 4
 //    (prepare::latlong_rows::fits_device), each with IRR_GL_ROWS nodes.

@@ -10,7 +10,7 @@ use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
 use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, mesh_atlas, record, texture_atlas};
-use crate::model::Light;
+use crate::model::{Light, LightType};
 use crate::prepare::{self, PortalMode, Prepared, TemperatureMode};
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
@@ -259,14 +259,65 @@ impl PreparedScene {
     ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", normals, "normals")?;
         let per_light = acc == Accumulate::PerLight;
-        let mut out = self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
-            cpu::irradiance_batch(&self.lights, points, normals, per_light, rule)
-        })?;
+        let mut out = match self.distinct_normals(normals) {
+            // Every light the kernel integrates depends on the normal only: one kernel row per
+            // distinct normal, copied to the rows that share it (the same input bits give the
+            // same output bits, so this is the undeduplicated answer).
+            Some((distinct, of_row)) => {
+                let origin = vec![[0.0f32; 3]; distinct.len()];
+                let rows = self.run(
+                    Kernel::Irradiance,
+                    &origin,
+                    Some(&distinct),
+                    per_light,
+                    || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
+                )?;
+                let (n, m) = (normals.len(), distinct.len());
+                let lights = if per_light { self.lights.len() } else { 1 };
+                (0..lights * n)
+                    .map(|r| rows[(r / n) * m + of_row[r % n]])
+                    .collect()
+            }
+            None => self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
+                cpu::irradiance_batch(&self.lights, points, normals, per_light, rule)
+            })?,
+        };
         if matches!(self.backend, Backend::Gpu(_)) {
             self.redo_spent_rows(points, normals, per_light, rule, &mut out);
             self.add_host_irradiance(points, normals, per_light, rule, &mut out);
         }
         Ok(out)
+    }
+
+    /// On a GPU evaluator whose kernel-integrated lights all depend on the normal only (domes
+    /// not masked by portals, distant lights: a textured dome's row integral costs the same for
+    /// every receiver, and a falloff map of a plane has one normal), the distinct normals and
+    /// each row's index among them; `None` elsewhere or when every normal differs. The host's
+    /// lights are added afterwards at every row (`add_host_irradiance`), as always.
+    fn distinct_normals(&self, normals: &[[f32; 3]]) -> Option<(Vec<[f32; 3]>, Vec<usize>)> {
+        if !matches!(self.backend, Backend::Gpu(_)) || normals.len() < 2 {
+            return None;
+        }
+        let normal_only = |p: &Prepared| {
+            p.irradiance_on_host()
+                || matches!(p.light.kind, LightType::Distant { .. })
+                || (p.light.kind == LightType::Dome && p.portals.is_none())
+        };
+        if !self.lights.iter().all(normal_only) {
+            return None;
+        }
+        let mut index = std::collections::HashMap::new();
+        let mut distinct = Vec::new();
+        let of_row: Vec<usize> = normals
+            .iter()
+            .map(|n| {
+                *index.entry(n.map(f32::to_bits)).or_insert_with(|| {
+                    distinct.push(*n);
+                    distinct.len() - 1
+                })
+            })
+            .collect();
+        (distinct.len() < normals.len()).then_some((distinct, of_row))
     }
 
     /// Rows the irradiance kernel could not finish (NaN: a chart with more outer breakpoints
