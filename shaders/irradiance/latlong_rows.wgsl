@@ -16,6 +16,9 @@
 // 4. Every loop checks its condition after it ends and sets irr_cut when the device's loop
 //    budget cut it short (shared/record.wgsl): W + H + 4 intervals, at most MAX_SIDES + 4
 //    (prepare::latlong_rows::fits_device), each with IRR_GL_ROWS nodes.
+// 5. Everything here is the optional part TEXTURE (gpu::shaders::Features): an irradiance
+//    pipeline without a textured dome to integrate is built without it (lavapipe compiles
+//    code it never calls).
 // GPU-only RowsInfo, RowMoments, RowEntry: structs standing in for the twin's Rows and tuples.
 // GPU-only rows_info: reads the tables' header (the twin's Rows holds the numbers).
 // GPU-only piece_moments: its f64 form is prepare::latlong_rows::piece_moments, which builds the
@@ -24,6 +27,7 @@
 // #import shared/record.wgsl
 // #import shared/math.wgsl
 
+// #if TEXTURE
 struct RowsInfo {
     base: u32,
     width: u32,
@@ -262,3 +266,4 @@ fn latlong_irradiance(t: RowsInfo, n: vec3<f32>) -> vec3<f32> {
     }
     return sum;
 }
+// #endif
