@@ -338,6 +338,13 @@ fn assert_resident_irradiance_is_the_host_paths(
     }
 }
 
+/// `img` encoded as a PNG texture named `name` (in memory).
+fn png_texture(name: &str, img: &image::RgbImage) -> Texture {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    Texture::new(Asset::from_bytes(name, bytes.into_inner()))
+}
+
 /// A textured latlong dome's irradiance is the kernel's (irradiance/latlong_rows.wgsl), so the
 /// GPU-resident call accepts it and gives the host path's rows; a mirroredBall dome's is the
 /// host's, and the call refuses it by name.
@@ -350,13 +357,7 @@ fn textured_latlong_dome_irradiance_is_resident() {
         let img = image::RgbImage::from_fn(w, h, |_, _| {
             image::Rgb([0, 1, 2].map(|_| 40 + rng.below(200) as u8))
         });
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-        Texture::new(Asset::from_bytes(
-            format!("gen-{w}x{h}.png"),
-            bytes.into_inner(),
-        ))
-        .with_format(format)
+        png_texture(&format!("gen-{w}x{h}.png"), &img).with_format(format)
     };
     let mut lights = synthetic_lights(2);
     lights.push(Light::dome().with_path("/Env").with_texture(png(
@@ -597,13 +598,7 @@ fn irradiance_tables_over_the_binding_limit_are_refused() {
     let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
     let png = |w: u32, h: u32| {
         let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb([x as u8, y as u8, 9]));
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-        Texture::new(Asset::from_bytes(
-            format!("big-{w}x{h}.png"),
-            bytes.into_inner(),
-        ))
-        .with_format(TextureFormat::LatLong)
+        png_texture(&format!("big-{w}x{h}.png"), &img).with_format(TextureFormat::LatLong)
     };
     // 64 × 32: its tables (101 KB) fit.
     let small = Light::dome().with_path("/Small").with_texture(png(64, 32));
