@@ -89,8 +89,8 @@ pub use prepare::ies::{
 };
 pub use prepare::{PortalMode, TemperatureMode};
 pub use query::{
-    Accumulate, Evaluator, Power, PreparedScene, Reference, SampleOptions, SamplerCheck, Samples,
-    Selection, StrategyVariance,
+    Accumulate, Evaluator, Power, PreparedScene, Reference, RowLayout, SampleOptions, SamplerCheck,
+    Samples, Selection, StrategyVariance,
 };
 #[cfg(feature = "usd")]
 pub use query::{lights_json, portal_multiplier};

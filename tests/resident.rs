@@ -8,7 +8,7 @@ use crate::common;
 
 use luxeval::testkit::{Rng, ies::with_random_ies, random_light, synthetic_lights};
 use luxeval::wgpu;
-use luxeval::{Accumulate, Asset, Evaluator, Light, LuxError, Texture, TextureFormat};
+use luxeval::{Accumulate, Asset, Evaluator, Light, LuxError, RowLayout, Texture, TextureFormat};
 
 /// What a renderer holds: its own device and queue.
 pub(crate) struct Renderer {
@@ -297,6 +297,158 @@ fn radiance_matches_the_host_path() {
             }
         }
     }
+}
+
+/// `rows` as 16-byte rows whose fourth float is NaN: a kernel that read it would show it.
+fn vec4_buffer(r: &Renderer, rows: &[[f32; 3]]) -> wgpu::Buffer {
+    let floats: Vec<f32> = rows
+        .iter()
+        .flat_map(|v| [v[0], v[1], v[2], f32::NAN])
+        .collect();
+    let b = r.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("renderer input, vec4 rows"),
+        size: (floats.len() * 4).max(16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    r.queue.write_buffer(&b, 0, bytemuck::cast_slice(&floats));
+    b
+}
+
+#[test]
+fn vec4_rows_are_the_packed_rows() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    // The IES mix for emission, intensity and radiance; five lights for irradiance (five
+    // dispatch groups on lavapipe, so the later groups add to rows the first wrote).
+    let packed = eval.prepare(&lights_with_ies()).unwrap();
+    let vec4 = eval
+        .prepare(&lights_with_ies())
+        .unwrap()
+        .with_row_layout(RowLayout::Vec4);
+    assert_eq!(vec4.row_layout(), RowLayout::Vec4);
+    assert_eq!(packed.row_layout(), RowLayout::Packed);
+    let mut rng = Rng::new(24);
+    let n = 4_099;
+    let dirs = unit_rows(&mut rng, n);
+    let pts = points(&mut rng, n);
+    let (dirs3, pts3) = (
+        r.buffer(&dirs, wgpu::BufferUsages::STORAGE),
+        r.buffer(&pts, wgpu::BufferUsages::STORAGE),
+    );
+    let (dirs4, pts4) = (vec4_buffer(&r, &dirs), vec4_buffer(&r, &pts));
+    // Runs one query in both layouts; the vec4 rows' fourth floats must be 0 and the rows
+    // past the call's untouched (the garbage `output` wrote).
+    let compare = |what: &str,
+                   rows: usize,
+                   run3: &dyn Fn(&mut wgpu::CommandEncoder, &wgpu::Buffer),
+                   run4: &dyn Fn(&mut wgpu::CommandEncoder, &wgpu::Buffer)| {
+        let out3 = r.output(rows);
+        let mut enc = r.encoder();
+        run3(&mut enc, &out3);
+        let want = r.finish(enc, &out3, rows);
+        // 4 floats a row, plus one row past the end.
+        let out4 = r.output((rows + 1) * 4 / 3 + 1);
+        let mut enc = r.encoder();
+        run4(&mut enc, &out4);
+        let got = r.finish_floats(enc, &out4, 4 * rows + 4);
+        for i in 0..rows {
+            assert_eq!(got[4 * i + 3], 0.0, "{what}: row {i}'s fourth float");
+        }
+        assert_eq!(
+            &got[4 * rows..],
+            &[1.0e6; 4],
+            "{what}: the row past the call"
+        );
+        let rows4: Vec<[f32; 3]> = got[..4 * rows]
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect();
+        assert_same(what, &rows4, &want);
+    };
+    for acc in [Accumulate::Sum, Accumulate::PerLight] {
+        let rows = if acc == Accumulate::Sum {
+            n
+        } else {
+            packed.len() * n
+        };
+        compare(
+            &format!("emission {acc:?}"),
+            rows,
+            &|e, o| packed.encode_emission(e, &dirs3, o, n as u32, acc).unwrap(),
+            &|e, o| vec4.encode_emission(e, &dirs4, o, n as u32, acc).unwrap(),
+        );
+        compare(
+            &format!("intensity {acc:?}"),
+            rows,
+            &|e, o| {
+                packed
+                    .encode_intensity(e, &dirs3, o, n as u32, acc)
+                    .unwrap()
+            },
+            &|e, o| vec4.encode_intensity(e, &dirs4, o, n as u32, acc).unwrap(),
+        );
+    }
+    // Radiance toward the lights' origins, so that rays hit shapes.
+    let origins: Vec<glam::DVec3> = packed.lights().map(|l| l.world.w_axis.truncate()).collect();
+    let aimed: Vec<[f32; 3]> = pts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let p = glam::DVec3::from_array(p.map(f64::from));
+            ((origins[i % origins.len()] - p).normalize() + rng.unit() * 0.05)
+                .normalize()
+                .as_vec3()
+                .to_array()
+        })
+        .collect();
+    let (aimed3, aimed4) = (
+        r.buffer(&aimed, wgpu::BufferUsages::STORAGE),
+        vec4_buffer(&r, &aimed),
+    );
+    let sum = Accumulate::Sum;
+    compare(
+        "radiance Sum",
+        n,
+        &|e, o| {
+            packed
+                .encode_radiance(e, &pts3, &aimed3, o, n as u32, sum)
+                .unwrap()
+        },
+        &|e, o| {
+            vec4.encode_radiance(e, &pts4, &aimed4, o, n as u32, sum)
+                .unwrap()
+        },
+    );
+    let packed = eval.prepare(&synthetic_lights(5)).unwrap();
+    let vec4 = eval
+        .prepare(&synthetic_lights(5))
+        .unwrap()
+        .with_row_layout(RowLayout::Vec4);
+    let m = 513;
+    compare(
+        "irradiance Sum",
+        m,
+        &|e, o| {
+            packed
+                .encode_irradiance(e, &pts3, &dirs3, o, m as u32, sum)
+                .unwrap()
+        },
+        &|e, o| {
+            vec4.encode_irradiance(e, &pts4, &dirs4, o, m as u32, sum)
+                .unwrap()
+        },
+    );
+    // A buffer of 12-byte rows is too small for `count` 16-byte ones.
+    let mut enc = r.encoder();
+    let out = r.output(4 * n);
+    let err = vec4
+        .encode_emission(&mut enc, &dirs3, &out, n as u32, sum)
+        .unwrap_err();
+    assert!(
+        matches!(&err, LuxError::InvalidInput { .. }) && err.to_string().contains("x, y, z, w"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -114,19 +114,30 @@ fn sample_index(gid: vec3<u32>) -> u32 {
     return gid.x + gid.y * params.row_stride;
 }
 
+// The f32 words of a row of in_a, in_b and out_rgb in the queries (not the sampling kernels'
+// own rows): 3 (packed, the host path's) or 4 (RowLayout::Vec4, GPU-resident only: 16-byte
+// rows, the fourth float ignored on input and written 0). A pipeline constant, so that the
+// driver sees the stride and can serve a 16-byte row in one aligned access.
+override ROW_WORDS: u32 = 3u;
+
 fn load3(buf_is_b: bool, i: u32) -> vec3<f32> {
+    let k = ROW_WORDS * i;
     if buf_is_b {
-        return vec3<f32>(in_b[3u * i], in_b[3u * i + 1u], in_b[3u * i + 2u]);
+        return vec3<f32>(in_b[k], in_b[k + 1u], in_b[k + 2u]);
     }
-    return vec3<f32>(in_a[3u * i], in_a[3u * i + 1u], in_a[3u * i + 2u]);
+    return vec3<f32>(in_a[k], in_a[k + 1u], in_a[k + 2u]);
 }
 
 // Writes one result: to the (light, sample) row when per_light, else (the caller passes the sum)
 // to the sample's row.
 fn store3(row: u32, v: vec3<f32>) {
-    out_rgb[3u * row] = v.x;
-    out_rgb[3u * row + 1u] = v.y;
-    out_rgb[3u * row + 2u] = v.z;
+    let k = ROW_WORDS * row;
+    out_rgb[k] = v.x;
+    out_rgb[k + 1u] = v.y;
+    out_rgb[k + 2u] = v.z;
+    if ROW_WORDS == 4u {
+        out_rgb[k + 3u] = 0.0;
+    }
 }
 
 // Every kernel loops over the lights for its sample i: `add` stores light l's value to its own
@@ -143,7 +154,8 @@ fn finish(i: u32, sum: vec3<f32>) {
     if params.per_light == 0u {
         var total = sum;
         if params.accumulate != 0u {
-            total += vec3<f32>(out_rgb[3u * i], out_rgb[3u * i + 1u], out_rgb[3u * i + 2u]);
+            let k = ROW_WORDS * i;
+            total += vec3<f32>(out_rgb[k], out_rgb[k + 1u], out_rgb[k + 2u]);
         }
         store3(i, total);
     }

@@ -67,8 +67,9 @@ pub struct Startup {
     pub pipelines: Vec<(String, std::time::Duration)>,
 }
 
-fn pipeline_name(kernel: Kernel, features: Features) -> String {
-    format!("{}{}", kernel.entry_point(), features.suffix())
+fn pipeline_name(kernel: Kernel, features: Features, row_words: u32) -> String {
+    let rows = if row_words == 3 { "" } else { "+vec4" };
+    format!("{}{}{rows}", kernel.entry_point(), features.suffix())
 }
 
 /// Environment variable that picks an adapter by (case-insensitive) name substring.
@@ -115,7 +116,7 @@ pub(crate) struct GpuContext {
     pub(crate) limits: wgpu::Limits,
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<(Kernel, Features), wgpu::ComputePipeline>>,
+    pipelines: Mutex<HashMap<(Kernel, Features, u32), wgpu::ComputePipeline>>,
     /// The persistent pipeline cache and its file (gpu/cache.rs), where the adapter has one.
     cache: Option<(wgpu::PipelineCache, std::path::PathBuf)>,
     cache_status: CacheStatus,
@@ -343,12 +344,25 @@ impl GpuContext {
     /// the IES lookup, the texture lookups, the irradiance chart quadrature and treatAsLine),
     /// compiled on first use. Parts the kernel's source lacks are ignored.
     pub fn pipeline(&self, kernel: Kernel, features: Features) -> Result<wgpu::ComputePipeline> {
+        self.pipeline_with_rows(kernel, features, 3)
+    }
+
+    /// [`GpuContext::pipeline`] with the rows of the query's buffers `row_words` f32 long (3:
+    /// packed, the host path's; 4: `RowLayout::Vec4`, GPU-resident only): WGSL's `override
+    /// ROW_WORDS`, so that the driver compiles the stride as a constant (16-byte rows as
+    /// single aligned accesses).
+    pub fn pipeline_with_rows(
+        &self,
+        kernel: Kernel,
+        features: Features,
+        row_words: u32,
+    ) -> Result<wgpu::ComputePipeline> {
         let features = features.restricted_to(Features::used_by(kernel));
         let mut cache = self
             .pipelines
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(p) = cache.get(&(kernel, features)) {
+        if let Some(p) = cache.get(&(kernel, features, row_words)) {
             return Ok(p.clone());
         }
         let source = shaders::compose(kernel, features);
@@ -360,6 +374,7 @@ impl GpuContext {
                 source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
             });
         let t0 = std::time::Instant::now();
+        let vec4_rows = [("ROW_WORDS", row_words as f64)];
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -367,7 +382,11 @@ impl GpuContext {
                 layout: Some(&self.pipeline_layout),
                 module: &module,
                 entry_point: Some(kernel.entry_point()),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                // The WGSL default is 3: the host path's pipelines set nothing.
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: if row_words == 3 { &[] } else { &vec4_rows },
+                    ..Default::default()
+                },
                 cache: self.cache.as_ref().map(|(c, _)| c),
             });
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -385,8 +404,8 @@ impl GpuContext {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
             .pipelines
-            .push((pipeline_name(kernel, features), took));
-        cache.insert((kernel, features), pipeline.clone());
+            .push((pipeline_name(kernel, features, row_words), took));
+        cache.insert((kernel, features, row_words), pipeline.clone());
         Ok(pipeline)
     }
 

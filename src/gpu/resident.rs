@@ -21,11 +21,12 @@ pub(crate) struct Operand<'a> {
     pub buffer: &'a wgpu::Buffer,
 }
 
-/// Bytes per row of every input and of the queries' outputs: three tightly packed f32.
+/// Bytes per row of the sampler's inputs: three tightly packed f32.
 const ROW_BYTES: u64 = 12;
 
 /// An input or query output row, and the GPU-resident sampler's output row, for messages.
 const TRIPLE: (u64, &str) = (ROW_BYTES, "f32 x, y, z");
+const QUAD: (u64, &str) = (16, "f32 x, y, z, w");
 const SAMPLE_ROW: (u64, &str) = (
     SAMPLE_ROW_FLOATS * 4,
     "f32 ω x, y, z, pdf, L r, g, b, light",
@@ -77,7 +78,7 @@ impl GpuContext {
 
     /// Records `kernel` over `count` rows of `a` (and `b`) into `encoder`, writing `out`:
     /// `count` rows summed over lights `0..n_lights`, or `n_lights × count` rows, light-major,
-    /// with `per_light`. Validates the buffers first (usage, size, aliasing, the device's
+    /// with `per_light`; every row of `row_words` f32 (3: packed, 4: vec4). Validates the buffers first (usage, size, aliasing, the device's
     /// binding and dispatch limits); the first call of a kernel builds its pipeline.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn encode(
@@ -91,9 +92,11 @@ impl GpuContext {
         out: Operand<'_>,
         count: u32,
         per_light: bool,
+        row_words: u32,
     ) -> Result<()> {
         let rows = if per_light { n_lights as u64 } else { 1 };
-        let in_bytes = count as u64 * ROW_BYTES;
+        let (row_bytes, row) = if row_words == 4 { QUAD } else { TRIPLE };
+        let in_bytes = count as u64 * row_bytes;
         let out_bytes = rows
             .checked_mul(in_bytes)
             .ok_or_else(|| LuxError::input(out.name, "the output size overflows u64"))?;
@@ -104,12 +107,12 @@ impl GpuContext {
             (Some(out), rows * count as u64),
         ] {
             let Some(op) = op else { continue };
-            check_buffer(op, wgpu::BufferUsages::STORAGE, n, TRIPLE)?;
+            check_buffer(op, wgpu::BufferUsages::STORAGE, n, (row_bytes, row))?;
         }
         check_distinct([Some(a), b], out)?;
-        // The kernels index the output as f32 with u32 arithmetic (3 · row + 2), and each
-        // binding must fit the device's storage binding limit.
-        let per_call = limit.min(4 * u32::MAX as u64) / (ROW_BYTES * rows.max(1));
+        // The kernels index the output as f32 with u32 arithmetic (ROW_WORDS · row + 3), and
+        // each binding must fit the device's storage binding limit.
+        let per_call = limit.min(4 * u32::MAX as u64) / (row_bytes * rows.max(1));
         if out_bytes > limit || in_bytes > limit || count as u64 > per_call {
             return Err(LuxError::input(
                 "count",
@@ -163,6 +166,7 @@ impl GpuContext {
             groups.len(),
             bound,
             grid,
+            row_words,
         )?;
         Ok(())
     }
@@ -305,6 +309,7 @@ impl GpuContext {
             1,
             bound,
             grid,
+            3,
         )?;
         Ok(())
     }
@@ -328,8 +333,9 @@ impl GpuContext {
         passes: usize,
         bound: [(Operand<'_>, u64); 3],
         grid: (u32, u32),
+        row_words: u32,
     ) -> Result<()> {
-        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
+        let pipeline = self.pipeline_with_rows(kernel, lights.variant(kernel), row_words)?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let params = self
             .device

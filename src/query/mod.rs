@@ -70,6 +70,33 @@ pub enum Accumulate {
     PerLight,
 }
 
+/// How the rows of a GPU-resident query's buffers are laid out ([`PreparedScene::with_row_layout`]):
+/// the directions, points and normals read and the rows written by
+/// [`PreparedScene::encode_emission`], `encode_intensity`, `encode_radiance` and
+/// `encode_irradiance` (not `encode_sample`, whose rows are its own).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RowLayout {
+    /// Three tightly packed `f32` a row (x, y, z or r, g, b): a 12-byte stride.
+    #[default]
+    Packed,
+    /// Four `f32` a row, a 16-byte stride (WGSL's `array<vec3<f32>>` and `array<vec4<f32>>`,
+    /// HLSL's `float4`): the fourth input float is ignored and the fourth output float is
+    /// written 0. Each row is one aligned 16-byte access, which a GPU's memory system serves
+    /// in fewer transactions than a 12-byte row's three 4-byte ones (BENCHMARKS.md, issue 24
+    /// item 7).
+    Vec4,
+}
+
+impl RowLayout {
+    /// The `f32` words of one row.
+    pub const fn words(self) -> u32 {
+        match self {
+            RowLayout::Packed => 3,
+            RowLayout::Vec4 => 4,
+        }
+    }
+}
+
 /// Evaluates the queries on one backend with one set of options. Cloning is cheap (the device
 /// is shared).
 #[derive(Clone, Debug)]

@@ -5,7 +5,7 @@
 //! module's).
 
 use super::sample::{SampleOptions, Selection};
-use super::{Accumulate, Backend, Evaluator, PreparedScene};
+use super::{Accumulate, Backend, Evaluator, PreparedScene, RowLayout};
 use crate::error::{LuxError, Result};
 use crate::gpu::record::{SELECT_BOUND, SELECT_POWER};
 use crate::gpu::resident::{Operand, ResidentDraw};
@@ -48,6 +48,23 @@ impl Evaluator {
 }
 
 impl PreparedScene {
+    /// This scene with its GPU-resident queries (`encode_emission`, `encode_intensity`,
+    /// `encode_radiance`, `encode_irradiance`) reading and writing rows of `layout` in the
+    /// caller's buffers: [`RowLayout::Packed`] (12 bytes, the default) or [`RowLayout::Vec4`]
+    /// (16 bytes; the fourth input float is ignored and the fourth output float written 0).
+    /// Nothing else changes: the host path's queries and `encode_sample` keep their own rows,
+    /// and the values are the same in either layout (the same kernels, compiled with the row's
+    /// stride as a constant: WGSL's `override ROW_WORDS`).
+    pub fn with_row_layout(mut self, layout: RowLayout) -> Self {
+        self.row_layout = layout;
+        self
+    }
+
+    /// The layout of the caller's buffers in GPU-resident queries ([`PreparedScene::with_row_layout`]).
+    pub fn row_layout(&self) -> RowLayout {
+        self.row_layout
+    }
+
     /// Records emission(light, ω) (see [`PreparedScene::emission`]) for `count` directions in
     /// `dirs` into `encoder`, writing `out`: GPU-resident evaluation, for callers whose data is
     /// already on the device. Nothing is uploaded, submitted or read back; the results are in
@@ -60,7 +77,9 @@ impl PreparedScene {
     /// Every buffer belongs to this scene's device ([`Evaluator::from_wgpu`], or
     /// [`Evaluator::wgpu_device`] of a GPU evaluator) and has `wgpu::BufferUsages::STORAGE`.
     /// Inputs and outputs are rows of three tightly packed `f32` (x, y, z or r, g, b): a 12-byte
-    /// stride with no padding (not a WGSL `array<vec3<f32>>`, whose stride is 16). Inputs hold
+    /// stride with no padding (not a WGSL `array<vec3<f32>>`, whose stride is 16), unless the
+    /// scene was given [`RowLayout::Vec4`] ([`PreparedScene::with_row_layout`]): then rows of
+    /// four `f32`, 16 bytes, the fourth ignored on input and written 0. Inputs hold
     /// at least `count` rows; `out` at least `count` rows with [`Accumulate::Sum`], or
     /// `lights × count` rows with [`Accumulate::PerLight`], light-major (row `l·count + i` is
     /// light `l` at sample `i`). Only the first rows are read and written: larger buffers are
@@ -413,6 +432,7 @@ impl PreparedScene {
             out,
             count,
             per_light,
+            self.row_layout.words(),
         )
     }
 }

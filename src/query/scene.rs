@@ -44,6 +44,8 @@ pub struct PreparedScene {
     /// Irradiance rows the kernel gave up on and the host recomputed (`redo_spent_rows`,
     /// `host_recomputed_rows`).
     spent_rows: std::sync::atomic::AtomicUsize,
+    /// The layout of the caller's buffers in GPU-resident queries (`with_row_layout`).
+    pub(super) row_layout: super::RowLayout,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -121,6 +123,7 @@ impl PreparedScene {
             sampling_tables: Default::default(),
             sampling_gpu: Default::default(),
             spent_rows: Default::default(),
+            row_layout: Default::default(),
         })
     }
 
