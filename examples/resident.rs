@@ -5,10 +5,11 @@
 //!
 //! ```sh
 //! cargo run --release --ignore-rust-version --example resident -- \
-//!     [LIGHTS] [DIRECTIONS] [REPEATS] [sum|per-light] [PASSES] [packed|vec4]
+//!     [LIGHTS] [DIRECTIONS] [REPEATS] [sum|per-light] [PASSES] [packed|vec4] [ROWS]
 //! ```
 //! (defaults: 8 lights, 4,000,000 directions, 10 repeats, `sum`, 1 pass, `packed` 12-byte rows
-//! (`vec4`: 16-byte rows, `RowLayout::Vec4`); the lights are
+//! (`vec4`: 16-byte rows, `RowLayout::Vec4`), the device's rows per invocation (ROWS: 1 to 16,
+//! through `testkit::with_rows_per_invocation`); the lights are
 //! `testkit::synthetic_lights`, the benchmark's mix of shaped and unshaped analytic lights).
 //! PASSES records the query that many times into one encoder per submit, so that a fast GPU's
 //! submit-and-wait overhead is spread over them; the time printed is per pass. The bytes a pass
@@ -50,6 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Some(other) => panic!("argument 6 must be packed or vec4, not {other:?}"),
     };
     let words = layout.words() as usize;
+    let rows_per_invocation = std::env::args().nth(7).map(|_| arg(7, 1) as u32);
     let out_rows = match acc {
         Accumulate::Sum => n,
         Accumulate::PerLight => lights * n,
@@ -74,9 +76,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // 2. luxeval on that device, and the lights prepared (uploaded) once.
     let eval = Evaluator::from_wgpu(device.clone(), queue.clone())?;
-    let scene = eval
+    let mut scene = eval
         .prepare(&luxeval::testkit::synthetic_lights(lights))?
         .with_row_layout(layout);
+    if let Some(r) = rows_per_invocation {
+        scene = luxeval::testkit::with_rows_per_invocation(scene, r);
+    }
 
     // 3. The renderer's data, already on the device: unit directions as tightly packed f32
     //    triples (12 bytes a row), or with `vec4` as four f32 (the fourth ignored). Uploaded
@@ -153,10 +158,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let bytes = ((n + out_rows) * 4 * words) as f64;
     println!("device: {}", eval.device_name());
     println!(
-        "emission, GPU-resident, {acc:?}, {layout:?} rows: {lights} lights × {n} directions, \
+        "emission, GPU-resident, {acc:?}, {layout:?} rows, {} an invocation: {lights} lights × {n} directions, \
          {passes} pass(es) a submit, median of {repeats} submits: {:.4} ms a pass ({:.3e} \
          evaluations/s, {:.1} GB/s of the {:.1} MB a pass must move; fastest {:.4} ms, slowest \
          {:.4} ms)",
+        rows_per_invocation.map_or("default".into(), |r| r.to_string()),
         median * 1e3,
         evals / median,
         bytes / median / 1e9,

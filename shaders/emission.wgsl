@@ -72,14 +72,18 @@ fn surface_emission(light: Record, e: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn emission_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = sample_index(gid);
-    if i >= params.count {
-        return;
+    let j = sample_index(gid);
+    let step = row_step();
+    for (var k = 0u; k < ROWS_PER_INVOCATION; k++) {
+        let i = j + k * step;
+        if j >= step || i >= params.count {
+            return;
+        }
+        let e = normalize(load3(false, i));
+        var sum = vec3<f32>(0.0);
+        for (var l = params.light_first; l < params.light_end; l++) {
+            add(i, l, emission(lights[l], e), &sum);
+        }
+        finish(i, sum);
     }
-    let e = normalize(load3(false, i));
-    var sum = vec3<f32>(0.0);
-    for (var l = params.light_first; l < params.light_end; l++) {
-        add(i, l, emission(lights[l], e), &sum);
-    }
-    finish(i, sum);
 }

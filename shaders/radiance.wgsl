@@ -77,15 +77,19 @@ fn radiance(light: Record, x: vec3<f32>, w: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(WORKGROUP_SIZE)
 fn radiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = sample_index(gid);
-    if i >= params.count {
-        return;
+    let j = sample_index(gid);
+    let step = row_step();
+    for (var k = 0u; k < ROWS_PER_INVOCATION; k++) {
+        let i = j + k * step;
+        if j >= step || i >= params.count {
+            return;
+        }
+        let x = load3(false, i);
+        let w = normalize(load3(true, i));
+        var sum = vec3<f32>(0.0);
+        for (var l = params.light_first; l < params.light_end; l++) {
+            add(i, l, radiance(lights[l], x, w), &sum);
+        }
+        finish(i, sum);
     }
-    let x = load3(false, i);
-    let w = normalize(load3(true, i));
-    var sum = vec3<f32>(0.0);
-    for (var l = params.light_first; l < params.light_end; l++) {
-        add(i, l, radiance(lights[l], x, w), &sum);
-    }
-    finish(i, sum);
 }

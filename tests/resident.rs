@@ -321,11 +321,15 @@ fn vec4_rows_are_the_packed_rows() {
     let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
     // The IES mix for emission, intensity and radiance; five lights for irradiance (five
     // dispatch groups on lavapipe, so the later groups add to rows the first wrote).
+    // The vec4 scene also takes three rows per invocation (a real GPU's resident path may;
+    // lavapipe's default is one), so that both the stride and the row loop are checked.
     let packed = eval.prepare(&lights_with_ies()).unwrap();
-    let vec4 = eval
-        .prepare(&lights_with_ies())
-        .unwrap()
-        .with_row_layout(RowLayout::Vec4);
+    let vec4 = luxeval::testkit::with_rows_per_invocation(
+        eval.prepare(&lights_with_ies())
+            .unwrap()
+            .with_row_layout(RowLayout::Vec4),
+        3,
+    );
     assert_eq!(vec4.row_layout(), RowLayout::Vec4);
     assert_eq!(packed.row_layout(), RowLayout::Packed);
     let mut rng = Rng::new(24);
@@ -439,6 +443,32 @@ fn vec4_rows_are_the_packed_rows() {
                 .unwrap()
         },
     );
+    // Packed rows, five per invocation (4,099 rows: the last invocation takes fewer).
+    let packed5 =
+        luxeval::testkit::with_rows_per_invocation(eval.prepare(&lights_with_ies()).unwrap(), 5);
+    let packed = eval.prepare(&lights_with_ies()).unwrap();
+    for acc in [Accumulate::Sum, Accumulate::PerLight] {
+        let rows = if acc == Accumulate::Sum {
+            n
+        } else {
+            packed.len() * n
+        };
+        let run = |scene: &luxeval::PreparedScene| {
+            let out = r.output(rows + 1);
+            let mut enc = r.encoder();
+            scene
+                .encode_emission(&mut enc, &dirs3, &out, n as u32, acc)
+                .unwrap();
+            r.finish(enc, &out, rows + 1)
+        };
+        let (got, want) = (run(&packed5), run(&packed));
+        assert_eq!(got[rows], [1.0e6; 3], "the row past the call");
+        assert_same(
+            &format!("emission {acc:?}, 5 rows an invocation"),
+            &got[..rows],
+            &want[..rows],
+        );
+    }
     // A buffer of 12-byte rows is too small for `count` 16-byte ones.
     let mut enc = r.encoder();
     let out = r.output(4 * n);

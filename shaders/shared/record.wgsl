@@ -120,6 +120,17 @@ fn sample_index(gid: vec3<u32>) -> u32 {
 // driver sees the stride and can serve a 16-byte row in one aligned access.
 override ROW_WORDS: u32 = 3u;
 
+// Rows per invocation of the emission, intensity and radiance kernels: 1 on the host path and
+// on CPU drivers; GPU-resident calls on a hardware adapter take `GpuContext::rows_per_invocation`
+// (a pipeline constant, like ROW_WORDS). Invocation j takes rows j, j + s, j + 2s, … with
+// s = row_step() = ⌈count / ROWS_PER_INVOCATION⌉, so that neighbouring invocations still read
+// and write neighbouring rows (coalesced), and each has several rows' loads in flight.
+override ROWS_PER_INVOCATION: u32 = 1u;
+
+fn row_step() -> u32 {
+    return (params.count + ROWS_PER_INVOCATION - 1u) / ROWS_PER_INVOCATION;
+}
+
 fn load3(buf_is_b: bool, i: u32) -> vec3<f32> {
     let k = ROW_WORDS * i;
     if buf_is_b {

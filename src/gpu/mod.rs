@@ -67,10 +67,49 @@ pub struct Startup {
     pub pipelines: Vec<(String, std::time::Duration)>,
 }
 
-fn pipeline_name(kernel: Kernel, features: Features, row_words: u32) -> String {
-    let rows = if row_words == 3 { "" } else { "+vec4" };
-    format!("{}{}{rows}", kernel.entry_point(), features.suffix())
+fn pipeline_name(kernel: Kernel, features: Features, rows: RowShape) -> String {
+    let mut name = format!("{}{}", kernel.entry_point(), features.suffix());
+    if rows.words != RowShape::HOST.words {
+        name += &format!("+rows{}", rows.words);
+    }
+    if rows.per_invocation != RowShape::HOST.per_invocation {
+        name += &format!("+x{}", rows.per_invocation);
+    }
+    name
 }
+
+/// The rows of a query's buffers as its pipeline is compiled for them: the f32 words of a row
+/// (WGSL's `ROW_WORDS`: 3 packed, 4 for `RowLayout::Vec4`) and the rows each invocation of the
+/// emission, intensity and radiance kernels takes (`ROWS_PER_INVOCATION`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct RowShape {
+    pub words: u32,
+    pub per_invocation: u32,
+}
+
+impl RowShape {
+    /// The host path's rows (and the WGSL defaults): packed, one per invocation.
+    pub const HOST: RowShape = RowShape {
+        words: 3,
+        per_invocation: 1,
+    };
+
+    /// The pipeline constants that differ from the WGSL defaults.
+    fn constants(self) -> Vec<(&'static str, f64)> {
+        let mut c = Vec::new();
+        if self.words != Self::HOST.words {
+            c.push(("ROW_WORDS", self.words as f64));
+        }
+        if self.per_invocation != Self::HOST.per_invocation {
+            c.push(("ROWS_PER_INVOCATION", self.per_invocation as f64));
+        }
+        c
+    }
+}
+
+/// The rows each invocation of a GPU-resident emission, intensity or radiance query takes on a
+/// hardware adapter ([`GpuContext::rows_per_invocation`]).
+const ROWS_PER_INVOCATION: u32 = 1;
 
 /// Environment variable that picks an adapter by (case-insensitive) name substring.
 pub const ADAPTER_ENV: &str = "LUXEVAL_ADAPTER";
@@ -116,7 +155,7 @@ pub(crate) struct GpuContext {
     pub(crate) limits: wgpu::Limits,
     pub(crate) layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    pipelines: Mutex<HashMap<(Kernel, Features, u32), wgpu::ComputePipeline>>,
+    pipelines: Mutex<HashMap<(Kernel, Features, RowShape), wgpu::ComputePipeline>>,
     /// The persistent pipeline cache and its file (gpu/cache.rs), where the adapter has one.
     cache: Option<(wgpu::PipelineCache, std::path::PathBuf)>,
     cache_status: CacheStatus,
@@ -344,25 +383,25 @@ impl GpuContext {
     /// the IES lookup, the texture lookups, the irradiance chart quadrature and treatAsLine),
     /// compiled on first use. Parts the kernel's source lacks are ignored.
     pub fn pipeline(&self, kernel: Kernel, features: Features) -> Result<wgpu::ComputePipeline> {
-        self.pipeline_with_rows(kernel, features, 3)
+        self.pipeline_with_rows(kernel, features, RowShape::HOST)
     }
 
-    /// [`GpuContext::pipeline`] with the rows of the query's buffers `row_words` f32 long (3:
-    /// packed, the host path's; 4: `RowLayout::Vec4`, GPU-resident only): WGSL's `override
-    /// ROW_WORDS`, so that the driver compiles the stride as a constant (16-byte rows as
-    /// single aligned accesses).
+    /// [`GpuContext::pipeline`] for rows of another [`RowShape`] (GPU-resident queries): its
+    /// fields are WGSL pipeline constants (`override ROW_WORDS`, `ROWS_PER_INVOCATION` in
+    /// shaders/shared/record.wgsl), so that the driver compiles the stride and the row loop as
+    /// constants (16-byte rows as single aligned accesses).
     pub fn pipeline_with_rows(
         &self,
         kernel: Kernel,
         features: Features,
-        row_words: u32,
+        rows: RowShape,
     ) -> Result<wgpu::ComputePipeline> {
         let features = features.restricted_to(Features::used_by(kernel));
         let mut cache = self
             .pipelines
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(p) = cache.get(&(kernel, features, row_words)) {
+        if let Some(p) = cache.get(&(kernel, features, rows)) {
             return Ok(p.clone());
         }
         let source = shaders::compose(kernel, features);
@@ -374,7 +413,7 @@ impl GpuContext {
                 source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
             });
         let t0 = std::time::Instant::now();
-        let vec4_rows = [("ROW_WORDS", row_words as f64)];
+        let constants = rows.constants();
         let pipeline = self
             .device
             .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -382,9 +421,9 @@ impl GpuContext {
                 layout: Some(&self.pipeline_layout),
                 module: &module,
                 entry_point: Some(kernel.entry_point()),
-                // The WGSL default is 3: the host path's pipelines set nothing.
+                // The WGSL defaults are the host path's: its pipelines set nothing.
                 compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: if row_words == 3 { &[] } else { &vec4_rows },
+                    constants: &constants,
                     ..Default::default()
                 },
                 cache: self.cache.as_ref().map(|(c, _)| c),
@@ -404,8 +443,8 @@ impl GpuContext {
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
             .pipelines
-            .push((pipeline_name(kernel, features, row_words), took));
-        cache.insert((kernel, features, row_words), pipeline.clone());
+            .push((pipeline_name(kernel, features, rows), took));
+        cache.insert((kernel, features, rows), pipeline.clone());
         Ok(pipeline)
     }
 
@@ -458,6 +497,24 @@ impl GpuContext {
             (Kernel::Irradiance, false) => 64,
             (_, true) => 16384,
             (_, false) => usize::MAX,
+        }
+    }
+
+    /// The rows each invocation of a GPU-resident `kernel` takes: 1 for irradiance and the
+    /// samplers (whose WGSL takes one row per invocation) and on llvmpipe (whose loops share
+    /// one budget per invocation, [`GpuContext::lights_per_dispatch`]); else `requested` (the
+    /// scene's, set by tests and benchmarks through `testkit::with_rows_per_invocation`) or
+    /// the default (BENCHMARKS.md, issue 24 item 7).
+    pub(crate) fn rows_per_invocation(&self, kernel: Kernel, requested: Option<u32>) -> u32 {
+        let simple = matches!(
+            kernel,
+            Kernel::Emission | Kernel::Intensity | Kernel::Radiance
+        );
+        match requested {
+            _ if !simple => 1,
+            Some(r) => r.clamp(1, 16),
+            None if self.is_llvmpipe() => 1,
+            None => ROWS_PER_INVOCATION,
         }
     }
 

@@ -78,7 +78,8 @@ impl GpuContext {
 
     /// Records `kernel` over `count` rows of `a` (and `b`) into `encoder`, writing `out`:
     /// `count` rows summed over lights `0..n_lights`, or `n_lights × count` rows, light-major,
-    /// with `per_light`; every row of `row_words` f32 (3: packed, 4: vec4). Validates the buffers first (usage, size, aliasing, the device's
+    /// with `per_light`; every row of `row_words` f32 (3: packed, 4: vec4), several rows per
+    /// invocation where [`GpuContext::rows_per_invocation`] says so. Validates the buffers first (usage, size, aliasing, the device's
     /// binding and dispatch limits); the first call of a kernel builds its pipeline.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn encode(
@@ -93,6 +94,7 @@ impl GpuContext {
         count: u32,
         per_light: bool,
         row_words: u32,
+        rows_per_invocation: Option<u32>,
     ) -> Result<()> {
         let rows = if per_light { n_lights as u64 } else { 1 };
         let (row_bytes, row) = if row_words == 4 { QUAD } else { TRIPLE };
@@ -131,7 +133,13 @@ impl GpuContext {
         let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
         let wg = count.div_ceil(WORKGROUP_SIZE);
         let lane_stride = self.lane_stride(kernel, lights);
-        let grid = self.grid(count * lane_stride);
+        // Several rows per invocation (emission, intensity, radiance on a hardware adapter):
+        // ⌈count / r⌉ invocations (shaders/shared/record.wgsl, `row_step`).
+        let shape = super::RowShape {
+            words: row_words,
+            per_invocation: self.rows_per_invocation(kernel, rows_per_invocation),
+        };
+        let grid = self.grid(count.div_ceil(shape.per_invocation) * lane_stride);
         if grid.1 > max_groups {
             return Err(LuxError::input(
                 "count",
@@ -166,7 +174,7 @@ impl GpuContext {
             groups.len(),
             bound,
             grid,
-            row_words,
+            shape,
         )?;
         Ok(())
     }
@@ -309,7 +317,7 @@ impl GpuContext {
             1,
             bound,
             grid,
-            3,
+            super::RowShape::HOST,
         )?;
         Ok(())
     }
@@ -333,9 +341,9 @@ impl GpuContext {
         passes: usize,
         bound: [(Operand<'_>, u64); 3],
         grid: (u32, u32),
-        row_words: u32,
+        rows: super::RowShape,
     ) -> Result<()> {
-        let pipeline = self.pipeline_with_rows(kernel, lights.variant(kernel), row_words)?;
+        let pipeline = self.pipeline_with_rows(kernel, lights.variant(kernel), rows)?;
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let params = self
             .device

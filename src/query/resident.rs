@@ -433,6 +433,7 @@ impl PreparedScene {
             count,
             per_light,
             self.row_layout.words(),
+            self.rows_per_invocation,
         )
     }
 }

@@ -46,6 +46,10 @@ pub struct PreparedScene {
     spent_rows: std::sync::atomic::AtomicUsize,
     /// The layout of the caller's buffers in GPU-resident queries (`with_row_layout`).
     pub(super) row_layout: super::RowLayout,
+    /// The rows each invocation of a GPU-resident emission, intensity or radiance query takes;
+    /// `None`: the device's default (`GpuContext::rows_per_invocation`). Set only through
+    /// `testkit::with_rows_per_invocation`.
+    pub(crate) rows_per_invocation: Option<u32>,
 }
 
 impl std::fmt::Debug for PreparedScene {
@@ -124,6 +128,7 @@ impl PreparedScene {
             sampling_gpu: Default::default(),
             spent_rows: Default::default(),
             row_layout: Default::default(),
+            rows_per_invocation: None,
         })
     }
 

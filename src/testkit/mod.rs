@@ -18,6 +18,19 @@ pub use crate::synthetic::{
 };
 pub use kernel_rule::kernel_rule_irradiance;
 
+/// `scene` with its GPU-resident emission, intensity and radiance queries taking `rows` rows
+/// per invocation (1 to 16; WGSL's `ROWS_PER_INVOCATION`), on any adapter: the tests' way to run
+/// the several-rows path on lavapipe, and the benchmark's to compare counts
+/// (`examples/resident.rs`). On llvmpipe, keep `rows ×` the lights of a dispatch well under
+/// its loop budget (65,535 iterations an invocation).
+pub fn with_rows_per_invocation(
+    mut scene: crate::PreparedScene,
+    rows: u32,
+) -> crate::PreparedScene {
+    scene.rows_per_invocation = Some(rows);
+    scene
+}
+
 /// The WGSL sources and the GPU record layouts, for the offline naga checks of `tests/wgsl.rs`
 /// and `tests/twins.rs`.
 pub mod wgsl {
