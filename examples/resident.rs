@@ -8,7 +8,7 @@
 //!     [LIGHTS] [DIRECTIONS] [REPEATS] [sum|per-light] [PASSES] [packed|vec4] [ROWS]
 //! ```
 //! (defaults: 8 lights, 4,000,000 directions, 10 repeats, `sum`, 1 pass, `packed` 12-byte rows
-//! (`vec4`: 16-byte rows, `RowLayout::Vec4`), the device's rows per invocation (ROWS: 1 to 16,
+//! (`vec4`: 16-byte rows, `RowLayout::Vec4`), the device's rows per invocation (2 on a hardware adapter, 1 on lavapipe; ROWS: 1 to 16,
 //! through `testkit::with_rows_per_invocation`); the lights are
 //! `testkit::synthetic_lights`, the benchmark's mix of shaped and unshaped analytic lights).
 //! PASSES records the query that many times into one encoder per submit, so that a fast GPU's

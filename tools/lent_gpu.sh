@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Issue 11 item 7: the benchmarks and the GPU test suite on a lent GPU (the `device` tool of the
 # developers' workplace; see BENCHMARKS.md "A real GPU"). Run there from the repository root as
-#     tools/lent_gpu.sh STEP...      (STEP: setup info tests resident cli bench)
+#     tools/lent_gpu.sh STEP...      (STEP: setup info tests resident cli maps bench ...)
 # with two carried folders, both ignored by git (.git/info/exclude):
 #   .gl/   the Vulkan loader's Debian packages (the machine has the NVIDIA driver, not the loader);
 #   .dev/  bins.tar.xz: x86-64 release binaries built here (luxeval, examples/resident,
@@ -49,28 +49,71 @@ info() {
 
 tests() {
     # CI=true: a GPU test fails, rather than skips, when no adapter is found.
+    # TEST_FILTER: the test-name filters given to every binary (none: all of its tests).
     for t in /tmp/bins/t_*; do
         case "${t##*/t_}" in ${SKIP_TESTS:-none}) echo "=== ${t##*/t_}: skipped this run"; continue ;; esac
         echo "=== ${t##*/t_}"
-        ( time CI=true timeout 240 "$t" --test-threads 8 2>&1 | tail -n 25 ) 2>&1
+        ( time CI=true timeout ${TEST_TIMEOUT:-240} "$t" --test-threads 16 ${TEST_FILTER:-} 2>&1 | tail -n 40 ) 2>&1
     done > "$OUT/tests.log" 2>&1
     grep -E '^(===|test result|real|.*FAILED|.*panicked)' "$OUT/tests.log" | head -n 80
 }
 
 resident() {
+    # GPU-resident emission against the bandwidth bound (issue 24 item 7): packed (12-byte) and
+    # vec4 (16-byte) rows, 1 to 4 rows an invocation (the last argument), 10 passes a submit;
+    # each prints the wall time per pass and the device's own (timestamp queries).
     {
-        for args in "8 4000000 20 sum 10" "8 4000000 20 per-light 10" "1 16000000 20 sum 10" \
-            "1 16000000 20 per-light 10" "64 4000000 10 sum 4" "8 16000000 10 sum 4"; do
-            echo "=== resident $args"
-            /tmp/bins/resident $args 2>&1
+        for shape in "1 16000000 20 sum 10" "1 16000000 20 per-light 10" \
+            "8 4000000 20 per-light 10" "8 16000000 10 sum 4" "1 64000000 10 sum 4"; do
+            for layout in packed vec4; do
+                for r in 1 2 4; do
+                    echo "=== resident $shape $layout $r"
+                    timeout 60 /tmp/bins/resident $shape $layout $r 2>&1
+                done
+            done
+        done
+        for args in "8 4000000 20 sum 10" "64 4000000 10 sum 4"; do
+            echo "=== resident $args packed 1"
+            timeout 60 /tmp/bins/resident $args packed 1 2>&1
         done
         # Light sampling (issue 23: 8 mixed lights × 4M samples, ≥ 1e9 samples/s GPU-resident).
         for args in "8 65536 64 20 bound 10" "8 65536 64 20 power 10" "64 65536 64 10 bound 4"; do
             echo "=== resident_sampling $args"
-            /tmp/bins/resident_sampling $args 2>&1
+            timeout 60 /tmp/bins/resident_sampling $args 2>&1
         done
     } > "$OUT/resident.log" 2>&1
     grep -E '^(===|emission|sampling)' "$OUT/resident.log"
+}
+
+maps() {
+    # "The jobs people run" (BENCHMARKS.md, issue 24): every luxtest floor, 128² and 1024², on
+    # the GPU and the CPU reference (16 cores), 1e-4 and 1e-2; luxeval_old (when carried) is
+    # the earlier binary, run in turn with the new one. Whole process, pipeline cache warm
+    # (a first run per scene fills it and is not timed).
+    floor="--origin -5,0,5 --u 10,0,0 --v 0,0,-10"
+    export LUXEVAL_CACHE_DIR=/tmp/lent-cache
+    bins="luxeval"
+    [ -x /tmp/bins/luxeval_old ] && bins="luxeval_old luxeval"
+    {
+        for sf in rect:31 sphere:31 disk:31 cylinder:31 distant:12 iesTest:15 dome:1 visibleRect:1; do
+            scene=${sf%%:*}; frame=${sf##*:}
+            f=tests/data/luxtest/usd/$scene.usda
+            for b in $bins; do
+                timeout 60 /tmp/bins/$b falloff $f --time $frame $floor --res 16,16 -o /tmp/w.exr --device gpu >/dev/null 2>&1
+            done
+            # GPU: old and new at 1e-4 (the device's f32 rule does not take a tolerance);
+            # CPU (new only): 128² at 1e-4, 1024² at 1e-4 and 1e-2.
+            for run in "gpu 128 1e-4 $bins" "gpu 1024 1e-4 $bins" "cpu 128 1e-4 luxeval" \
+                "cpu 1024 1e-4 luxeval" "cpu 1024 1e-2 luxeval"; do
+                set -- $run; dev=$1; res=$2; tol=$3; shift 3
+                for b in "$@"; do
+                    echo "--- $b $scene $res $dev $tol"
+                    ( time timeout 45 /tmp/bins/$b falloff $f --time $frame $floor --res $res,$res -o /tmp/m_${b}_${dev}.exr --device $dev --tolerance $tol >/dev/null ) 2>&1 | grep -E 'wall|rror'
+                done
+            done
+        done
+    } > "$OUT/maps.log" 2>&1
+    cat "$OUT/maps.log"
 }
 
 cli() {

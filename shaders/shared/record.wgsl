@@ -121,7 +121,7 @@ fn sample_index(gid: vec3<u32>) -> u32 {
 override ROW_WORDS: u32 = 3u;
 
 // Rows per invocation of the emission, intensity and radiance kernels: 1 on the host path and
-// on CPU drivers; GPU-resident calls on a hardware adapter take `GpuContext::rows_per_invocation`
+// on CPU drivers; GPU-resident calls on a hardware adapter take 2 (`GpuContext::rows_per_invocation`)
 // (a pipeline constant, like ROW_WORDS). Invocation j takes rows j, j + s, j + 2s, … with
 // s = row_step() = ⌈count / ROWS_PER_INVOCATION⌉, so that neighbouring invocations still read
 // and write neighbouring rows (coalesced), and each has several rows' loads in flight.

@@ -8,6 +8,7 @@
 //! (linear and quadratic equations); arcs meet planes in closed form (`A cos t + B sin t = C`)
 //! and cones by bracketing and bisection ([`bracket_roots`]).
 
+use arrayvec::ArrayVec;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -28,34 +29,36 @@ pub fn wrap_into(t: f64, t0: f64) -> f64 {
 }
 
 /// Real roots of qa·t² + 2·qb·t + qc = 0 (numerically stable).
-pub fn quadratic_roots(qa: f64, qb: f64, qc: f64) -> Vec<f64> {
+pub fn quadratic_roots(qa: f64, qb: f64, qc: f64) -> ArrayVec<f64, 2> {
+    let mut out = ArrayVec::new();
     if qa == 0.0 {
-        return if qb != 0.0 {
-            vec![-qc / (2.0 * qb)]
-        } else {
-            vec![]
-        };
+        if qb != 0.0 {
+            out.push(-qc / (2.0 * qb));
+        }
+        return out;
     }
     let disc = qb * qb - qa * qc;
     if disc < 0.0 {
-        return vec![];
+        return out;
     }
     let q = -(qb + qb.signum() * disc.sqrt());
     if q == 0.0 {
-        return vec![0.0];
+        out.push(0.0);
+        return out;
     }
-    vec![q / qa, qc / q]
+    out.extend([q / qa, qc / q]);
+    out
 }
 
 /// X where w = a + X e1 lies on the kink cone −ŵ·axis = cos (the correct nappe only):
 /// `(w·axis)² = cos²|w|²` is quadratic in X.
-pub fn cone_roots_on_line(axis: DVec3, cos: f64, a: DVec3, e1: DVec3) -> Vec<f64> {
+pub fn cone_roots_on_line(axis: DVec3, cos: f64, a: DVec3, e1: DVec3) -> ArrayVec<f64, 2> {
     let c2 = cos * cos;
     let (aa, ea) = (a.dot(axis), e1.dot(axis));
     let qa = ea * ea - c2 * e1.length_squared();
     let qb = aa * ea - c2 * a.dot(e1);
     let qc = aa * aa - c2 * a.length_squared();
-    let mut out = Vec::new();
+    let mut out = ArrayVec::new();
     for xk in quadratic_roots(qa, qb, qc) {
         let wa = -(aa + xk * ea);
         if wa * cos > 0.0 {
@@ -169,7 +172,7 @@ mod tests {
         // t² − 3t + 2 = 0 → 1, 2 (qb is half the linear coefficient).
         let mut r = quadratic_roots(1.0, -1.5, 2.0);
         r.sort_by(f64::total_cmp);
-        assert_eq!(r, vec![1.0, 2.0]);
+        assert_eq!(r.as_slice(), &[1.0, 2.0]);
         assert!(quadratic_roots(1.0, 0.0, 1.0).is_empty());
         // cos t = 0.5 → ±π/3.
         let r = lin_trig_roots(1.0, 0.0, 0.5);

@@ -19,6 +19,15 @@ use crate::cpu::roots::{axis_approach, cone_roots_on_line};
 use crate::cpu::shaping::shaping;
 use crate::prepare::Kink;
 
+thread_local! {
+    /// `line_integral`'s breakpoint list, kept by each thread between lines: a new list per
+    /// line cost a malloc and a realloc or two, and on many cores those calls contend for
+    /// malloc's arena locks (on a 16-core VM a 1024² map spent 3× its user time in the kernel:
+    /// BENCHMARKS.md, "The CPU path's system time").
+    static BREAKPOINTS: std::cell::RefCell<Vec<(f64, bool)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
 /// `∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX` along w = a + X e1 for X in [x0, x1], the line Y = `y` of the
 /// chart (`y` is read only for a textured rect's texture factor, `rect_texture`).
 pub fn line_integral<R: Rule>(
@@ -33,8 +42,11 @@ pub fn line_integral<R: Rule>(
         Some(v) => v,
         None => return DVec3::ZERO,
     };
-    // Breakpoints with their grading flag.
-    let mut bps: Vec<(f64, bool)> = vec![(lo, false), (hi, false)];
+    // Breakpoints with their grading flag, in the thread's list (taken, so that a nested call
+    // would get a list of its own).
+    let mut bps = BREAKPOINTS.with(|b| std::mem::take(&mut *b.borrow_mut()));
+    bps.clear();
+    bps.extend([(lo, false), (hi, false)]);
     // (An unshaped line has no shaping kinks; one whose factor is uniformly 1 ignores them.)
     let kinks: &[Kink] = if ctx.unshaped {
         &[]
@@ -127,6 +139,7 @@ pub fn line_integral<R: Rule>(
             }
         }
     }
+    BREAKPOINTS.with(|b| *b.borrow_mut() = bps);
     sum
 }
 

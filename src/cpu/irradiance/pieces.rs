@@ -132,16 +132,22 @@ fn grading(s: f64, lo: bool, hi: bool) -> (f64, f64) {
 
 /// A sub-interval with graded ends split so that only the quarter next to each graded end is
 /// graded (the cubic grading starves the rest of the interval of nodes): (t0, t1, lo, hi).
-pub fn graded_parts(t0: f64, t1: f64, g0: bool, g1: bool) -> Vec<(f64, f64, bool, bool)> {
+pub fn graded_parts(
+    t0: f64,
+    t1: f64,
+    g0: bool,
+    g1: bool,
+) -> arrayvec::ArrayVec<(f64, f64, bool, bool), 3> {
     let q = 0.25 * (t1 - t0);
-    match (g0, g1) {
-        (false, false) => vec![(t0, t1, false, false)],
-        (true, false) => vec![(t0, t0 + q, true, false), (t0 + q, t1, false, false)],
-        (false, true) => vec![(t0, t1 - q, false, false), (t1 - q, t1, false, true)],
-        (true, true) => vec![
+    let parts: &[(f64, f64, bool, bool)] = match (g0, g1) {
+        (false, false) => &[(t0, t1, false, false)],
+        (true, false) => &[(t0, t0 + q, true, false), (t0 + q, t1, false, false)],
+        (false, true) => &[(t0, t1 - q, false, false), (t1 - q, t1, false, true)],
+        (true, true) => &[
             (t0, t0 + q, true, false),
             (t0 + q, t1 - q, false, false),
             (t1 - q, t1, false, true),
         ],
-    }
+    };
+    parts.iter().copied().collect()
 }
