@@ -89,7 +89,9 @@ maps() {
     # "The jobs people run" (BENCHMARKS.md, issue 24): every luxtest floor, 128² and 1024², on
     # the GPU and the CPU reference (16 cores), 1e-4 and 1e-2; luxeval_old (when carried) is
     # the earlier binary, run in turn with the new one. Whole process, pipeline cache warm
-    # (a first run per scene fills it and is not timed).
+    # (a first run per scene fills it and is not timed). Each run is stopped after MAP_TIMEOUT
+    # seconds (20): the H200 run of 2026-11-26 spent most of its call on old binaries' host
+    # integrals stopped at 45 s, and never reached its last steps. Run `ceiling` first.
     floor="--origin -5,0,5 --u 10,0,0 --v 0,0,-10"
     export LUXEVAL_CACHE_DIR=/tmp/lent-cache
     bins="luxeval"
@@ -108,7 +110,7 @@ maps() {
                 set -- $run; dev=$1; res=$2; tol=$3; shift 3
                 for b in "$@"; do
                     echo "--- $b $scene $res $dev $tol"
-                    ( time timeout 45 /tmp/bins/$b falloff $f --time $frame $floor --res $res,$res -o /tmp/m_${b}_${dev}.exr --device $dev --tolerance $tol >/dev/null ) 2>&1 | grep -E 'wall|rror'
+                    ( time timeout ${MAP_TIMEOUT:-20} /tmp/bins/$b falloff $f --time $frame $floor --res $res,$res -o /tmp/m_${b}_${dev}.exr --device $dev --tolerance $tol >/dev/null ) 2>&1 | grep -E 'wall|rror'
                 done
             done
         done
