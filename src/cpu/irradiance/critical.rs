@@ -201,7 +201,11 @@ pub fn critical_ys_with(
 ) -> Vec<f64> {
     let axis = p.axis;
     let (ya, yb) = chart.y_range();
-    let mut ys = vec![ya, yb];
+    // Room for a typical chart's breakpoints at once: growing the list a push at a time cost
+    // several reallocations per receiver, which contend for malloc's locks on many cores
+    // (BENCHMARKS.md, "The CPU path's system time").
+    let mut ys = Vec::with_capacity(64);
+    ys.extend([ya, yb]);
     let mut planes: Vec<DVec3> = vec![n];
     let mut cones: Vec<f64> = Vec::new();
     for k in &prof.kinks {
@@ -332,7 +336,7 @@ pub fn ies_ys(p: &Prepared, chart: &Chart, n: DVec3, kinks: &IesKinks) -> Vec<f6
         }
     }
     let (segs, arcs) = region_edges(&lc);
-    let mut ys = Vec::new();
+    let mut ys = Vec::with_capacity(64);
     for &m in &kinks.planes {
         plane_ys(&mut ys, &lc, &segs, &arcs, m);
         for &m2 in fixed.iter().chain(&kinks.planes) {
