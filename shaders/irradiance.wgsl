@@ -152,7 +152,13 @@ fn irradiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var sum = vec3<f32>(0.0);
     for (var l = params.light_first; l < params.light_end; l++) {
         var v = vec3<f32>(0.0);
-        if valid {
+        // Params::light_filter. Normal-only: the kinds of Prepared::irradiance_is_normal_only
+        // (a masked dome is the host's, FLAG_HOST_IRRADIANCE, 0 in either pass).
+        let kind = lights[l].kind;
+        let normal_only = kind == KIND_DISTANT || kind == KIND_DOME;
+        let wanted = params.light_filter == LIGHTS_ALL
+            || (params.light_filter == LIGHTS_NORMAL_ONLY) == normal_only;
+        if valid && wanted {
             irr_cut = false;
             v = irradiance(lights[l], x, n);
             if irr_cut {

@@ -289,6 +289,82 @@ fn normal_only_scenes_are_integrated_once_per_distinct_normal() {
     }
 }
 
+/// A textured dome beside lights whose irradiance depends on the position: the kernel
+/// integrates the dome (and the distant light) once per distinct normal and the others per
+/// receiver (query's `irradiance_plan`), and adds them. Per light, each row is the row that
+/// scenes of the normal-only lights or of the positional lights alone give (bit for bit: the
+/// same kernel on the same inputs); summed, their sum; and within the tolerance of the
+/// reference.
+#[test]
+fn a_textured_dome_beside_local_lights_is_integrated_once_per_distinct_normal() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(24);
+    let dome = Light::dome()
+        .with_path("/Env")
+        .with_texture(Texture::new(png(16, 8, &mut rng)).with_format(TextureFormat::LatLong));
+    let sun = Light::distant(0.53).with_path("/Sun").with_intensity(3.0);
+    let sphere = Light::sphere(0.3)
+        .with_path("/Bulb")
+        .with_intensity(40.0)
+        .with_transform(DMat4::from_translation(DVec3::new(0.5, 2.0, -0.5)));
+    let rect = Light::rect(1.0, 0.5)
+        .with_path("/Panel")
+        .with_intensity(20.0)
+        .with_transform(DMat4::from_translation(DVec3::new(-1.0, 3.0, 0.0)));
+    // In scene order: positional and normal-only lights interleaved.
+    let lights = vec![sphere.clone(), dome.clone(), rect.clone(), sun.clone()];
+    let three: Vec<[f32; 3]> = vec![[0.0, 1.0, 0.0], unit(&mut rng), [0.3, 0.9, 0.1]];
+    let normals: Vec<[f32; 3]> = (0..120).map(|i| three[(i * 7) % 3]).collect();
+    let points: Vec<[f32; 3]> = (0..120)
+        .map(|i| [(i % 11) as f32 * 0.3 - 1.5, 0.0, (i % 7) as f32 * 0.4 - 1.2])
+        .collect();
+    let per = gpu
+        .irradiance(&lights, &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let normal_only = gpu
+        .irradiance(&[dome, sun], &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let positional = gpu
+        .irradiance(&[sphere, rect], &points, &normals, Accumulate::PerLight)
+        .unwrap();
+    let n = points.len();
+    for i in 0..n {
+        assert_eq!(per[i], positional[i], "sphere row {i}");
+        assert_eq!(per[n + i], normal_only[i], "dome row {i}");
+        assert_eq!(per[2 * n + i], positional[n + i], "rect row {i}");
+        assert_eq!(per[3 * n + i], normal_only[n + i], "sun row {i}");
+    }
+    let sum = gpu
+        .irradiance(&lights, &points, &normals, Accumulate::Sum)
+        .unwrap();
+    let want = Evaluator::cpu()
+        .irradiance(&lights, &points, &normals, Accumulate::Sum)
+        .unwrap();
+    for i in 0..n {
+        for c in 0..3 {
+            let total: f64 = (0..4).map(|l| per[l * n + i][c] as f64).sum();
+            assert!(
+                (sum[i][c] as f64 - total).abs() <= 1e-6 * total.abs(),
+                "row {i}: {} vs {total}",
+                sum[i][c]
+            );
+        }
+        assert!(
+            rel(sum[i], want[i]) < TOL,
+            "row {i}: {:?} vs {:?}",
+            sum[i],
+            want[i]
+        );
+    }
+    let lit = (0..n)
+        .filter(|&i| per[i][0] > 0.0 && per[2 * n + i][0] > 0.0)
+        .count();
+    assert!(
+        lit * 3 >= n,
+        "only {lit} of {n} receivers lit by both local lights"
+    );
+}
+
 /// The domes the kernel does not integrate (other formats; a frame that is not a rotation times
 /// a uniform scale) take their irradiance from the CPU reference (query's
 /// `irradiance_on_host`): exactly the reference's value rounded to f32.

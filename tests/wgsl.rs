@@ -189,7 +189,7 @@ fn params_layout_matches_naga() {
         ("row_stride", offset_of!(Params, row_stride)),
         ("accumulate", offset_of!(Params, accumulate)),
         ("lane_stride", offset_of!(Params, lane_stride)),
-        ("pad0", offset_of!(Params, pad)),
+        ("light_filter", offset_of!(Params, light_filter)),
         ("seed", offset_of!(Params, seed)),
         ("per_point", offset_of!(Params, per_point)),
         ("first_point", offset_of!(Params, first_point)),

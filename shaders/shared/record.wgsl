@@ -76,7 +76,10 @@ struct Params {
     // invocations it runs together, so an irradiance call whose quadrature is long runs one
     // sample per lane_stride invocations (GpuContext::lane_stride).
     lane_stride: u32,
-    pad0: u32,
+    // Which lights irradiance_main integrates (LIGHTS_ALL; LIGHTS_NORMAL_ONLY: distant lights
+    // and domes, whose irradiance depends on the normal alone, in a pass over the distinct
+    // normals; LIGHTS_POSITIONAL: the others); the rest give 0. 0 for every other kernel.
+    light_filter: u32,
     // GPU-resident sampling (sample_resident_main): the generator's seed, samples per point, the
     // first point's key (DESIGN.md §9 S3), the light choice (SELECT_POWER or SELECT_BOUND, plus
     // SELECT_HAS_NORMALS). 0 for every other kernel.

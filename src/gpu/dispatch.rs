@@ -242,7 +242,10 @@ impl GpuContext {
 
     /// Runs `kernel` over `a` (and `b`) for every light: `count` rows summed over lights, or
     /// `lights × count` rows in light-major order with `per_light`. `scratch` holds the buffers
-    /// of the last call and is replaced when this call needs another size class.
+    /// of the last call and is replaced when this call needs another size class. The
+    /// irradiance kernel integrates only the lights `light_filter` names (`record::LIGHTS_*`;
+    /// the others' rows are 0); the other kernels ignore it.
+    #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
         kernel: Kernel,
@@ -251,6 +254,7 @@ impl GpuContext {
         a: Input<'_>,
         b: Option<Input<'_>>,
         per_light: bool,
+        light_filter: u32,
     ) -> Result<Vec<[f32; 3]>> {
         let n = a.rows.len();
         let count = lights.count;
@@ -274,7 +278,17 @@ impl GpuContext {
         }
         let s = scratch.as_ref().expect("set above");
         let lane_stride = self.lane_stride(kernel, lights);
-        let result = self.run_chunks(&pipeline, kernel, s, a, b, per_light, lane_stride, &mut out);
+        let result = self.run_chunks(
+            &pipeline,
+            kernel,
+            s,
+            a,
+            b,
+            per_light,
+            lane_stride,
+            light_filter,
+            &mut out,
+        );
         let oom = pollster::block_on(oom.pop());
         let validation = pollster::block_on(validation.pop());
         // A lost device fails every later call with validation errors about invalid buffers;
@@ -373,6 +387,7 @@ impl GpuContext {
         b: Option<Input<'_>>,
         per_light: bool,
         lane_stride: u32,
+        light_filter: u32,
         out: &mut [[f32; 3]],
     ) -> Result<()> {
         let n = a.rows.len();
@@ -387,7 +402,15 @@ impl GpuContext {
                 self.write_rows(buf, b, start..start + count)?;
             }
             let grid = self.grid(count as u32 * lane_stride);
-            let block = params_block(groups, align, count as u32, per_light, grid, lane_stride);
+            let block = params_block(
+                groups,
+                align,
+                count as u32,
+                per_light,
+                grid,
+                lane_stride,
+                light_filter,
+            );
             self.queue.write_buffer(&s.params, 0, &block);
             let mut enc = self
                 .device
@@ -530,6 +553,7 @@ pub(super) fn params_block(
     per_light: bool,
     (gx, _): (u32, u32),
     lane_stride: u32,
+    light_filter: u32,
 ) -> Vec<u8> {
     let mut block = vec![0u8; groups.len() * align];
     for (g, &(first, end)) in groups.iter().enumerate() {
@@ -541,6 +565,7 @@ pub(super) fn params_block(
             row_stride: gx * WORKGROUP_SIZE,
             accumulate: (g > 0) as u32,
             lane_stride,
+            light_filter,
             ..Params::default()
         };
         block[g * align..g * align + std::mem::size_of::<Params>()]

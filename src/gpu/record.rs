@@ -92,6 +92,9 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_MESH_FRONTS", FLAG_MESH_FRONTS),
     ("FLAG_PORTALS", FLAG_PORTALS),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
+    ("LIGHTS_ALL", LIGHTS_ALL),
+    ("LIGHTS_NORMAL_ONLY", LIGHTS_NORMAL_ONLY),
+    ("LIGHTS_POSITIONAL", LIGHTS_POSITIONAL),
     ("SELECT_POWER", SELECT_POWER),
     ("SELECT_BOUND", SELECT_BOUND),
     ("SELECT_HAS_NORMALS", SELECT_HAS_NORMALS),
@@ -181,7 +184,9 @@ pub struct Params {
     /// Invocations per sample (1, or on llvmpipe more for an irradiance call with a light whose
     /// quadrature is long: `GpuContext::lane_stride`); the others return at once.
     pub lane_stride: u32,
-    pub pad: u32,
+    /// Which lights the irradiance kernel integrates ([`LIGHTS_ALL`], [`LIGHTS_NORMAL_ONLY`],
+    /// [`LIGHTS_POSITIONAL`]); the others give 0. 0 for every other kernel.
+    pub light_filter: u32,
     /// GPU-resident sampling (`sample_resident_main`): the generator's seed, samples per point,
     /// the first point's key (DESIGN.md §9 S3) and the light choice ([`SELECT_POWER`] or
     /// [`SELECT_BOUND`], plus [`SELECT_HAS_NORMALS`]). 0 for every other kernel.
@@ -190,6 +195,15 @@ pub struct Params {
     pub first_point: u32,
     pub select: u32,
 }
+
+/// `Params::light_filter`: every light.
+pub const LIGHTS_ALL: u32 = 0;
+/// `Params::light_filter`: only the lights whose irradiance depends on the receiver's normal
+/// alone (distant lights and domes: `Prepared::irradiance_is_normal_only`), for a pass over
+/// the distinct normals of the receivers (`query::scene`).
+pub const LIGHTS_NORMAL_ONLY: u32 = 1;
+/// `Params::light_filter`: every light but those of [`LIGHTS_NORMAL_ONLY`].
+pub const LIGHTS_POSITIONAL: u32 = 2;
 
 /// `Params::select`: choose lights by power.
 pub const SELECT_POWER: u32 = 0;

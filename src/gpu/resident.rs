@@ -161,7 +161,15 @@ impl GpuContext {
         };
         // One Params block per light group at the uniform offset alignment.
         let align = self.params_align();
-        let block = params_block(&groups, align, count, per_light, grid, lane_stride);
+        let block = params_block(
+            &groups,
+            align,
+            count,
+            per_light,
+            grid,
+            lane_stride,
+            super::record::LIGHTS_ALL,
+        );
         // Emission and intensity read no second input; bind the first again (read-only
         // aliasing is allowed).
         let bound = [(a, in_bytes), (b.unwrap_or(a), in_bytes), (out, out_bytes)];
@@ -288,7 +296,15 @@ impl GpuContext {
             None => &sampling.buffer,
         };
         let align = self.params_align();
-        let mut block = params_block(&[(0, n_lights)], align, count, false, grid, 1);
+        let mut block = params_block(
+            &[(0, n_lights)],
+            align,
+            count,
+            false,
+            grid,
+            1,
+            super::record::LIGHTS_ALL,
+        );
         let params = Params {
             seed: draw.seed,
             per_point: draw.per_point,

@@ -304,7 +304,15 @@ impl GpuContext {
             self.queue.write_buffer(&buf_a, 0, bytemuck::cast_slice(a));
             self.queue.write_buffer(&buf_b, 0, bytemuck::cast_slice(b));
             let grid = self.grid(count as u32);
-            let block = params_block(&[(0, 0)], align, count as u32, false, grid, 1);
+            let block = params_block(
+                &[(0, 0)],
+                align,
+                count as u32,
+                false,
+                grid,
+                1,
+                super::record::LIGHTS_ALL,
+            );
             self.queue.write_buffer(&params, 0, &block);
             let mut enc = dev.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some(kernel.entry_point()),

@@ -205,6 +205,14 @@ impl Prepared {
         }
     }
 
+    /// Whether this light's irradiance depends on the receiver's normal alone, not its
+    /// position: distant lights and domes (a masked dome's too, though its irradiance is the
+    /// host's). The irradiance kernel's `LIGHTS_NORMAL_ONLY` pass integrates these kinds
+    /// (shaders/irradiance.wgsl tests the same kinds).
+    pub fn irradiance_is_normal_only(&self) -> bool {
+        matches!(self.light.kind, LightType::Distant { .. } | LightType::Dome)
+    }
+
     /// Whether the GPU path takes this light's irradiance from the CPU reference
     /// ([`Prepared::gpu_path`]).
     pub fn irradiance_on_host(&self) -> bool {

@@ -9,8 +9,9 @@ use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
+use crate::gpu::record::{LIGHTS_ALL, LIGHTS_NORMAL_ONLY, LIGHTS_POSITIONAL};
 use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, mesh_atlas, record, texture_atlas};
-use crate::model::{Light, LightType};
+use crate::model::Light;
 use crate::prepare::{self, PortalMode, Prepared, TemperatureMode};
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
@@ -267,11 +268,12 @@ impl PreparedScene {
     ) -> Result<Vec<[f32; 3]>> {
         check_pairs(points, "points", normals, "normals")?;
         let per_light = acc == Accumulate::PerLight;
-        let mut out = match self.distinct_normals(normals) {
+        let lights = if per_light { self.lights.len() } else { 1 };
+        let mut out = match self.irradiance_plan(normals) {
             // Every light the kernel integrates depends on the normal only: one kernel row per
             // distinct normal, copied to the rows that share it (the same input bits give the
             // same output bits, so this is the undeduplicated answer).
-            Some((distinct, of_row)) => {
+            Some((distinct, of_row, false)) => {
                 let origin = vec![[0.0f32; 3]; distinct.len()];
                 let rows = self.run(
                     Kernel::Irradiance,
@@ -281,9 +283,38 @@ impl PreparedScene {
                     || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
                 )?;
                 let (n, m) = (normals.len(), distinct.len());
-                let lights = if per_light { self.lights.len() } else { 1 };
                 (0..lights * n)
                     .map(|r| rows[(r / n) * m + of_row[r % n]])
+                    .collect()
+            }
+            // A textured dome beside lights whose irradiance depends on the position: the
+            // others over every receiver, the dome (and any distant light) once per distinct
+            // normal, added. Per light, one of the two rows is exactly 0; summed, the sum of
+            // the two subsets' f32 sums (another order of additions than one pass).
+            Some((distinct, of_row, true)) => {
+                let everywhere = self.run_filtered(
+                    Kernel::Irradiance,
+                    points,
+                    Some(normals),
+                    per_light,
+                    LIGHTS_POSITIONAL,
+                    || cpu::irradiance_batch(&self.lights, points, normals, per_light, rule),
+                )?;
+                let origin = vec![[0.0f32; 3]; distinct.len()];
+                let by_normal = self.run_filtered(
+                    Kernel::Irradiance,
+                    &origin,
+                    Some(&distinct),
+                    per_light,
+                    LIGHTS_NORMAL_ONLY,
+                    || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
+                )?;
+                let (n, m) = (normals.len(), distinct.len());
+                (0..lights * n)
+                    .map(|r| {
+                        let (p, q) = (everywhere[r], by_normal[(r / n) * m + of_row[r % n]]);
+                        [p[0] + q[0], p[1] + q[1], p[2] + q[2]]
+                    })
                     .collect()
             }
             None => self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
@@ -297,21 +328,34 @@ impl PreparedScene {
         Ok(out)
     }
 
-    /// On a GPU evaluator whose kernel-integrated lights all depend on the normal only (domes
-    /// not masked by portals, distant lights: a textured dome's row integral costs the same for
-    /// every receiver, and a falloff map of a plane has one normal), the distinct normals and
-    /// each row's index among them; `None` elsewhere or when every normal differs. The host's
-    /// lights are added afterwards at every row (`add_host_irradiance`), as always.
-    fn distinct_normals(&self, normals: &[[f32; 3]]) -> Option<(Vec<[f32; 3]>, Vec<usize>)> {
+    /// How a GPU evaluator integrates irradiance over `normals`: `None`, every receiver in one
+    /// pass; else the distinct normals, each row's index among them, and whether to split.
+    /// Without a split: every light the kernel integrates depends on the normal only (domes,
+    /// distant lights: `Prepared::irradiance_is_normal_only`; a textured dome's row integral
+    /// costs the same for every receiver, and a falloff map of a plane has one normal), so
+    /// one pass over the distinct normals. With a split: the kernel integrates a textured dome
+    /// beside lights that depend on the position, which go over every receiver in one pass
+    /// (`LIGHTS_POSITIONAL`) while the normal-only lights go over the distinct normals in
+    /// another (`LIGHTS_NORMAL_ONLY`). `None` on the CPU reference or when every normal
+    /// differs. The host's lights are added afterwards at every row (`add_host_irradiance`).
+    fn irradiance_plan(&self, normals: &[[f32; 3]]) -> Option<(Vec<[f32; 3]>, Vec<usize>, bool)> {
         if !matches!(self.backend, Backend::Gpu(_)) || normals.len() < 2 {
             return None;
         }
-        let normal_only = |p: &Prepared| {
-            p.irradiance_on_host()
-                || matches!(p.light.kind, LightType::Distant { .. })
-                || (p.light.kind == LightType::Dome && p.portals.is_none())
-        };
-        if !self.lights.iter().all(normal_only) {
+        let on_device = |p: &&Prepared| !p.irradiance_on_host();
+        let positional = self
+            .lights
+            .iter()
+            .filter(on_device)
+            .any(|p| !p.irradiance_is_normal_only());
+        // The split pays only where the normal-only part is costly: a textured dome's row
+        // integral (an untextured dome and a distant light are closed forms).
+        let textured_dome = self
+            .lights
+            .iter()
+            .filter(on_device)
+            .any(|p| p.irradiance_is_normal_only() && p.light.texture.is_some());
+        if positional && !textured_dome {
             return None;
         }
         let mut index = std::collections::HashMap::new();
@@ -325,7 +369,7 @@ impl PreparedScene {
                 })
             })
             .collect();
-        (distinct.len() < normals.len()).then_some((distinct, of_row))
+        (distinct.len() < normals.len()).then_some((distinct, of_row, positional))
     }
 
     /// Rows the irradiance kernel could not finish (NaN: a chart with more outer breakpoints
@@ -431,6 +475,22 @@ impl PreparedScene {
         per_light: bool,
         on_cpu: impl FnOnce() -> Vec<DVec3>,
     ) -> Result<Vec<[f32; 3]>> {
+        self.run_filtered(kernel, a, b, per_light, LIGHTS_ALL, on_cpu)
+    }
+
+    /// [`Self::run`] with the irradiance kernel integrating only the lights `light_filter`
+    /// names on a GPU (`gpu::record::LIGHTS_*`). `on_cpu` answers on the CPU reference, for
+    /// every light: only `LIGHTS_ALL` is asked for there (`irradiance_plan` splits on a GPU
+    /// only).
+    fn run_filtered(
+        &self,
+        kernel: Kernel,
+        a: &[[f32; 3]],
+        b: Option<&[[f32; 3]]>,
+        per_light: bool,
+        light_filter: u32,
+        on_cpu: impl FnOnce() -> Vec<DVec3>,
+    ) -> Result<Vec<[f32; 3]>> {
         match (&self.backend, &self.gpu) {
             (Backend::Cpu, _) => Ok(on_cpu()
                 .into_iter()
@@ -462,7 +522,7 @@ impl PreparedScene {
                         }),
                     ),
                 };
-                g.run(kernel, lights, &mut scratch, a, b, per_light)
+                g.run(kernel, lights, &mut scratch, a, b, per_light, light_filter)
             }
             // No lights: every row is zero.
             (Backend::Gpu(_), None) => {
@@ -541,6 +601,63 @@ pub(super) fn scaled_weights(w: &[f64]) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::super::{Accumulate, Backend};
+    use crate::model::{Light, Texture, TextureFormat};
+
+    /// A 4 × 2 latlong dome texture (PNG bytes).
+    fn textured_dome() -> Light {
+        let img = image::RgbImage::from_fn(4, 2, |x, y| {
+            image::Rgb([40 * x as u8 + 10, 90, 30 * y as u8 + 5])
+        });
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png)
+            .expect("a PNG encodes");
+        Light::dome().with_texture(
+            Texture::new(crate::Asset::from_bytes("dome.png", bytes.into_inner()))
+                .with_format(TextureFormat::LatLong),
+        )
+    }
+
+    /// Which scenes integrate irradiance once per distinct normal, and which split the
+    /// lights into a pass over every receiver and one over the distinct normals.
+    #[test]
+    fn irradiance_plan_splits_only_a_textured_dome_from_positional_lights() {
+        let Some(eval) = super::super::test_gpu() else {
+            return;
+        };
+        let repeated = vec![[0.0f32, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]];
+        let distinct = vec![[0.0f32, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        let sphere = Light::sphere(0.5).with_intensity(3.0);
+        let plan = |lights: &[Light], normals: &[[f32; 3]]| {
+            eval.prepare(lights)
+                .expect("the lights prepare")
+                .irradiance_plan(normals)
+                .map(|(d, of_row, split)| (d.len(), of_row, split))
+        };
+        // Normal-only lights alone: one pass over the distinct normals.
+        assert_eq!(
+            plan(&[textured_dome(), Light::distant(0.5)], &repeated),
+            Some((2, vec![0, 1, 0], false))
+        );
+        // A textured dome beside a sphere: split.
+        assert_eq!(
+            plan(&[sphere.clone(), textured_dome()], &repeated),
+            Some((2, vec![0, 1, 0], true))
+        );
+        // A sphere beside closed forms only (a distant light, an untextured dome): one pass.
+        assert_eq!(
+            plan(
+                &[sphere.clone(), Light::distant(0.5), Light::dome()],
+                &repeated
+            ),
+            None
+        );
+        // Every normal differs: one pass.
+        assert_eq!(plan(&[sphere.clone(), textured_dome()], &distinct), None);
+        // The CPU reference never plans.
+        let cpu = super::super::Evaluator::cpu();
+        let scene = cpu.prepare(&[sphere, textured_dome()]).unwrap();
+        assert!(scene.irradiance_plan(&repeated).is_none());
+    }
 
     /// A batch cut into many GPU chunks (the chunk size capped, the last chunk partial, the
     /// first larger than one upload piece) gives the rows one chunk gives, summed and per light,
