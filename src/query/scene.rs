@@ -270,50 +270,47 @@ impl PreparedScene {
         let per_light = acc == Accumulate::PerLight;
         let lights = if per_light { self.lights.len() } else { 1 };
         let mut out = match self.irradiance_plan(normals) {
-            // Every light the kernel integrates depends on the normal only: one kernel row per
-            // distinct normal, copied to the rows that share it (the same input bits give the
-            // same output bits, so this is the undeduplicated answer).
-            Some((distinct, of_row, false)) => {
+            // One kernel row per distinct normal, copied to the rows that share it (the same
+            // input bits give the same output bits, so this is the undeduplicated answer):
+            // every light the kernel integrates, where all depend on the normal only; else
+            // (`split`: a textured dome beside lights that depend on the position) the
+            // normal-only ones, the others going over every receiver in a pass of their own,
+            // added. Per light, one of the two rows is exactly 0; summed, the sum of the two
+            // subsets' f32 sums (another order of additions than one pass).
+            Some((distinct, of_row, split)) => {
                 let origin = vec![[0.0f32; 3]; distinct.len()];
-                let rows = self.run(
-                    Kernel::Irradiance,
-                    &origin,
-                    Some(&distinct),
-                    per_light,
-                    || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
-                )?;
-                let (n, m) = (normals.len(), distinct.len());
-                (0..lights * n)
-                    .map(|r| rows[(r / n) * m + of_row[r % n]])
-                    .collect()
-            }
-            // A textured dome beside lights whose irradiance depends on the position: the
-            // others over every receiver, the dome (and any distant light) once per distinct
-            // normal, added. Per light, one of the two rows is exactly 0; summed, the sum of
-            // the two subsets' f32 sums (another order of additions than one pass).
-            Some((distinct, of_row, true)) => {
-                let everywhere = self.run_filtered(
-                    Kernel::Irradiance,
-                    points,
-                    Some(normals),
-                    per_light,
-                    LIGHTS_POSITIONAL,
-                    || cpu::irradiance_batch(&self.lights, points, normals, per_light, rule),
-                )?;
-                let origin = vec![[0.0f32; 3]; distinct.len()];
+                let filter = if split {
+                    LIGHTS_NORMAL_ONLY
+                } else {
+                    LIGHTS_ALL
+                };
                 let by_normal = self.run_filtered(
                     Kernel::Irradiance,
                     &origin,
                     Some(&distinct),
                     per_light,
-                    LIGHTS_NORMAL_ONLY,
+                    filter,
                     || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
                 )?;
+                let everywhere = match split {
+                    true => Some(self.run_filtered(
+                        Kernel::Irradiance,
+                        points,
+                        Some(normals),
+                        per_light,
+                        LIGHTS_POSITIONAL,
+                        || cpu::irradiance_batch(&self.lights, points, normals, per_light, rule),
+                    )?),
+                    false => None,
+                };
                 let (n, m) = (normals.len(), distinct.len());
                 (0..lights * n)
                     .map(|r| {
-                        let (p, q) = (everywhere[r], by_normal[(r / n) * m + of_row[r % n]]);
-                        [p[0] + q[0], p[1] + q[1], p[2] + q[2]]
+                        let q = by_normal[(r / n) * m + of_row[r % n]];
+                        match &everywhere {
+                            Some(p) => [p[r][0] + q[0], p[r][1] + q[1], p[r][2] + q[2]],
+                            None => q,
+                        }
                     })
                     .collect()
             }
