@@ -3,16 +3,17 @@
 use std::sync::Mutex;
 
 use glam::DVec3;
-use rayon::prelude::*;
 
 use super::{Accumulate, Backend, check_directions, check_pairs};
 use crate::cpu;
 use crate::cpu::irradiance::Adaptive;
 use crate::error::{LuxError, Result};
-use crate::gpu::record::{LIGHTS_ALL, LIGHTS_NORMAL_ONLY, LIGHTS_POSITIONAL};
+use crate::gpu::record::LIGHTS_ALL;
 use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, mesh_atlas, record, texture_atlas};
 use crate::model::Light;
 use crate::prepare::{self, PortalMode, Prepared, TemperatureMode};
+
+mod irradiance;
 
 /// Lights validated and prepared once (per-light constants in f64; on a GPU, the packed records
 /// uploaded and the input/output buffers of the last size class kept), answering emission,
@@ -233,197 +234,6 @@ impl PreparedScene {
         Ok(out)
     }
 
-    /// irradiance(x, n) for every (point, receiver normal) pair (DESIGN.md §3): the
-    /// diffuse-weighted irradiance `diffuse · ∫ radiance(x, ω) max(0, n·ω) dω` on a one-sided
-    /// receiver, no occlusion.
-    pub fn irradiance(
-        &self,
-        points: &[[f32; 3]],
-        normals: &[[f32; 3]],
-        acc: Accumulate,
-    ) -> Result<Vec<[f32; 3]>> {
-        self.irradiance_by(points, normals, acc, &self.rule)
-    }
-
-    /// [`PreparedScene::irradiance`] to relative tolerance `rel` for this call, whatever the
-    /// evaluator's (see [`Evaluator::with_irradiance_tolerance`](super::Evaluator::with_irradiance_tolerance) for what it means and
-    /// which values each backend takes).
-    pub fn irradiance_with_tolerance(
-        &self,
-        points: &[[f32; 3]],
-        normals: &[[f32; 3]],
-        acc: Accumulate,
-        rel: f64,
-    ) -> Result<Vec<[f32; 3]>> {
-        super::check_tolerance(rel, matches!(self.backend, Backend::Gpu(_)))?;
-        self.irradiance_by(points, normals, acc, &Adaptive::for_tolerance(rel))
-    }
-
-    fn irradiance_by(
-        &self,
-        points: &[[f32; 3]],
-        normals: &[[f32; 3]],
-        acc: Accumulate,
-        rule: &Adaptive,
-    ) -> Result<Vec<[f32; 3]>> {
-        check_pairs(points, "points", normals, "normals")?;
-        let per_light = acc == Accumulate::PerLight;
-        let lights = if per_light { self.lights.len() } else { 1 };
-        let mut out = match self.irradiance_plan(normals) {
-            // One kernel row per distinct normal, copied to the rows that share it (the same
-            // input bits give the same output bits, so this is the undeduplicated answer):
-            // every light the kernel integrates, where all depend on the normal only; else
-            // (`split`: a textured dome beside lights that depend on the position) the
-            // normal-only ones, the others going over every receiver in a pass of their own,
-            // added. Per light, one of the two rows is exactly 0; summed, the sum of the two
-            // subsets' f32 sums (another order of additions than one pass).
-            Some((distinct, of_row, split)) => {
-                let origin = vec![[0.0f32; 3]; distinct.len()];
-                let filter = if split {
-                    LIGHTS_NORMAL_ONLY
-                } else {
-                    LIGHTS_ALL
-                };
-                let by_normal = self.run_filtered(
-                    Kernel::Irradiance,
-                    &origin,
-                    Some(&distinct),
-                    per_light,
-                    filter,
-                    || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
-                )?;
-                let everywhere = match split {
-                    true => Some(self.run_filtered(
-                        Kernel::Irradiance,
-                        points,
-                        Some(normals),
-                        per_light,
-                        LIGHTS_POSITIONAL,
-                        || cpu::irradiance_batch(&self.lights, points, normals, per_light, rule),
-                    )?),
-                    false => None,
-                };
-                let (n, m) = (normals.len(), distinct.len());
-                (0..lights * n)
-                    .map(|r| {
-                        let q = by_normal[(r / n) * m + of_row[r % n]];
-                        match &everywhere {
-                            Some(p) => [p[r][0] + q[0], p[r][1] + q[1], p[r][2] + q[2]],
-                            None => q,
-                        }
-                    })
-                    .collect()
-            }
-            None => self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
-                cpu::irradiance_batch(&self.lights, points, normals, per_light, rule)
-            })?,
-        };
-        if matches!(self.backend, Backend::Gpu(_)) {
-            self.redo_spent_rows(points, normals, per_light, rule, &mut out);
-            self.add_host_irradiance(points, normals, per_light, rule, &mut out);
-        }
-        Ok(out)
-    }
-
-    /// How a GPU evaluator integrates irradiance over `normals`: `None`, every receiver in one
-    /// pass; else the distinct normals, each row's index among them, and whether to split.
-    /// Without a split: every light the kernel integrates depends on the normal only (domes,
-    /// distant lights: `Prepared::irradiance_is_normal_only`; a textured dome's row integral
-    /// costs the same for every receiver, and a falloff map of a plane has one normal), so
-    /// one pass over the distinct normals. With a split: the kernel integrates a textured dome
-    /// beside lights that depend on the position, which go over every receiver in one pass
-    /// (`LIGHTS_POSITIONAL`) while the normal-only lights go over the distinct normals in
-    /// another (`LIGHTS_NORMAL_ONLY`). `None` on the CPU reference or when every normal
-    /// differs. The host's lights are added afterwards at every row (`add_host_irradiance`).
-    fn irradiance_plan(&self, normals: &[[f32; 3]]) -> Option<(Vec<[f32; 3]>, Vec<usize>, bool)> {
-        if !matches!(self.backend, Backend::Gpu(_)) || normals.len() < 2 {
-            return None;
-        }
-        let on_device = |p: &&Prepared| !p.irradiance_on_host();
-        let positional = self
-            .lights
-            .iter()
-            .filter(on_device)
-            .any(|p| !p.irradiance_is_normal_only());
-        // The split pays only where the normal-only part is costly: a textured dome's row
-        // integral (an untextured dome and a distant light are closed forms).
-        let textured_dome = self
-            .lights
-            .iter()
-            .filter(on_device)
-            .any(|p| p.irradiance_is_normal_only() && p.light.texture.is_some());
-        if positional && !textured_dome {
-            return None;
-        }
-        let mut index = std::collections::HashMap::new();
-        let mut distinct = Vec::new();
-        let of_row: Vec<usize> = normals
-            .iter()
-            .map(|n| {
-                *index.entry(n.map(f32::to_bits)).or_insert_with(|| {
-                    distinct.push(*n);
-                    distinct.len() - 1
-                })
-            })
-            .collect();
-        (distinct.len() < normals.len()).then_some((distinct, of_row, positional))
-    }
-
-    /// Rows the irradiance kernel could not finish (NaN: a chart with more outer breakpoints
-    /// than the kernel holds, or on llvmpipe a loop cut short by its budget,
-    /// `GpuContext::lane_stride`; `irr_cut` in shaders/shared/record.wgsl) are recomputed here
-    /// on the CPU reference: with `per_light` that light's row, else the receiver's sum over
-    /// the lights the device integrates (the host lights are added after). Finite inputs never
-    /// give NaN otherwise (DESIGN.md §5), so a NaN row is exactly such a row.
-    fn redo_spent_rows(
-        &self,
-        points: &[[f32; 3]],
-        normals: &[[f32; 3]],
-        per_light: bool,
-        rule: &Adaptive,
-        out: &mut [[f32; 3]],
-    ) {
-        let n = points.len();
-        let spent: Vec<usize> = (0..out.len())
-            .filter(|&r| out[r].iter().any(|v| v.is_nan()))
-            .collect();
-        if spent.is_empty() {
-            return;
-        }
-        self.spent_rows
-            .fetch_add(spent.len(), std::sync::atomic::Ordering::Relaxed);
-        let redo: Vec<(usize, [f32; 3])> = spent
-            .par_iter()
-            .map(|&r| {
-                let (i, lights) = if per_light {
-                    (r % n, &self.lights[r / n..r / n + 1])
-                } else {
-                    (r, &self.lights[..])
-                };
-                let (x, nn) = (&points[i..i + 1], &normals[i..i + 1]);
-                let sum: DVec3 = lights
-                    .iter()
-                    .filter(|l| !l.irradiance_on_host())
-                    .map(|l| cpu::irradiance_batch(std::slice::from_ref(l), x, nn, true, rule)[0])
-                    .sum();
-                (r, sum.as_vec3().to_array())
-            })
-            .collect();
-        for (r, v) in redo {
-            out[r] = v;
-        }
-    }
-
-    /// How many irradiance rows (receivers, or receiver × light with `PerLight`) the device
-    /// could not finish and the CPU reference recomputed, over this scene's calls: a chart with
-    /// more outer breakpoints than the kernel holds, or on a software GPU (llvmpipe) a
-    /// quadrature cut short by its loop budget. Their values are the reference's at the
-    /// scene's tolerance, and they cost the CPU's time; 0 on the CPU backend. The command
-    /// line reports it after an irradiance query or a falloff map.
-    pub fn host_recomputed_rows(&self) -> usize {
-        self.spent_rows.load(std::sync::atomic::Ordering::Relaxed)
-    }
-
     /// On a GPU evaluator, the kernels give 0 for the lights `on_host` names for the query
     /// ([`Prepared::gpu_path`]: mesh lights): their values are the CPU reference's (`values`
     /// of one light, one row per input row), added here. Nothing to do on the CPU backend.
@@ -441,26 +251,6 @@ impl PreparedScene {
             if on_host(light) {
                 add_rows(out, k, per_light, values(std::slice::from_ref(light)));
             }
-        }
-    }
-
-    /// The GPU irradiance kernel gives 0 for the lights [`Prepared::irradiance_on_host`] names (see the
-    /// header of shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here.
-    fn add_host_irradiance(
-        &self,
-        points: &[[f32; 3]],
-        normals: &[[f32; 3]],
-        per_light: bool,
-        rule: &Adaptive,
-        out: &mut [[f32; 3]],
-    ) {
-        for (k, light) in self.lights.iter().enumerate() {
-            if !light.irradiance_on_host() {
-                continue;
-            }
-            let values =
-                cpu::irradiance_batch(std::slice::from_ref(light), points, normals, true, rule);
-            add_rows(out, k, per_light, values);
         }
     }
 
@@ -598,63 +388,6 @@ pub(super) fn scaled_weights(w: &[f64]) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::super::{Accumulate, Backend};
-    use crate::model::{Light, Texture, TextureFormat};
-
-    /// A 4 × 2 latlong dome texture (PNG bytes).
-    fn textured_dome() -> Light {
-        let img = image::RgbImage::from_fn(4, 2, |x, y| {
-            image::Rgb([40 * x as u8 + 10, 90, 30 * y as u8 + 5])
-        });
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut bytes, image::ImageFormat::Png)
-            .expect("a PNG encodes");
-        Light::dome().with_texture(
-            Texture::new(crate::Asset::from_bytes("dome.png", bytes.into_inner()))
-                .with_format(TextureFormat::LatLong),
-        )
-    }
-
-    /// Which scenes integrate irradiance once per distinct normal, and which split the
-    /// lights into a pass over every receiver and one over the distinct normals.
-    #[test]
-    fn irradiance_plan_splits_only_a_textured_dome_from_positional_lights() {
-        let Some(eval) = super::super::test_gpu() else {
-            return;
-        };
-        let repeated = vec![[0.0f32, 1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]];
-        let distinct = vec![[0.0f32, 1.0, 0.0], [0.0, 0.0, 1.0]];
-        let sphere = Light::sphere(0.5).with_intensity(3.0);
-        let plan = |lights: &[Light], normals: &[[f32; 3]]| {
-            eval.prepare(lights)
-                .expect("the lights prepare")
-                .irradiance_plan(normals)
-                .map(|(d, of_row, split)| (d.len(), of_row, split))
-        };
-        // Normal-only lights alone: one pass over the distinct normals.
-        assert_eq!(
-            plan(&[textured_dome(), Light::distant(0.5)], &repeated),
-            Some((2, vec![0, 1, 0], false))
-        );
-        // A textured dome beside a sphere: split.
-        assert_eq!(
-            plan(&[sphere.clone(), textured_dome()], &repeated),
-            Some((2, vec![0, 1, 0], true))
-        );
-        // A sphere beside closed forms only (a distant light, an untextured dome): one pass.
-        assert_eq!(
-            plan(
-                &[sphere.clone(), Light::distant(0.5), Light::dome()],
-                &repeated
-            ),
-            None
-        );
-        // Every normal differs: one pass.
-        assert_eq!(plan(&[sphere.clone(), textured_dome()], &distinct), None);
-        // The CPU reference never plans.
-        let cpu = super::super::Evaluator::cpu();
-        let scene = cpu.prepare(&[sphere, textured_dome()]).unwrap();
-        assert!(scene.irradiance_plan(&repeated).is_none());
-    }
 
     /// A batch cut into many GPU chunks (the chunk size capped, the last chunk partial, the
     /// first larger than one upload piece) gives the rows one chunk gives, summed and per light,
