@@ -18,6 +18,9 @@
 //! Tables (built lazily on the first query, in parallel): pieces grouped in tiles of T × T
 //! (T = 1 up to 2²⁰ pieces), each with its summed moment and a bounding cap. A receiver adds
 //! `m · V` for tiles whose cap is wholly lit, skips wholly dark ones, and descends into the rest.
+//! A latlong map under a conformal frame skips the tables for `E(n)`: one pass over the pieces
+//! per normal gives the same sum as fast as the walk, without the tables' build ([`latlong`]);
+//! the tables serve the other formats and frames, and every masked dome.
 //!
 //! Moments: latlong under a conformal frame (rotation × uniform scale, `w` constant) is separable
 //! — `∫∫ wx wy (sin θ sin φ, cos θ, sin θ cos φ) sin θ dφ dθ` is a product of one column integral
@@ -30,6 +33,7 @@
 
 pub mod clip;
 pub mod horizon;
+mod latlong;
 pub mod pieces;
 pub mod quadrature;
 pub mod sh;
@@ -78,6 +82,8 @@ pub struct DomeIrradiance {
     /// Upper bound of the frame's condition number.
     kappa: f64,
     tables: OnceLock<Tables>,
+    /// A latlong map's per-axis moment factors (conformal frames only, latlong.rs).
+    axes: OnceLock<latlong::Axes>,
     /// The 9-coefficient fast path, projected on first use.
     sh9: OnceLock<sh::IrradianceSh>,
 }
@@ -120,6 +126,7 @@ impl DomeIrradiance {
             conformal,
             kappa: kappa.max(1.0),
             tables: OnceLock::new(),
+            axes: OnceLock::new(),
             sh9: OnceLock::new(),
         })
     }

@@ -8,7 +8,6 @@ use rayon::prelude::*;
 use super::clip::{Clip, exact};
 use super::horizon::HorizonCurve;
 use super::pieces::Domain;
-use super::quadrature::gl;
 use super::{DomeIrradiance, REL_TOL, add};
 use crate::prepare::texture::DomeFormat;
 
@@ -31,10 +30,6 @@ struct Tile {
 pub(super) struct Tables {
     tiles: Vec<Tile>,
     single: bool,
-    /// Separable latlong factors per axis piece: columns (a ∈ {0,1}) × (sin φ, 1, cos φ),
-    /// rows (b ∈ {0,1}) × (sin²θ, sinθ cosθ).
-    cols: Vec<[[f64; 3]; 2]>,
-    rows: Vec<[[f64; 2]; 2]>,
 }
 
 /// Where a cap lies with respect to the lit region, the intersection of the half-spaces
@@ -83,7 +78,7 @@ fn outer(tex: DVec3, v: DVec3) -> [f64; 9] {
 
 impl DomeIrradiance {
     /// `V = ∫_piece L d w dd` (RGB × xyz, channel-major).
-    fn moment(&self, t: &Tables, grid: usize, ix: usize, iy: usize) -> [f64; 9] {
+    fn moment(&self, grid: usize, ix: usize, iy: usize) -> [f64; 9] {
         let p = self.piece(grid, ix, iy);
         let dom = self.geom.domain(&p);
         if dom == Domain::Outside {
@@ -91,11 +86,12 @@ impl DomeIrradiance {
         }
         let mut f = |d: DVec3, tex: DVec3, j: f64| outer(tex, d * (self.weight(d) * j));
         // A latlong piece always has a cap (`Geometry::cap`); its moment comes from the axis
-        // tables, and its cap (two sin_cos per piece, once a quarter of a dome map's time)
-        // is not needed for that.
+        // factors (latlong.rs), and its cap (two sin_cos per piece, once a quarter of a dome
+        // map's time) is not needed for that.
         match self.conformal {
-            Some(w) if self.format == DomeFormat::LatLong => {
-                let (cx, ry) = (&t.cols[ix], &t.rows[iy]);
+            Some(w) if self.sweeps() => {
+                let axes = self.axes();
+                let (cx, ry) = (&axes.cols[ix], &axes.rows[iy]);
                 let k = w
                     * (2.0 * std::f64::consts::PI / self.geom.w)
                     * (std::f64::consts::PI / self.geom.h);
@@ -127,51 +123,9 @@ impl DomeIrradiance {
     fn build(&self) -> Tables {
         let count: usize = self.grids.iter().map(|g| g.xs.len() * g.ys.len()).sum();
         let tsize = ((count as f64 / MAX_TILES as f64).sqrt().ceil() as usize).max(1);
-        let axis_rule = |a: f64, b: f64, f: &dyn Fn(f64) -> [f64; 3]| gl::<3>(16, a, b, f);
-        let (mut cols, mut rows) = (vec![], vec![]);
-        if self.format == DomeFormat::LatLong {
-            let (w, h) = (self.geom.w, self.geom.h);
-            let phi = |x: f64| std::f64::consts::PI - 2.0 * std::f64::consts::PI * x / w;
-            cols = self.grids[0]
-                .xs
-                .iter()
-                .map(|p| {
-                    [0, 1].map(|a| {
-                        axis_rule(p.x0, p.x1, &|x| {
-                            let wt = if a == 0 {
-                                p.weights(x).0
-                            } else {
-                                p.weights(x).1
-                            };
-                            [wt * phi(x).sin(), wt, wt * phi(x).cos()]
-                        })
-                    })
-                })
-                .collect();
-            rows = self.grids[0]
-                .ys
-                .iter()
-                .map(|p| {
-                    [0, 1].map(|b| {
-                        let v = axis_rule(p.x0, p.x1, &|y| {
-                            let wt = if b == 0 {
-                                p.weights(y).0
-                            } else {
-                                p.weights(y).1
-                            };
-                            let (s, c) = (std::f64::consts::PI * y / h).sin_cos();
-                            [wt * s * s, wt * s * c, 0.0]
-                        });
-                        [v[0], v[1]]
-                    })
-                })
-                .collect();
-        }
         let mut t = Tables {
             tiles: vec![],
             single: tsize == 1,
-            cols,
-            rows,
         };
         let mut specs = vec![];
         for (gi, g) in self.grids.iter().enumerate() {
@@ -187,19 +141,13 @@ impl DomeIrradiance {
         }
         let tiles: Vec<Tile> = specs
             .into_par_iter()
-            .filter_map(|(grid, ix, iy)| self.tile(&t, grid, ix, iy))
+            .filter_map(|(grid, ix, iy)| self.tile(grid, ix, iy))
             .collect();
         t.tiles = tiles;
         t
     }
 
-    fn tile(
-        &self,
-        t: &Tables,
-        grid: usize,
-        ix: (usize, usize),
-        iy: (usize, usize),
-    ) -> Option<Tile> {
+    fn tile(&self, grid: usize, ix: (usize, usize), iy: (usize, usize)) -> Option<Tile> {
         let mut v = [0.0; 9];
         let mut caps = vec![];
         let mut bounded = true;
@@ -209,7 +157,7 @@ impl DomeIrradiance {
                 if self.geom.domain(&p) == Domain::Outside {
                     continue;
                 }
-                add(&mut v, &self.moment(t, grid, i, j));
+                add(&mut v, &self.moment(grid, i, j));
                 match self.geom.cap(&p) {
                     Some(c) => caps.push(c),
                     None => bounded = false,
@@ -241,8 +189,11 @@ impl DomeIrradiance {
     /// `E(n)` (RGB) for a unit world normal `n`: the exact integral of the filtered texture
     /// (module docs). Multiply by the dome's `intensity · 2^exposure · color ⊙ temperature` and
     /// `diffuse` outside.
+    /// A latlong map under a conformal frame takes the sweep (latlong.rs: the same sum, without
+    /// building the tables).
     pub fn irradiance(&self, n: DVec3) -> DVec3 {
-        self.irradiance_within(n, &[])
+        self.sweep(n)
+            .unwrap_or_else(|| self.irradiance_within(n, &[]))
     }
 
     /// `∫ L(ω) max(0, n·ω) dω` over the directions ω with `k·ω ≥ 0` for every `k` in `planes`
@@ -306,7 +257,7 @@ impl DomeIrradiance {
                             let p = self.piece(tile.grid, i, j);
                             match self.geom.cap(&p).map(|(c, r)| side(&hats, c, r, r.sin())) {
                                 _ if self.geom.domain(&p) == Domain::Outside => {}
-                                Some(Side::Lit) => e += dot(&self.moment(t, tile.grid, i, j)),
+                                Some(Side::Lit) => e += dot(&self.moment(tile.grid, i, j)),
                                 Some(Side::Dark) => {}
                                 _ => e += self.crossed(tile.grid, i, j, m, &clips),
                             }
@@ -330,7 +281,14 @@ impl DomeIrradiance {
 
     /// One piece's share of `E`, clipped exactly at the horizon and the other clips (the first
     /// clip is the horizon `m`).
-    fn crossed(&self, grid: usize, i: usize, j: usize, m: DVec3, clips: &[Clip]) -> DVec3 {
+    pub(super) fn crossed(
+        &self,
+        grid: usize,
+        i: usize,
+        j: usize,
+        m: DVec3,
+        clips: &[Clip],
+    ) -> DVec3 {
         let p = self.piece(grid, i, j);
         let delta = self.geom.cap(&p).map_or(0.5, |c| c.1.min(0.5));
         let v = exact(

@@ -1,0 +1,405 @@
+//! Latlong domes under a conformal frame (rotation × uniform scale, so that `w` is constant):
+//! the separable moment factors of the pieces (dome.rs "Moments"), and the **sweep**, one
+//! receiver's `E(n)` straight from them without the tile tables.
+//!
+//! The tables (tables.rs) cost one moment and one bounding cap per piece, built once: about
+//! 0.15 s and 80 MB for a 2048 × 1024 map, then a walk over their tiles per normal. A falloff map
+//! of a plane, the job people run most, asks for one normal: the tables' build was most of
+//! that map's time (BENCHMARKS.md "The jobs people run"). The sweep computes the same sum,
+//! `E = Σ_lit m·V + Σ_crossed (exact clipped integral)`, in one pass over the pieces:
+//!
+//! - In dome space `d = (sin θ sin φ, cos θ, sin θ cos φ)` (§6 D2), so on the horizon's side
+//!   `m·d = a cos θ + ρ sin θ cos(φ − φ₀)` with `a = m_y`, `ρ = |(m_x, m_z)|`,
+//!   `φ₀ = atan2(m_x, m_z)`. On a piece, `sin θ ≥ 0`, so `m·d` is smallest where `cos(φ − φ₀)`
+//!   is smallest over the piece's columns (`c_min`) and largest where it is largest
+//!   (`c_max`); each is a sinusoid `A cos θ + B sin θ` in θ, positive on arcs of length π, and a
+//!   piece's θ span is at most 0.25 rad (pieces.rs `MAX_PIECE_ANGLE`), so it is positive on the
+//!   whole span when it is at both ends. A piece is therefore wholly lit when
+//!   `a cos θ + ρ sin θ c_min > ε` at both of its row's ends, wholly dark when
+//!   `a cos θ + ρ sin θ c_max < −ε` at both, and crossed otherwise. The margin `ε = 1e-12 |m|`
+//!   only sends pieces to the exact clipped integral that would not need it.
+//! - A lit piece adds `m·V` with `V` the piece's moment from the per-axis factors, the very
+//!   moment the tables sum (`DomeIrradiance::moment`): four texels times a column factor times
+//!   a row factor. A crossed piece is integrated exactly at the horizon
+//!   (`DomeIrradiance::crossed`, the tables' own routine).
+//!
+//! Per normal this is O(W·H) multiply-adds with no trigonometry but `φ₀`'s, plus the crossed
+//! pieces that the tables' walk integrates too; the tables cost O(W·H) `sin_cos` and 80 MB once,
+//! then O(tiles) per normal. Measured on luxtest's 2048 × 1024 map (release, 2 cores, random
+//! normals): about 23 ms per normal for the sweep, 26 ms for the walk, both mostly the crossed
+//! pieces, and 0.15 s for the build. So `DomeIrradiance::irradiance` sweeps wherever it can.
+//! The rows are summed in order, so the result does not depend on the thread count.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::DomeIrradiance;
+use super::clip::Clip;
+use super::quadrature::gl;
+use crate::prepare::texture::DomeFormat;
+
+/// The per-axis factors of a latlong map's piece moments, and the trigonometry of the pieces'
+/// ends (both independent of the receiver).
+pub(super) struct Axes {
+    /// Per column piece and texel weight (a ∈ {0,1}): `∫ w_a(x) (sin φ, 1, cos φ) dx`.
+    pub cols: Vec<[[f64; 3]; 2]>,
+    /// Per row piece and texel weight (b ∈ {0,1}): `∫ w_b(y) (sin²θ, sin θ cos θ) dy`.
+    pub rows: Vec<[[f64; 2]; 2]>,
+    /// Per column piece: `(φ, sin φ, cos φ)` at its lower φ end (its x1) and the φ span.
+    col_ends: Vec<([f64; 3], f64)>,
+    /// Per column piece: `(sin φ, cos φ)` at its upper φ end (its x0).
+    col_hi: Vec<[f64; 2]>,
+    /// Per row piece: `(sin θ, cos θ)` at y0 and at y1.
+    row_ends: Vec<[[f64; 2]; 2]>,
+}
+
+impl Axes {
+    pub(super) fn new(d: &DomeIrradiance) -> Axes {
+        let pi = std::f64::consts::PI;
+        let (w, h) = (d.geom.w, d.geom.h);
+        let g = &d.grids[0];
+        let phi = |x: f64| pi - 2.0 * pi * x / w;
+        let theta = |y: f64| pi * y / h;
+        // 16-point Gauss–Legendre per axis piece: exact to rounding on pieces ≤ π/8 (dome.rs).
+        let cols =
+            g.xs.iter()
+                .map(|p| {
+                    [0, 1].map(|a| {
+                        gl::<3>(16, p.x0, p.x1, |x| {
+                            let (w0, w1) = p.weights(x);
+                            let wt = if a == 0 { w0 } else { w1 };
+                            let (s, c) = phi(x).sin_cos();
+                            [wt * s, wt, wt * c]
+                        })
+                    })
+                })
+                .collect();
+        let rows =
+            g.ys.iter()
+                .map(|p| {
+                    [0, 1].map(|b| {
+                        let v = gl::<2>(16, p.x0, p.x1, |y| {
+                            let (w0, w1) = p.weights(y);
+                            let wt = if b == 0 { w0 } else { w1 };
+                            let (s, c) = theta(y).sin_cos();
+                            [wt * s * s, wt * s * c]
+                        });
+                        [v[0], v[1]]
+                    })
+                })
+                .collect();
+        let col_ends =
+            g.xs.iter()
+                .map(|p| {
+                    let lo = phi(p.x1);
+                    let (s, c) = lo.sin_cos();
+                    ([lo, s, c], phi(p.x0) - lo)
+                })
+                .collect();
+        let col_hi =
+            g.xs.iter()
+                .map(|p| {
+                    let (s, c) = phi(p.x0).sin_cos();
+                    [s, c]
+                })
+                .collect();
+        let row_ends =
+            g.ys.iter()
+                .map(|p| {
+                    [p.x0, p.x1].map(|y| {
+                        let (s, c) = theta(y).sin_cos();
+                        [s, c]
+                    })
+                })
+                .collect();
+        Axes {
+            cols,
+            rows,
+            col_ends,
+            col_hi,
+            row_ends,
+        }
+    }
+}
+
+/// `min` and `max` of `cos(φ − φ₀)` over each column piece, `(sin φ₀, cos φ₀)` given.
+fn column_range(axes: &Axes, phi0: f64, s0: f64, c0: f64) -> Vec<[f64; 2]> {
+    let tau = std::f64::consts::TAU;
+    let pi = std::f64::consts::PI;
+    axes.col_ends
+        .iter()
+        .zip(&axes.col_hi)
+        .map(|(([lo, s, c], span), [sh, ch])| {
+            let (at_lo, at_hi) = (c * c0 + s * s0, ch * c0 + sh * s0);
+            let holds = |t: f64| (t - lo).rem_euclid(tau) <= *span;
+            let max = if holds(phi0) { 1.0 } else { at_lo.max(at_hi) };
+            let min = if holds(phi0 + pi) {
+                -1.0
+            } else {
+                at_lo.min(at_hi)
+            };
+            [min, max]
+        })
+        .collect()
+}
+
+impl DomeIrradiance {
+    pub(super) fn axes(&self) -> &Axes {
+        self.axes.get_or_init(|| Axes::new(self))
+    }
+
+    /// Whether [`DomeIrradiance::sweep`] applies: a latlong map under a conformal frame.
+    pub(super) fn sweeps(&self) -> bool {
+        self.format == DomeFormat::LatLong && self.conformal.is_some()
+    }
+
+    /// `E(n)` by the sweep (module docs): the tables' value (`irradiance_within(n, &[])`),
+    /// summed in another order. `None` where it does not apply ([`DomeIrradiance::sweeps`]).
+    pub fn sweep(&self, n: DVec3) -> Option<DVec3> {
+        let w = self.conformal.filter(|_| self.sweeps())?;
+        let axes = self.axes();
+        let m = self.frame.horizon(n);
+        let (a, rho) = (m.y, m.x.hypot(m.z));
+        let (s0, c0) = if rho > 0.0 {
+            (m.x / rho, m.z / rho)
+        } else {
+            (0.0, 1.0)
+        };
+        let cos_range = column_range(axes, m.x.atan2(m.z), s0, c0);
+        let eps = 1e-12 * m.length();
+        let clips = [Clip {
+            m,
+            curve: None,
+            line: false,
+        }];
+        let pi = std::f64::consts::PI;
+        let k = w * (2.0 * pi / self.geom.w) * (pi / self.geom.h);
+        let g = &self.grids[0];
+        // Per row: (Σ over lit pieces of m·V / k, Σ over crossed pieces of their exact part).
+        let rows: Vec<(DVec3, DVec3)> = (0..g.ys.len())
+            .into_par_iter()
+            .map(|j| {
+                let ends = axes.row_ends[j];
+                let side = |c: f64| ends.map(|[s, ct]| a * ct + rho * s * c);
+                let ry = &axes.rows[j];
+                let py = g.ys[j];
+                let (mut lit, mut crossed) = (DVec3::ZERO, DVec3::ZERO);
+                for (i, [cmin, cmax]) in cos_range.iter().enumerate() {
+                    if side(*cmin).iter().all(|h| *h > eps) {
+                        let cx = &axes.cols[i];
+                        let px = g.xs[i];
+                        for (ti, tj, ca, rb) in [
+                            (px.i0, py.i0, 0, 0),
+                            (px.i1, py.i0, 1, 0),
+                            (px.i0, py.i1, 0, 1),
+                            (px.i1, py.i1, 1, 1),
+                        ] {
+                            let (c, r) = (cx[ca], ry[rb]);
+                            let f = m.x * c[0] * r[0] + m.y * c[1] * r[1] + m.z * c[2] * r[0];
+                            lit += crate::cpu::texture::tex_fetch(&self.img, ti, tj) * f;
+                        }
+                    } else if !side(*cmax).iter().all(|h| *h < -eps) {
+                        crossed += self.crossed(0, i, j, m, &clips);
+                    }
+                }
+                (lit, crossed)
+            })
+            .collect();
+        let (lit, crossed) = rows
+            .iter()
+            .fold((DVec3::ZERO, DVec3::ZERO), |(l, c), (a, b)| {
+                (l + *a, c + *b)
+            });
+        Some(lit * k + crossed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::{DMat3, DVec3};
+
+    use super::*;
+    use crate::cpu::irradiance::latlong_rows::{Rows, latlong_irradiance};
+    use crate::prepare::latlong_rows::tables;
+    use crate::prepare::texture::{DomeFrame, Filter, Image};
+
+    /// A random HDR-like map, and one dark map with a single bright texel (a piece lit or missed
+    /// whole shows there).
+    fn image(w: usize, h: usize, seed: u64, one_texel: bool) -> Arc<Image> {
+        let mut state = seed.wrapping_mul(6364136223846793005) ^ 0x9e37_79b9_7f4a_7c15;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) as f64 / (1u64 << 31) as f64) as f32
+        };
+        let bright = (w * h) / 3 + w / 2;
+        let rgb = (0..w * h)
+            .map(|i| match one_texel {
+                true if i == bright => [50.0, 20.0, 5.0],
+                true => [0.0; 3],
+                false => [next() * 4.0, next(), next() * next() * 30.0],
+            })
+            .collect();
+        Arc::new(Image {
+            width: w,
+            height: h,
+            rgb,
+            envmap: None,
+            source: "random.exr".into(),
+        })
+    }
+
+    /// The axes and poles, normals grazing the poles, and a spiral of 24 more.
+    fn normals() -> Vec<DVec3> {
+        let mut v = vec![
+            DVec3::Y,
+            -DVec3::Y,
+            DVec3::X,
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::new(1e-9, 1.0, 0.0),
+            DVec3::new(0.0, -1.0, 1e-13),
+            DVec3::new(0.3, 1e-7, -0.9),
+            DVec3::new(1.0, 1e-12, 0.0),
+        ];
+        for i in 0..24 {
+            let z = 1.0 - (i as f64 + 0.5) / 12.0;
+            let phi = i as f64 * 2.399963;
+            let r = (1.0 - z * z).sqrt();
+            v.push(DVec3::new(r * phi.cos(), z, r * phi.sin()));
+        }
+        v.into_iter().map(|n| n.normalize()).collect()
+    }
+
+    /// Normals (dome space = world under the identity frame) whose horizon dips into a piece
+    /// between its columns' ends at one of its row's ends: the middle of the piece's columns
+    /// is `φ₀ + π` (or `φ₀`) and the horizon meets that end halfway between the middle's and
+    /// the column ends' values of `cos(φ − φ₀)`. A piece is then neither wholly lit nor wholly
+    /// dark although both column ends are, which only the interior extremum of `cos` shows.
+    fn grazing(d: &DomeIrradiance) -> Vec<DVec3> {
+        let pi = std::f64::consts::PI;
+        let g = &d.grids[0];
+        let mut out = vec![];
+        for (i, j) in [
+            (0, 0),
+            (g.xs.len() / 2, g.ys.len() / 2),
+            (g.xs.len() - 1, g.ys.len() - 1),
+        ] {
+            let (px, py) = (g.xs[i], g.ys[j]);
+            let phi = |x: f64| pi - 2.0 * pi * x / d.geom.w;
+            let (phic, half) = (phi(0.5 * (px.x0 + px.x1)), 0.5 * (phi(px.x0) - phi(px.x1)));
+            for y in [py.x0, py.x1] {
+                let theta = pi * y / d.geom.h;
+                if theta.cos().abs() < 1e-3 || theta.sin() < 1e-3 {
+                    continue;
+                }
+                for (phi0, c) in [
+                    (phic + pi, -(1.0 + half.cos()) / 2.0),
+                    (phic, (1.0 + half.cos()) / 2.0),
+                ] {
+                    // a cos θ + sin θ · c = 0 with ρ = 1.
+                    let a = -theta.sin() * c / theta.cos();
+                    out.push(DVec3::new(phi0.sin(), a, phi0.cos()).normalize());
+                    out.push(-DVec3::new(phi0.sin(), a, phi0.cos()).normalize());
+                }
+            }
+        }
+        out
+    }
+
+    /// The sweep against the tiles (the same moments and crossed pieces, summed another way:
+    /// within 1e-12 of the value) and against the row method of the device path
+    /// (`cpu::irradiance::latlong_rows`, an independent integration of the same filtered map:
+    /// within 1e-9), over sizes from 1 × 1 (pieces cut to 0.25 rad) to 96 × 2, both filters,
+    /// the identity, a rotation and a rotation times a uniform scale.
+    #[test]
+    fn the_sweep_is_the_tables_integral() {
+        let axis = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let frames = [
+            DMat3::IDENTITY,
+            DMat3::from_axis_angle(axis, 0.9),
+            DMat3::from_axis_angle(axis, -2.1) * 3.0,
+        ];
+        let (mut worst_tables, mut worst_rows, mut count) = (0.0f64, 0.0f64, 0);
+        for &(w, h) in &[(1, 1), (2, 1), (4, 2), (13, 5), (16, 8), (64, 32), (96, 2)] {
+            for filter in [Filter::Bilinear, Filter::Nearest] {
+                for one_texel in [false, true] {
+                    let img = image(w, h, (w * 31 + h) as u64, one_texel);
+                    let mut data = Vec::new();
+                    tables(&img, filter, |v| v, &mut data);
+                    let rows = Rows {
+                        data: &data,
+                        width: w,
+                        height: h,
+                        bilinear: filter == Filter::Bilinear,
+                    };
+                    for a in frames {
+                        let frame = DomeFrame::new(a, DMat3::IDENTITY).unwrap();
+                        let d =
+                            DomeIrradiance::new(img.clone(), DomeFormat::LatLong, filter, frame)
+                                .unwrap();
+                        assert!(d.sweeps());
+                        // The row method is held to 1e-9 on `normals()`, its own test's set;
+                        // the grazing normals probe the sweep's classification (against the
+                        // tables at 1e-12), where that rule's error reached 2e-9.
+                        let plain = normals().len();
+                        let mut ns = normals();
+                        if a == DMat3::IDENTITY {
+                            ns.extend(grazing(&d));
+                        }
+                        for (k, n) in ns.into_iter().enumerate() {
+                            let want = d.irradiance_within(n, &[]);
+                            let got = d.sweep(n).unwrap();
+                            // The map's whole-sphere scale: ∫ L over the lit hemisphere ≤ π max L.
+                            let scale = img
+                                .rgb
+                                .iter()
+                                .map(|t| t[0].max(t[1]).max(t[2]) as f64)
+                                .fold(0.0, f64::max)
+                                * std::f64::consts::PI;
+                            let err = (got - want).abs().max_element() / scale;
+                            assert!(
+                                err < 1e-12,
+                                "{w}x{h} {filter:?} one texel {one_texel} frame {a} n={n}: \
+                                 sweep {got} tables {want} ({err:.1e})"
+                            );
+                            worst_tables = worst_tables.max(err);
+                            if a == DMat3::IDENTITY && k < plain {
+                                let rows = latlong_irradiance(&rows, n);
+                                let err = (got - rows).abs().max_element() / scale;
+                                assert!(
+                                    err < 1e-9,
+                                    "{w}x{h} {filter:?} n={n}: sweep {got} rows {rows} ({err:.1e})"
+                                );
+                                worst_rows = worst_rows.max(err);
+                            }
+                            count += 1;
+                        }
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "{count} normals: sweep − tables ≤ {worst_tables:.1e}, sweep − rows ≤ {worst_rows:.1e} \
+             (of π max L)"
+        );
+    }
+
+    /// Formats and frames the sweep does not cover say so (`irradiance` then walks the tables).
+    #[test]
+    fn the_sweep_declines_other_formats_and_frames() {
+        let img = image(8, 8, 3, false);
+        let sheared = DMat3::from_cols(DVec3::X, DVec3::new(0.5, 1.0, 0.0), DVec3::Z);
+        let frame = DomeFrame::new(sheared, DMat3::IDENTITY).unwrap();
+        let d =
+            DomeIrradiance::new(img.clone(), DomeFormat::LatLong, Filter::Bilinear, frame).unwrap();
+        assert!(d.sweep(DVec3::Y).is_none());
+        let frame = DomeFrame::new(DMat3::IDENTITY, DMat3::IDENTITY).unwrap();
+        let d =
+            DomeIrradiance::new(img, DomeFormat::MirroredBall, Filter::Bilinear, frame).unwrap();
+        assert!(d.sweep(DVec3::Y).is_none());
+    }
+}
