@@ -201,6 +201,83 @@ fn the_cpu_evaluator_gives_the_exact_irradiance() {
     }
 }
 
+/// At a loose tolerance a batch of more than 16 distinct normals takes a latlong dome's row rule
+/// (`cpu::dome_by_normal`; that it does is the unit test
+/// `dome_batches_take_the_row_rule_only_for_many_normals_at_loose_tolerances`): its rows stay
+/// within the tolerance of the exact integral (the reference, which sweeps the pieces) — in fact
+/// within f32 rounding — under a rotation times a uniform scale, both filters. With 16 normals
+/// the batch gives what it gives at the reference tolerance, bit for bit.
+#[test]
+fn a_loose_tolerance_batch_of_many_normals_stays_within_its_tolerance() {
+    let file = png(64, 32, |x, y| {
+        let v = ((x * 37 + y * 91) % 251) as u8;
+        [v, 255 - v, (x * 4) as u8]
+    });
+    let axis = DVec3::new(0.3, -0.5, 0.8).normalize();
+    let ns: Vec<DVec3> = (0..40)
+        .map(|i| {
+            let z = 1.0 - (i as f64 + 0.5) / 20.0;
+            let phi = i as f64 * 2.399963;
+            let r = (1.0 - z * z).sqrt();
+            DVec3::new(r * phi.cos(), z, r * phi.sin())
+        })
+        .collect();
+    let f32s =
+        |v: &[DVec3]| -> Vec<[f32; 3]> { v.iter().map(|n| n.as_vec3().to_array()).collect() };
+    // The normals as the batch reads them: f32, then in f64 divided by their length.
+    let ns: Vec<DVec3> = f32s(&ns)
+        .iter()
+        .map(|n| {
+            let d = DVec3::from_array(n.map(f64::from));
+            d / d.length()
+        })
+        .collect();
+    let normals32 = f32s(&ns);
+    let points = vec![[0.0f32; 3]; ns.len()];
+    let batch = |l: &Light, tol: f64, count: usize| {
+        luxeval::Evaluator::cpu()
+            .with_irradiance_tolerance(tol)
+            .unwrap()
+            .irradiance(
+                std::slice::from_ref(l),
+                &points[..count],
+                &normals32[..count],
+                luxeval::Accumulate::Sum,
+            )
+            .unwrap()
+    };
+    let mut worst = 0.0f64;
+    for nearest in [false, true] {
+        let mut t = Texture::new(file.clone());
+        if nearest {
+            t = t.with_filter(luxeval::TextureFilter::Nearest);
+        }
+        let l = Light::dome()
+            .with_path("/Tex")
+            .with_transform(
+                DMat4::from_axis_angle(axis, 0.7) * DMat4::from_scale(DVec3::splat(2.0)),
+            )
+            .with_texture(t);
+        let r = Reference::new(&l, TemperatureMode::Spec).unwrap();
+        let exact: Vec<DVec3> = ns.iter().map(|n| r.irradiance(DVec3::ZERO, *n)).collect();
+        for tol in [1e-4, 1e-2] {
+            let out = batch(&l, tol, ns.len());
+            for ((n, v), e) in ns.iter().zip(&out).zip(&exact) {
+                let got = DVec3::from_array(v.map(f64::from));
+                let err = (got - *e).abs().max_element() / e.max_element();
+                assert!(
+                    err < 1e-6,
+                    "nearest {nearest} tol {tol} n {n}: {got} vs {e}"
+                );
+                worst = worst.max(err);
+            }
+        }
+        let reference = batch(&l, 1e-9, ns.len());
+        assert_eq!(batch(&l, 1e-4, 16), reference[..16], "nearest {nearest}");
+    }
+    eprintln!("row rule at 1e-4 and 1e-2, 40 normals: worst relative error {worst:.1e}");
+}
+
 /// The fast path (`Reference::dome_irradiance_sh9`, 9 spherical-harmonic coefficients) against
 /// the exact integral on real maps: luxtest's dome grid (2048 × 1024, hard-edged colour blocks)
 /// and Blender's studio map (1024 × 512, HDR). Normals: the 6 axes, 12 edge and 8 corner

@@ -113,7 +113,7 @@ pub fn irradiance_batch(
             (matches!(l.light.kind, LightType::Dome)
                 && l.dome_texture().is_some()
                 && l.portals.is_none())
-            .then(|| dome_by_normal(l, normals))
+            .then(|| dome_by_normal(l, normals, rule))
         })
         .collect();
     batch(lights.len(), points.len(), per_light, |k, i| {
@@ -130,18 +130,98 @@ pub fn irradiance_batch(
 /// A textured dome's irradiance for each distinct normal among `normals` (keyed by their bits).
 /// A dome lies at infinity, so its irradiance depends on the normal alone (DESIGN.md §2), and
 /// its exact integral (irradiance/dome.rs) costs far more than a lookup: a falloff map, whose
-/// receivers share one normal, needs one evaluation instead of one per pixel.
-fn dome_by_normal(light: &Prepared, normals: &[[f32; 3]]) -> HashMap<[u32; 3], DVec3> {
+/// receivers share one normal, needs one evaluation instead of one per pixel. At a loose
+/// tolerance, more than [`DOME_ROWS_MIN_NORMALS`] distinct normals take the row rule where it
+/// applies ([`irradiance::dome_irradiance_by_rows`]).
+fn dome_by_normal(
+    light: &Prepared,
+    normals: &[[f32; 3]],
+    rule: &irradiance::Adaptive,
+) -> HashMap<[u32; 3], DVec3> {
     let mut keys: Vec<[u32; 3]> = normals.iter().map(|n| n.map(f32::to_bits)).collect();
     keys.sort_unstable();
     keys.dedup();
+    let by_rows =
+        irradiance::Rule::texture_tolerance(rule).is_some() && keys.len() > DOME_ROWS_MIN_NORMALS;
     keys.into_par_iter()
         .map(|key| {
             let e = match unit(key.map(f32::from_bits)) {
-                Some(n) => irradiance::irradiance(light, DVec3::ZERO, n),
+                Some(n) => by_rows
+                    .then(|| irradiance::dome_irradiance_by_rows(light, n))
+                    .flatten()
+                    .unwrap_or_else(|| irradiance::irradiance(light, DVec3::ZERO, n)),
                 None => DVec3::ZERO,
             };
             (key, e)
         })
         .collect()
+}
+
+/// Past this many distinct normals a loose-tolerance batch builds a latlong dome's row tables
+/// (0.18 s for a 2048 × 1024 map, then ~8 ms of one core per normal against the exact sweep's
+/// ~46 ms: BENCHMARKS.md "Textured latlong domes").
+const DOME_ROWS_MIN_NORMALS: usize = 16;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Light, Texture};
+    use crate::prepare::TemperatureMode;
+
+    /// A 16 × 8 latlong dome under a rotation times a uniform scale.
+    fn textured_dome() -> Prepared {
+        let img = image::RgbImage::from_fn(16, 8, |x, y| {
+            image::Rgb([15 * x as u8 + 10, 90, 30 * y as u8 + 5])
+        });
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png)
+            .expect("a PNG encodes");
+        let axis = DVec3::new(0.3, -0.5, 0.8).normalize();
+        let light = Light::dome()
+            .with_transform(
+                glam::DMat4::from_axis_angle(axis, 0.7)
+                    * glam::DMat4::from_scale(DVec3::splat(2.0)),
+            )
+            .with_texture(Texture::new(crate::Asset::from_bytes(
+                "dome.png",
+                bytes.into_inner(),
+            )));
+        Prepared::new(&light, TemperatureMode::Spec).expect("the dome prepares")
+    }
+
+    /// A batch of more than [`DOME_ROWS_MIN_NORMALS`] distinct normals at a loose tolerance
+    /// gives the row rule's values, bit for bit; at the reference tolerance, or with that many
+    /// normals only, the exact integral's. The two differ (the rule is not the exact sum).
+    #[test]
+    fn dome_batches_take_the_row_rule_only_for_many_normals_at_loose_tolerances() {
+        let p = textured_dome();
+        let normals: Vec<[f32; 3]> = (0..DOME_ROWS_MIN_NORMALS + 4)
+            .map(|i| {
+                let z = 1.0 - (i as f32 + 0.5) / 10.0;
+                let phi = i as f32 * 2.4;
+                let r = (1.0 - z * z).sqrt();
+                [r * phi.cos(), z, r * phi.sin()]
+            })
+            .collect();
+        let points = vec![[0.0f32; 3]; normals.len()];
+        let lights = std::slice::from_ref(&p);
+        let loose = irradiance::Adaptive::for_tolerance(1e-4);
+        let rows = irradiance_batch(lights, &points, &normals, true, &loose);
+        let exact = irradiance_batch(
+            lights,
+            &points,
+            &normals,
+            true,
+            &irradiance::Adaptive::REFERENCE,
+        );
+        for ((n, r), e) in normals.iter().zip(&rows).zip(&exact) {
+            let n = unit(*n).expect("a unit normal");
+            assert_eq!(Some(*r), irradiance::dome_irradiance_by_rows(&p, n));
+            assert_eq!(*e, irradiance::irradiance(&p, DVec3::ZERO, n));
+        }
+        assert_ne!(rows, exact);
+        let few = DOME_ROWS_MIN_NORMALS;
+        let some = irradiance_batch(lights, &points[..few], &normals[..few], true, &loose);
+        assert_eq!(some, exact[..few]);
+    }
 }

@@ -84,6 +84,10 @@ pub struct DomeIrradiance {
     tables: OnceLock<Tables>,
     /// A latlong map's per-axis moment factors (conformal frames only, latlong.rs).
     axes: OnceLock<latlong::Axes>,
+    filter: Filter,
+    /// A latlong map's row tables in f64 for the row rule (latlong.rs "The row rule"); `None`
+    /// over [`latlong::ROWS_MAX_BYTES`].
+    row_tables: OnceLock<Option<Vec<f64>>>,
     /// The 9-coefficient fast path, projected on first use.
     sh9: OnceLock<sh::IrradianceSh>,
 }
@@ -127,6 +131,8 @@ impl DomeIrradiance {
             kappa: kappa.max(1.0),
             tables: OnceLock::new(),
             axes: OnceLock::new(),
+            filter,
+            row_tables: OnceLock::new(),
             sh9: OnceLock::new(),
         })
     }
