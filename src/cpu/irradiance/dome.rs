@@ -33,7 +33,7 @@
 
 pub mod clip;
 pub mod horizon;
-mod latlong;
+pub(crate) mod latlong;
 pub mod pieces;
 pub mod quadrature;
 pub mod sh;

@@ -276,58 +276,16 @@ pub fn latlong_irradiance(t: &Rows, n: DVec3) -> DVec3 {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::Arc;
-
     use glam::DMat3;
 
     use super::*;
     use crate::cpu::irradiance::dome::DomeIrradiance;
+    use crate::cpu::irradiance::dome::latlong::tests::{image, normals};
     use crate::prepare::latlong_rows::tables;
-    use crate::prepare::texture::{DomeFormat, DomeFrame, Filter, Image};
+    use crate::prepare::texture::{DomeFormat, DomeFrame, Filter};
 
-    fn image(w: usize, h: usize, seed: u64) -> Arc<Image> {
-        let mut state = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 33) as f64 / (1u64 << 31) as f64) as f32
-        };
-        let rgb = (0..w * h)
-            .map(|_| [next() * 4.0, next(), next() * 0.25])
-            .collect();
-        Arc::new(Image {
-            width: w,
-            height: h,
-            rgb,
-            envmap: None,
-            source: "random.exr".into(),
-        })
-    }
-
-    fn normals() -> Vec<DVec3> {
-        let mut v = vec![
-            DVec3::Y,
-            -DVec3::Y,
-            DVec3::X,
-            DVec3::Z,
-            -DVec3::Z,
-            DVec3::new(1e-9, 1.0, 0.0),
-            DVec3::new(0.3, 1e-7, -0.9),
-        ];
-        for i in 0..24 {
-            let z = 1.0 - (i as f64 + 0.5) / 12.0;
-            let phi = i as f64 * 2.399963;
-            let r = (1.0 - z * z).sqrt();
-            v.push(DVec3::new(r * phi.cos(), z, r * phi.sin()));
-        }
-        v.into_iter().map(|n| n.normalize()).collect()
-    }
-
-    /// The row method against the CPU reference (pieces and caps): independent integrations of
-    /// the same filtered texture, so agreement to 1e-9 checks both.
+    /// The row method against the CPU reference (the exact sum over texel pieces): independent
+    /// integrations of the same filtered texture, so agreement to 1e-9 checks both.
     #[test]
     fn rows_match_the_reference_within_1e_9() {
         let mut worst = 0.0f64;
@@ -341,7 +299,7 @@ mod tests {
             (7, 5, Filter::Bilinear),
             (64, 32, Filter::Nearest),
         ] {
-            let img = image(w, h, (w * 31 + h) as u64);
+            let img = image(w, h, (w * 31 + h) as u64, false);
             let mut data = Vec::new();
             tables(&img, filter, |v| v, &mut data);
             let rows = Rows {

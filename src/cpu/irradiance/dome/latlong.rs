@@ -263,7 +263,7 @@ impl DomeIrradiance {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use std::sync::Arc;
 
     use glam::{DMat3, DVec3};
@@ -273,7 +273,7 @@ mod tests {
 
     /// A random HDR-like map, and one dark map with a single bright texel (a piece lit or missed
     /// whole shows there).
-    fn image(w: usize, h: usize, seed: u64, one_texel: bool) -> Arc<Image> {
+    pub(crate) fn image(w: usize, h: usize, seed: u64, one_texel: bool) -> Arc<Image> {
         let mut state = seed.wrapping_mul(6364136223846793005) ^ 0x9e37_79b9_7f4a_7c15;
         let mut next = move || {
             state = state
@@ -299,7 +299,7 @@ mod tests {
     }
 
     /// The axes and poles, normals grazing the poles, and a spiral of 24 more.
-    fn normals() -> Vec<DVec3> {
+    pub(crate) fn normals() -> Vec<DVec3> {
         let mut v = vec![
             DVec3::Y,
             -DVec3::Y,
