@@ -19,6 +19,11 @@ pub struct HorizonCurve {
     e2: DVec3,
     /// Per coordinate (a, b): monotone segments (γ₀, γ₁, v₀, v₁), γ₁ > γ₀.
     segments: [Vec<(f64, f64, f64, f64)>; 2],
+    /// The adaptive samples `(γ, (a, b))` over `[0, 4π)` (the circle twice, so that every
+    /// segment's samples are one run), and per coordinate and segment the run of them strictly
+    /// inside it: a crossing is bracketed between two neighbours before it is solved.
+    samples: Vec<(f64, DVec2)>,
+    runs: [Vec<(usize, usize)>; 2],
 }
 
 impl HorizonCurve {
@@ -31,6 +36,8 @@ impl HorizonCurve {
             e1,
             e2,
             segments: [vec![], vec![]],
+            samples: vec![],
+            runs: [vec![], vec![]],
         };
         let tau = TAU;
         let mut g: Vec<f64> = (0..=512).map(|k| tau * k as f64 / 512.0).collect();
@@ -64,6 +71,19 @@ impl HorizonCurve {
                     .map(|w| (w[0], w[1], c.point(w[0])[axis], c.point(w[1])[axis]))
                     .collect();
             }
+        }
+        let n = pts.len() - 1;
+        c.samples = (0..2 * n)
+            .map(|i| (g[i % n] + tau * (i / n) as f64, pts[i % n]))
+            .collect();
+        for axis in 0..2 {
+            c.runs[axis] = c.segments[axis]
+                .iter()
+                .map(|&(g0, g1, _, _)| {
+                    let first = c.samples.partition_point(|s| s.0 <= g0);
+                    (first, first.max(c.samples.partition_point(|s| s.0 < g1)))
+                })
+                .collect();
         }
         c
     }
@@ -110,17 +130,34 @@ impl HorizonCurve {
         0.5 * (lo + hi)
     }
 
-    /// Every horizon point whose coordinate `axis` equals `v`, appended as (a, b).
+    /// Every horizon point whose coordinate `axis` equals `v`, appended as (a, b). On each
+    /// monotone segment the samples inside it bracket the crossing to one sample step first
+    /// (a binary search: it ends between two neighbours across which `coordinate − v` changes
+    /// sign, whatever the samples), then regula falsi (Illinois) solves it there.
     pub fn crossings(&self, axis: usize, v: f64, out: &mut Vec<DVec2>) {
-        for &(g0, g1, v0, v1) in &self.segments[axis] {
+        for (&(g0, g1, v0, v1), &(first, last)) in self.segments[axis].iter().zip(&self.runs[axis])
+        {
             if (v0 - v) * (v1 - v) < 0.0 {
-                let g = super::quadrature::illinois(
-                    &mut |g| self.point(g)[axis] - v,
-                    g0,
-                    g1,
-                    v0 - v,
-                    v1 - v,
-                );
+                let below = v0 < v;
+                let run = &self.samples[first..last];
+                let k = run.partition_point(|s| (s.1[axis] < v) == below);
+                let (a, fa) = match k {
+                    0 => (g0, v0 - v),
+                    _ => (run[k - 1].0, run[k - 1].1[axis] - v),
+                };
+                let (b, fb) = match run.get(k) {
+                    Some(s) => (s.0, s.1[axis] - v),
+                    None => (g1, v1 - v),
+                };
+                let g = if fb == 0.0 {
+                    b
+                } else {
+                    // The segment's own stopping width (what solving on the whole segment
+                    // stopped at), at least a few ulps of γ: the bracket is far narrower.
+                    let tol = (1e-15 * (g1 - g0)).max(4.0 * f64::EPSILON * b.abs()) + 1e-300;
+                    let f = &mut |g| self.point(g)[axis] - v;
+                    super::quadrature::illinois_to(f, a, b, fa, fb, tol)
+                };
                 out.push(self.point(g));
             }
         }

@@ -107,14 +107,20 @@ fn split<const K: usize>(
 
 /// A root of `f` in `[a, b]` given `f(a)`, `f(b)` of opposite signs (Illinois regula falsi,
 /// converged to ~1e-15 of the interval or 100 steps).
-pub fn illinois(
+pub fn illinois(f: &mut impl FnMut(f64) -> f64, a: f64, b: f64, fa: f64, fb: f64) -> f64 {
+    let tol = 1e-15 * (b - a).abs().max(1e-300) + 1e-300;
+    illinois_to(f, a, b, fa, fb, tol)
+}
+
+/// [`illinois`] stopping once the bracket is at most `tol` wide (or after 100 steps).
+pub fn illinois_to(
     f: &mut impl FnMut(f64) -> f64,
     mut a: f64,
     mut b: f64,
     mut fa: f64,
     mut fb: f64,
+    tol: f64,
 ) -> f64 {
-    let tol = 1e-15 * (b - a).abs().max(1e-300) + 1e-300;
     let mut side = 0;
     for _ in 0..100 {
         if (b - a).abs() <= tol {
