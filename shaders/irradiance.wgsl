@@ -152,10 +152,10 @@ fn irradiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var sum = vec3<f32>(0.0);
     for (var l = params.light_first; l < params.light_end; l++) {
         var v = vec3<f32>(0.0);
-        // Params::light_filter. Normal-only: the kinds of Prepared::irradiance_is_normal_only
-        // (a masked dome is the host's, FLAG_HOST_IRRADIANCE, 0 in either pass).
-        let kind = lights[l].kind;
-        let normal_only = kind == KIND_DISTANT || kind == KIND_DOME;
+        // Params::light_filter. Normal-only: FLAG_NORMAL_ONLY, set from
+        // Prepared::irradiance_is_normal_only (a masked dome is the host's,
+        // FLAG_HOST_IRRADIANCE, 0 in either pass).
+        let normal_only = has_flag(lights[l], FLAG_NORMAL_ONLY);
         let wanted = params.light_filter == LIGHTS_ALL
             || (params.light_filter == LIGHTS_NORMAL_ONLY) == normal_only;
         if valid && wanted {

@@ -170,22 +170,14 @@ mod tests {
 
     /// A 16 × 8 latlong dome under a rotation times a uniform scale.
     fn textured_dome() -> Prepared {
-        let img = image::RgbImage::from_fn(16, 8, |x, y| {
-            image::Rgb([15 * x as u8 + 10, 90, 30 * y as u8 + 5])
-        });
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut bytes, image::ImageFormat::Png)
-            .expect("a PNG encodes");
+        let png = crate::Asset::png(16, 8, |x, y| [15 * x as u8 + 10, 90, 30 * y as u8 + 5]);
         let axis = DVec3::new(0.3, -0.5, 0.8).normalize();
         let light = Light::dome()
             .with_transform(
                 glam::DMat4::from_axis_angle(axis, 0.7)
                     * glam::DMat4::from_scale(DVec3::splat(2.0)),
             )
-            .with_texture(Texture::new(crate::Asset::from_bytes(
-                "dome.png",
-                bytes.into_inner(),
-            )));
+            .with_texture(Texture::new(png));
         Prepared::new(&light, TemperatureMode::Spec).expect("the dome prepares")
     }
 

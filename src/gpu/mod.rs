@@ -6,6 +6,7 @@
 pub(crate) mod cache;
 pub(crate) mod dispatch;
 pub(crate) mod ies_atlas;
+pub(crate) mod launch;
 pub(crate) mod mesh_atlas;
 pub(crate) mod record;
 pub(crate) mod resident;

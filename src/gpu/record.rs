@@ -61,6 +61,10 @@ pub const FLAG_MESH_FRONTS: u32 = 32768;
 /// A dome masked by portals, which are in the mesh atlas at `tex.w` (DESIGN.md §8 P2 mask
 /// mode; `super::mesh_atlas`, shaders/portal.wgsl).
 pub const FLAG_PORTALS: u32 = 65536;
+/// The light's irradiance depends on the receiver's normal alone
+/// (`prepare::Prepared::irradiance_is_normal_only`): the irradiance kernel's
+/// [`LIGHTS_NORMAL_ONLY`] pass integrates it, [`LIGHTS_POSITIONAL`] skips it.
+pub const FLAG_NORMAL_ONLY: u32 = 131072;
 
 /// Threads per workgroup of every kernel.
 pub const WORKGROUP_SIZE: u32 = 64;
@@ -91,6 +95,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("FLAG_DOUBLE_SIDED", FLAG_DOUBLE_SIDED),
     ("FLAG_MESH_FRONTS", FLAG_MESH_FRONTS),
     ("FLAG_PORTALS", FLAG_PORTALS),
+    ("FLAG_NORMAL_ONLY", FLAG_NORMAL_ONLY),
     ("WORKGROUP_SIZE", WORKGROUP_SIZE),
     ("LIGHTS_ALL", LIGHTS_ALL),
     ("LIGHTS_NORMAL_ONLY", LIGHTS_NORMAL_ONLY),
@@ -307,6 +312,9 @@ pub fn pack(
     }
     if p.irradiance_on_host() {
         r.flags |= FLAG_HOST_IRRADIANCE;
+    }
+    if p.irradiance_is_normal_only() {
+        r.flags |= FLAG_NORMAL_ONLY;
     }
     let (kind, size) = match p.light.kind {
         LightType::Distant { .. } => {

@@ -9,7 +9,8 @@ use wgpu::util::DeviceExt;
 
 use crate::error::{LuxError, Result};
 
-use super::dispatch::{GpuLights, entry, params_block, params_entry, record_passes};
+use super::dispatch::GpuLights;
+use super::launch::{entry, params_block, params_entry, record_passes};
 use super::record::{Params, Record, SELECT_HAS_NORMALS, WORKGROUP_SIZE};
 use super::sample::SampleLights;
 use super::{GpuContext, Kernel};

@@ -6,7 +6,8 @@
 use crate::error::{GpuFailure, LuxError, Result};
 use crate::prepare::env_table::EnvTable;
 
-use super::dispatch::{GpuLights, entry, params_block, params_entry, record_passes};
+use super::dispatch::GpuLights;
+use super::launch::{entry, params_block, params_entry, record_passes};
 use super::texture_atlas::env_table_words;
 use super::{GpuContext, Kernel};
 

@@ -40,3 +40,15 @@ impl Asset {
         self.resolved.as_deref().unwrap_or(&self.authored)
     }
 }
+
+#[cfg(test)]
+impl Asset {
+    /// A `w × h` RGB PNG in memory with texels `f(x, y)`, for the unit tests' textures.
+    pub(crate) fn png(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) -> Asset {
+        let img = image::RgbImage::from_fn(w, h, |x, y| image::Rgb(f(x, y)));
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png)
+            .expect("a PNG encodes");
+        Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
+    }
+}

@@ -207,8 +207,8 @@ impl Prepared {
 
     /// Whether this light's irradiance depends on the receiver's normal alone, not its
     /// position: distant lights and domes (a masked dome's too, though its irradiance is the
-    /// host's). The irradiance kernel's `LIGHTS_NORMAL_ONLY` pass integrates these kinds
-    /// (shaders/irradiance.wgsl tests the same kinds).
+    /// host's). The irradiance kernel's `LIGHTS_NORMAL_ONLY` pass integrates these lights
+    /// (the record's `FLAG_NORMAL_ONLY` is set from this).
     pub fn irradiance_is_normal_only(&self) -> bool {
         matches!(self.light.kind, LightType::Distant { .. } | LightType::Dome)
     }

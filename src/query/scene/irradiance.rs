@@ -233,16 +233,8 @@ mod tests {
 
     /// A 4 × 2 latlong dome texture (PNG bytes).
     fn textured_dome() -> Light {
-        let img = image::RgbImage::from_fn(4, 2, |x, y| {
-            image::Rgb([40 * x as u8 + 10, 90, 30 * y as u8 + 5])
-        });
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut bytes, image::ImageFormat::Png)
-            .expect("a PNG encodes");
-        Light::dome().with_texture(
-            Texture::new(crate::Asset::from_bytes("dome.png", bytes.into_inner()))
-                .with_format(TextureFormat::LatLong),
-        )
+        let png = crate::Asset::png(4, 2, |x, y| [40 * x as u8 + 10, 90, 30 * y as u8 + 5]);
+        Light::dome().with_texture(Texture::new(png).with_format(TextureFormat::LatLong))
     }
 
     /// Which scenes integrate irradiance once per distinct normal, and which split the

@@ -63,12 +63,18 @@ pub(super) struct Axes {
     pub cols: Vec<[[f64; 3]; 2]>,
     /// Per row piece and texel weight (b ∈ {0,1}): `∫ w_b(y) (sin²θ, sin θ cos θ) dy`.
     pub rows: Vec<[[f64; 2]; 2]>,
-    /// Per column piece: `(φ, sin φ, cos φ)` at its lower φ end (its x1) and the φ span.
-    col_ends: Vec<([f64; 3], f64)>,
-    /// Per column piece: `(sin φ, cos φ)` at its upper φ end (its x0).
-    col_hi: Vec<[f64; 2]>,
+    /// Per column piece: its lower φ end (at x1), its φ span, and `(sin φ, cos φ)` at the
+    /// lower and at the upper end.
+    col_ends: Vec<ColumnEnds>,
     /// Per row piece: `(sin θ, cos θ)` at y0 and at y1.
     row_ends: Vec<[[f64; 2]; 2]>,
+}
+
+struct ColumnEnds {
+    lo: f64,
+    span: f64,
+    at_lo: [f64; 2],
+    at_hi: [f64; 2],
 }
 
 impl Axes {
@@ -96,45 +102,39 @@ impl Axes {
             g.ys.iter()
                 .map(|p| {
                     [0, 1].map(|b| {
-                        let v = gl::<2>(16, p.x0, p.x1, |y| {
+                        gl::<2>(16, p.x0, p.x1, |y| {
                             let (w0, w1) = p.weights(y);
                             let wt = if b == 0 { w0 } else { w1 };
                             let (s, c) = theta(y).sin_cos();
                             [wt * s * s, wt * s * c]
-                        });
-                        [v[0], v[1]]
+                        })
                     })
                 })
                 .collect();
+        let sin_cos = |t: f64| {
+            let (s, c) = t.sin_cos();
+            [s, c]
+        };
         let col_ends =
             g.xs.iter()
                 .map(|p| {
-                    let lo = phi(p.x1);
-                    let (s, c) = lo.sin_cos();
-                    ([lo, s, c], phi(p.x0) - lo)
-                })
-                .collect();
-        let col_hi =
-            g.xs.iter()
-                .map(|p| {
-                    let (s, c) = phi(p.x0).sin_cos();
-                    [s, c]
+                    let (lo, hi) = (phi(p.x1), phi(p.x0));
+                    ColumnEnds {
+                        lo,
+                        span: hi - lo,
+                        at_lo: sin_cos(lo),
+                        at_hi: sin_cos(hi),
+                    }
                 })
                 .collect();
         let row_ends =
             g.ys.iter()
-                .map(|p| {
-                    [p.x0, p.x1].map(|y| {
-                        let (s, c) = theta(y).sin_cos();
-                        [s, c]
-                    })
-                })
+                .map(|p| [p.x0, p.x1].map(|y| sin_cos(theta(y))))
                 .collect();
         Axes {
             cols,
             rows,
             col_ends,
-            col_hi,
             row_ends,
         }
     }
@@ -146,10 +146,10 @@ fn column_range(axes: &Axes, phi0: f64, s0: f64, c0: f64) -> Vec<[f64; 2]> {
     let pi = std::f64::consts::PI;
     axes.col_ends
         .iter()
-        .zip(&axes.col_hi)
-        .map(|(([lo, s, c], span), [sh, ch])| {
-            let (at_lo, at_hi) = (c * c0 + s * s0, ch * c0 + sh * s0);
-            let holds = |t: f64| (t - lo).rem_euclid(tau) <= *span;
+        .map(|e| {
+            let cos = |[s, c]: [f64; 2]| c * c0 + s * s0;
+            let (at_lo, at_hi) = (cos(e.at_lo), cos(e.at_hi));
+            let holds = |t: f64| (t - e.lo).rem_euclid(tau) <= e.span;
             let max = if holds(phi0) { 1.0 } else { at_lo.max(at_hi) };
             let min = if holds(phi0 + pi) {
                 -1.0
@@ -204,7 +204,10 @@ impl DomeIrradiance {
     /// `E(n)` by the sweep (module docs): the tables' value (`irradiance_within(n, &[])`),
     /// summed in another order. `None` where it does not apply ([`DomeIrradiance::sweeps`]).
     pub fn sweep(&self, n: DVec3) -> Option<DVec3> {
-        let w = self.conformal.filter(|_| self.sweeps())?;
+        if !self.sweeps() {
+            return None;
+        }
+        let w = self.conformal?;
         let axes = self.axes();
         let m = self.frame.horizon(n);
         let (a, rho) = (m.y, m.x.hypot(m.z));
