@@ -1,6 +1,7 @@
 //! The tile tables of a textured dome (each piece's moment, grouped in tiles under bounding
-//! caps, built once) and the walk over them that gives a receiver's `E(n)`, or its part inside a
-//! convex intersection of half-spaces (a masked dome's portal piece, DESIGN.md §8 P2).
+//! caps, the tiles in blocks under bounding caps, built once) and the walk over them that gives
+//! a receiver's `E(n)`, or its part inside a convex intersection of half-spaces (a masked dome's
+//! portal piece, DESIGN.md §8 P2).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -27,8 +28,25 @@ struct Tile {
     sin_radius: f64,
 }
 
+/// A block of up to [`BLOCK`] × [`BLOCK`] neighbouring tiles of one grid (a contiguous range
+/// of `Tables::tiles`): their summed moment under a cap bounding all of theirs. The walk tests
+/// blocks first and only a crossed block's tiles, so a receiver costs the blocks plus the tiles
+/// along its clip lines rather than every tile: a masked dome's portal piece clips a small
+/// part of the sphere, and its walk tested all 524,288 tiles of a 1024 × 512 map each time.
+struct Block {
+    tiles: std::ops::Range<usize>,
+    v: [f64; 9],
+    centre: DVec3,
+    radius: f64,
+    sin_radius: f64,
+}
+
+/// Tiles per block side.
+const BLOCK: usize = 16;
+
 pub(super) struct Tables {
     tiles: Vec<Tile>,
+    blocks: Vec<Block>,
     single: bool,
 }
 
@@ -123,28 +141,73 @@ impl DomeIrradiance {
     fn build(&self) -> Tables {
         let count: usize = self.grids.iter().map(|g| g.xs.len() * g.ys.len()).sum();
         let tsize = ((count as f64 / MAX_TILES as f64).sqrt().ceil() as usize).max(1);
-        let mut t = Tables {
-            tiles: vec![],
-            single: tsize == 1,
-        };
+        // Tiles in block order (blocks of BLOCK × BLOCK tiles, row by row), each block's
+        // tiles contiguous.
         let mut specs = vec![];
+        let mut block = 0;
         for (gi, g) in self.grids.iter().enumerate() {
-            for y in (0..g.ys.len()).step_by(tsize) {
-                for x in (0..g.xs.len()).step_by(tsize) {
-                    specs.push((
-                        gi,
-                        (x, (x + tsize).min(g.xs.len())),
-                        (y, (y + tsize).min(g.ys.len())),
-                    ));
+            let (nx, ny) = (g.xs.len().div_ceil(tsize), g.ys.len().div_ceil(tsize));
+            for by in (0..ny).step_by(BLOCK) {
+                for bx in (0..nx).step_by(BLOCK) {
+                    for ty in by..(by + BLOCK).min(ny) {
+                        for tx in bx..(bx + BLOCK).min(nx) {
+                            let (x, y) = (tx * tsize, ty * tsize);
+                            specs.push((
+                                block,
+                                gi,
+                                (x, (x + tsize).min(g.xs.len())),
+                                (y, (y + tsize).min(g.ys.len())),
+                            ));
+                        }
+                    }
+                    block += 1;
                 }
             }
         }
-        let tiles: Vec<Tile> = specs
+        let tiles: Vec<(usize, Tile)> = specs
             .into_par_iter()
-            .filter_map(|(grid, ix, iy)| self.tile(grid, ix, iy))
+            .filter_map(|(b, grid, ix, iy)| self.tile(grid, ix, iy).map(|t| (b, t)))
             .collect();
-        t.tiles = tiles;
-        t
+        let mut ranges = vec![];
+        let mut start = 0;
+        for i in 1..=tiles.len() {
+            if i == tiles.len() || tiles[i].0 != tiles[start].0 {
+                ranges.push(start..i);
+                start = i;
+            }
+        }
+        let tiles: Vec<Tile> = tiles.into_iter().map(|(_, t)| t).collect();
+        let blocks = ranges
+            .into_par_iter()
+            .map(|r| Self::block(&tiles, r))
+            .collect();
+        Tables {
+            tiles,
+            blocks,
+            single: tsize == 1,
+        }
+    }
+
+    /// The block over `tiles[range]`: their moments summed, and a cap about the middle tile's
+    /// centre that holds every tile's cap (unbounded where one is).
+    fn block(tiles: &[Tile], range: std::ops::Range<usize>) -> Block {
+        let part = &tiles[range.clone()];
+        let mut v = [0.0; 9];
+        for t in part {
+            add(&mut v, &t.v);
+        }
+        let centre = part[part.len() / 2].centre;
+        let radius = part
+            .iter()
+            .map(|t| centre.cross(t.centre).length().atan2(centre.dot(t.centre)) + t.radius)
+            .fold(0.0, f64::max);
+        Block {
+            tiles: range,
+            v,
+            centre,
+            radius,
+            sin_radius: radius.sin(),
+        }
     }
 
     fn tile(&self, grid: usize, ix: (usize, usize), iy: (usize, usize)) -> Option<Tile> {
@@ -243,8 +306,17 @@ impl DomeIrradiance {
                 m.dot(DVec3::new(v[6], v[7], v[8])),
             )
         };
+        // Blocks first; a crossed block's tiles; a crossed tile's pieces.
         let mut e = DVec3::ZERO;
-        for tile in &t.tiles {
+        let mut crossed_tiles = vec![];
+        for b in &t.blocks {
+            match side(&hats, b.centre, b.radius, b.sin_radius) {
+                Side::Lit => e += dot(&b.v),
+                Side::Dark => {}
+                Side::Crossed => crossed_tiles.extend(&t.tiles[b.tiles.clone()]),
+            }
+        }
+        for tile in crossed_tiles {
             match side(&hats, tile.centre, tile.radius, tile.sin_radius) {
                 Side::Lit => e += dot(&tile.v),
                 Side::Dark => {}
