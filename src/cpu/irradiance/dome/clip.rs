@@ -22,7 +22,7 @@
 use glam::DVec3;
 
 use super::horizon::HorizonCurve;
-use super::pieces::{Domain, Geometry, PI, Piece, texture_at};
+use super::pieces::{Domain, Geometry, Line, PI, Piece, texture_at};
 use super::quadrature::{adaptive, gl, sign_change_roots};
 use crate::cpu::texture;
 use crate::prepare::texture::DomeFormat;
@@ -70,11 +70,11 @@ pub fn exact<const K: usize>(
     let boundary = g.domain(p) == Domain::Boundary;
     let disk = g.is_disk();
     // `!(m·d <= 0)` as the one-clip code had it (a NaN counts as lit there).
-    let dark = |x: f64, y: f64| {
+    let dark = |line: &Line, y: f64| {
         if clips.is_empty() {
             return false;
         }
-        let d = g.dir_jac(p.face, x, y).0;
+        let d = g.dir_jac_on(line, y).0;
         clips.iter().any(|c| c.m.dot(d) <= 0.0)
     };
     let mut breaks = vec![x0, x1];
@@ -100,14 +100,7 @@ pub fn exact<const K: usize>(
             }
             None => {
                 for ye in [y0, y1] {
-                    let m = c.m;
-                    sign_change_roots(
-                        &mut |x| m.dot(g.dir_jac(p.face, x, ye).0),
-                        x0,
-                        x1,
-                        16,
-                        &mut breaks,
-                    );
+                    edge_roots(g, p.face, c.m, ye, x0, x1, &mut breaks);
                 }
             }
         }
@@ -162,6 +155,7 @@ pub fn exact<const K: usize>(
                 return [0.0; K];
             }
         }
+        let line = g.line(p.face, x);
         roots.clear();
         roots.push(ylo);
         for c in clips {
@@ -187,7 +181,7 @@ pub fn exact<const K: usize>(
                     );
                     roots[start..].sort_by(f64::total_cmp);
                 }
-                None => inner_roots(g, p.face, c.m, x, ylo, yhi, &mut roots, disk),
+                None => inner_roots(g, &line, c.m, ylo, yhi, &mut roots, disk),
             }
         }
         if clips.len() > 1 {
@@ -197,7 +191,7 @@ pub fn exact<const K: usize>(
         let mut sum = [0.0; K];
         for k in 0..roots.len() - 1 {
             let (a, b) = (roots[k], roots[k + 1]);
-            if b <= a || dark(x, 0.5 * (a + b)) {
+            if b <= a || dark(&line, 0.5 * (a + b)) {
                 continue;
             }
             let v = if ball {
@@ -207,12 +201,12 @@ pub fn exact<const K: usize>(
                 gl(n, tau(b), tau(a), |t| {
                     let (st, ct) = t.sin_cos();
                     let y = 0.5 * g.h * (1.0 - bmax * st);
-                    let (d, j) = g.dir_jac(p.face, x, y);
+                    let (d, j) = g.dir_jac_on(&line, y);
                     f(d, texture_at(img, p, x, y), j).map(|c| c * 0.5 * g.h * bmax * ct)
                 })
             } else {
                 gl(n, a, b, |y| {
-                    let (d, j) = g.dir_jac(p.face, x, y);
+                    let (d, j) = g.dir_jac_on(&line, y);
                     f(d, texture_at(img, p, x, y), j)
                 })
             };
@@ -252,13 +246,61 @@ fn substitute(a: f64, b: f64, u: f64, lo: bool, hi: bool) -> (f64, f64) {
     }
 }
 
-/// Roots of `m·d(x, ·)` strictly inside `(ylo, yhi)`, appended in increasing order.
+/// The x in `(x0, x1)` where the circle `m·d = 0` crosses the sheet's horizontal line at
+/// height `ye` of `face`, appended (unsorted), in closed form for latlong and cross:
+/// - latlong: on the latitude `θ = πy/H`, `m·d = m_y cos θ + R sin θ cos(φ − β)` with
+///   `R = √(m_x² + m_z²)`, `β = atan2(m_x, m_z)` (§6 D2's `d = (sin θ sin φ, cos θ, sin θ cos φ)`,
+///   `φ = π − 2πx/W`): zero at `φ = β ± acos(−m_y cos θ / (R sin θ))`, each taken to the period
+///   of x that holds the piece (a tangency, `|…| = 1`, adds one break where the sign does not
+///   change: harmless);
+/// - cross: `m·(F + aR + bU) = 0` is a line of the face's `(a, b)`, met once at fixed b;
+/// - otherwise sign changes between samples.
+///
+/// Sampling 16 points per edge for every clip was most of a masked latlong dome's crossed
+/// pieces' directions.
 #[allow(clippy::too_many_arguments)]
+fn edge_roots(g: &Geometry, face: u32, m: DVec3, ye: f64, x0: f64, x1: f64, out: &mut Vec<f64>) {
+    match g.format {
+        DomeFormat::LatLong => {
+            let (st, ct) = (PI * ye / g.h).sin_cos();
+            let r = m.x.hypot(m.z) * st;
+            if !(r > 0.0) {
+                return;
+            }
+            let c = -m.y * ct / r;
+            if !(c.abs() <= 1.0) {
+                return;
+            }
+            let (beta, half) = (m.x.atan2(m.z), c.acos());
+            for phi in [beta - half, beta + half] {
+                let x = g.w * (PI - phi) / (2.0 * PI);
+                let x = x - g.w * ((x - x0) / g.w).floor();
+                if x > x0 && x < x1 {
+                    out.push(x);
+                }
+            }
+        }
+        DomeFormat::Cross => {
+            let (f, r, u, blk) = texture::cross_basis(face);
+            let b = 1.0 - 2.0 * (ye - blk.y * g.n) / g.n;
+            let mr = m.dot(r);
+            if mr != 0.0 {
+                let a = -(m.dot(f) + b * m.dot(u)) / mr;
+                let x = blk.x * g.n + 0.5 * g.n * (a + 1.0);
+                if x > x0 && x < x1 {
+                    out.push(x);
+                }
+            }
+        }
+        _ => sign_change_roots(&mut |x| m.dot(g.dir_jac(face, x, ye).0), x0, x1, 16, out),
+    }
+}
+
+/// Roots of `m·d` along `line` strictly inside `(ylo, yhi)`, appended in increasing order.
 fn inner_roots(
     g: &Geometry,
-    face: u32,
+    line: &Line,
     m: DVec3,
-    x: f64,
     ylo: f64,
     yhi: f64,
     out: &mut Vec<f64>,
@@ -268,8 +310,8 @@ fn inner_roots(
     match g.format {
         DomeFormat::LatLong => {
             // m·d = m_y cos θ + c sin θ = R cos(θ − α), zero at θ = α ± π/2 (mod π).
-            let phi = PI - 2.0 * PI * x / g.w;
-            let c = m.x * phi.sin() + m.z * phi.cos();
+            let (sp, cp) = line.phi;
+            let c = m.x * sp + m.z * cp;
             if c == 0.0 && m.y == 0.0 {
                 return;
             }
@@ -283,8 +325,8 @@ fn inner_roots(
         }
         DomeFormat::Cross => {
             // m·(F + aR + bU) = 0 is a line in the face's (a, b).
-            let (f, r, u, blk) = texture::cross_basis(face);
-            let a = 2.0 * (x - blk.x * g.n) / g.n - 1.0;
+            let (f, r, u, blk) = texture::cross_basis(line.face);
+            let a = 2.0 * (line.x - blk.x * g.n) / g.n - 1.0;
             let mu = m.dot(u);
             if mu != 0.0 {
                 let b = -(m.dot(f) + a * m.dot(r)) / mu;
@@ -298,7 +340,7 @@ fn inner_roots(
             debug_assert!(disk);
             let mut found = Vec::with_capacity(4);
             sign_change_roots(
-                &mut |y| m.dot(g.dir_jac(face, x, y).0),
+                &mut |y| m.dot(g.dir_jac_on(line, y).0),
                 ylo,
                 yhi,
                 8,
@@ -308,4 +350,66 @@ fn inner_roots(
         }
     }
     out[start..].sort_by(f64::total_cmp);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synthetic::Rng;
+
+    /// The closed-form edge crossings are those a dense sampling of the edge finds (4,096
+    /// intervals, refined), on latlong maps (pieces straddling the seam included) and on every
+    /// face of a cross, for random circles.
+    #[test]
+    fn edge_roots_in_closed_form_are_the_sampled_ones() {
+        let mut rng = Rng::new(17);
+        let mut found = 0;
+        for (format, w, h) in [
+            (DomeFormat::LatLong, 8, 4),
+            (DomeFormat::LatLong, 64, 32),
+            (DomeFormat::Cross, 12, 16),
+        ] {
+            let g = Geometry::new(format, w, h);
+            for _ in 0..4000 {
+                let m = DVec3::new(
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                    rng.range(-1.0, 1.0),
+                );
+                let (face, x0, ye) = if format == DomeFormat::Cross {
+                    let face = rng.below(6) as u32;
+                    let blk = texture::cross_basis(face).3;
+                    let x0 = blk.x * g.n + rng.range(0.0, 0.8) * g.n;
+                    (face, x0, blk.y * g.n + rng.f64() * g.n)
+                } else {
+                    (0, rng.range(-1.0, g.w + 1.0), rng.f64() * g.h)
+                };
+                let x1 = x0 + rng.range(0.01, 0.2) * g.w.min(g.n.max(1.0) * 3.0);
+                let mut want = vec![];
+                sign_change_roots(
+                    &mut |x| m.dot(g.dir_jac(face, x, ye).0),
+                    x0,
+                    x1,
+                    4096,
+                    &mut want,
+                );
+                let mut got = vec![];
+                edge_roots(&g, face, m, ye, x0, x1, &mut got);
+                got.sort_by(f64::total_cmp);
+                assert_eq!(
+                    got.len(),
+                    want.len(),
+                    "{format:?} m {m} y {ye} x {x0}..{x1}: {got:?} vs {want:?}"
+                );
+                for (a, b) in got.iter().zip(&want) {
+                    assert!(
+                        (a - b).abs() <= 1e-9 * g.w,
+                        "{format:?}: {got:?} vs {want:?}"
+                    );
+                }
+                found += got.len();
+            }
+        }
+        assert!(found > 1000, "only {found} crossings: the test saw too few");
+    }
 }

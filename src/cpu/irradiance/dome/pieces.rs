@@ -76,6 +76,17 @@ fn refine(pieces: Vec<AxisPiece>, max_len: f64) -> Vec<AxisPiece> {
     out
 }
 
+/// One inner line of a piece's integral (a fixed sheet x, `clip.rs`, [`tensor`]): a latlong
+/// line is a meridian, whose azimuth's sine and cosine are computed once for every node and
+/// clip on it rather than per node (they were a third of a masked dome's crossed pieces).
+#[derive(Clone, Copy)]
+pub struct Line {
+    pub face: u32,
+    pub x: f64,
+    /// Latlong: `(sin φ, cos φ)` of the meridian's `φ = π − 2πx/W` (§6 D2); unused otherwise.
+    pub phi: (f64, f64),
+}
+
 /// Where a piece lies with respect to a disk format's rim.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Domain {
@@ -156,20 +167,39 @@ impl Geometry {
         DVec2::new(2.0 * x / self.w - 1.0, 1.0 - 2.0 * y / self.h)
     }
 
-    /// Dome direction and dome solid angle per unit sheet area at (x, y) (module docs).
+    /// The inner line at sheet x of `face` ([`Line`]).
     #[inline]
-    pub fn dir_jac(&self, face: u32, x: f64, y: f64) -> (DVec3, f64) {
+    pub fn line(&self, face: u32, x: f64) -> Line {
+        let phi = if self.format == DomeFormat::LatLong {
+            (PI - 2.0 * PI * x / self.w).sin_cos()
+        } else {
+            (0.0, 0.0)
+        };
+        Line { face, x, phi }
+    }
+
+    /// [`Geometry::dir_jac`] at height y on `line`.
+    #[inline]
+    pub fn dir_jac_on(&self, line: &Line, y: f64) -> (DVec3, f64) {
         match self.format {
             DomeFormat::LatLong => {
-                let phi = PI - 2.0 * PI * x / self.w;
                 let theta = PI * y / self.h;
                 let (st, ct) = theta.sin_cos();
-                let (sp, cp) = phi.sin_cos();
+                let (sp, cp) = line.phi;
                 (
                     DVec3::new(st * sp, ct, st * cp),
                     st * (2.0 * PI / self.w) * (PI / self.h),
                 )
             }
+            _ => self.dir_jac(line.face, line.x, y),
+        }
+    }
+
+    /// Dome direction and dome solid angle per unit sheet area at (x, y) (module docs).
+    #[inline]
+    pub fn dir_jac(&self, face: u32, x: f64, y: f64) -> (DVec3, f64) {
+        match self.format {
+            DomeFormat::LatLong => self.dir_jac_on(&self.line(face, x), y),
             DomeFormat::MirroredBall => {
                 let p = self.ab(x, y);
                 (ball_dir(p.x, p.y), 16.0 / (self.w * self.h))
@@ -330,8 +360,9 @@ pub fn tensor<const K: usize>(
     f: &mut impl FnMut(DVec3, DVec3, f64) -> [f64; K],
 ) -> [f64; K] {
     gl(n, p.ax.x0, p.ax.x1, |x| {
+        let line = g.line(p.face, x);
         gl(n, p.ay.x0, p.ay.x1, |y| {
-            let (d, j) = g.dir_jac(p.face, x, y);
+            let (d, j) = g.dir_jac_on(&line, y);
             f(d, texture_at(img, p, x, y), j)
         })
     })
