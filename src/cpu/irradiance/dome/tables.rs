@@ -79,6 +79,30 @@ fn side(mhats: &[DVec3], centre: DVec3, radius: f64, sin_radius: f64) -> Side {
     if lit { Side::Lit } else { Side::Crossed }
 }
 
+/// The clips whose circle may meet a crossed cap ([`side`]'s test, clip by clip): a clip
+/// positive over the whole cap has no root in the piece, no crossing on its edges and no
+/// vertex inside it, so [`exact`] gives the same value without it, and the five clips of a
+/// portal piece (four edges and the horizon) cost a crossed piece along one edge one clip's
+/// roots per line rather than five.
+fn meeting<'a>(
+    clips: &[Clip<'a>],
+    hats: &[DVec3],
+    centre: DVec3,
+    radius: f64,
+    sin_radius: f64,
+) -> Vec<Clip<'a>> {
+    if radius >= 0.5 * std::f64::consts::PI {
+        return clips.to_vec();
+    }
+    let r = sin_radius + 1e-12;
+    clips
+        .iter()
+        .zip(hats)
+        .filter(|(_, h)| !(h.dot(centre) > r))
+        .map(|(c, _)| *c)
+        .collect()
+}
+
 /// `tex ⊗ v`, channel-major: a moment's RGB × xyz entries.
 fn outer(tex: DVec3, v: DVec3) -> [f64; 9] {
     [
@@ -321,17 +345,27 @@ impl DomeIrradiance {
                 Side::Lit => e += dot(&tile.v),
                 Side::Dark => {}
                 Side::Crossed if t.single && tile.radius.is_finite() => {
-                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, &clips);
+                    let meet = meeting(&clips, &hats, tile.centre, tile.radius, tile.sin_radius);
+                    e += self.crossed(tile.grid, tile.ix.0, tile.iy.0, m, &meet);
                 }
                 Side::Crossed => {
                     for j in tile.iy.0..tile.iy.1 {
                         for i in tile.ix.0..tile.ix.1 {
                             let p = self.piece(tile.grid, i, j);
-                            match self.geom.cap(&p).map(|(c, r)| side(&hats, c, r, r.sin())) {
-                                _ if self.geom.domain(&p) == Domain::Outside => {}
+                            if self.geom.domain(&p) == Domain::Outside {
+                                continue;
+                            }
+                            let cap = self.geom.cap(&p).map(|(c, r)| (c, r, r.sin()));
+                            match cap.map(|(c, r, sr)| side(&hats, c, r, sr)) {
                                 Some(Side::Lit) => e += dot(&self.moment(tile.grid, i, j)),
                                 Some(Side::Dark) => {}
-                                _ => e += self.crossed(tile.grid, i, j, m, &clips),
+                                _ => {
+                                    let meet = match cap {
+                                        Some((c, r, sr)) => meeting(&clips, &hats, c, r, sr),
+                                        None => clips.clone(),
+                                    };
+                                    e += self.crossed(tile.grid, i, j, m, &meet);
+                                }
                             }
                         }
                     }
