@@ -106,6 +106,12 @@ pub fn irradiance_batch(
     per_light: bool,
     rule: &irradiance::Adaptive,
 ) -> Vec<DVec3> {
+    for l in lights.iter().filter(|l| l.portals.is_some()) {
+        // Before the parallel loop below (DomeIrradiance::warm).
+        if let Some(t) = irradiance::dome::tables(l) {
+            t.warm(true, false);
+        }
+    }
     let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
         .iter()
         .map(|l| {
@@ -143,6 +149,10 @@ fn dome_by_normal(
     keys.dedup();
     let by_rows =
         irradiance::Rule::texture_tolerance(rule).is_some() && keys.len() > DOME_ROWS_MIN_NORMALS;
+    if let Some(t) = irradiance::dome::tables(light) {
+        // Before the parallel loop below (DomeIrradiance::warm).
+        t.warm(false, by_rows);
+    }
     keys.into_par_iter()
         .map(|key| {
             let e = match unit(key.map(f32::from_bits)) {

@@ -214,6 +214,22 @@ impl DomeIrradiance {
         }
     }
 
+    /// Builds the lazily built tables that a batch's parallel loop will read, here, before that
+    /// loop: the tile tables for a masked dome (`masked`) or one the sweep does not take, and
+    /// the row rule's tables when the batch takes it (`by_rows`). Their builds run rayon jobs
+    /// inside a `OnceLock`; first reached from inside a rayon loop, the builder, while it waits
+    /// for a stolen job, may steal another iteration of that loop, which then waits on the same
+    /// `OnceLock` for ever (rayon-rs/rayon#592 and #1251: work stealing makes the
+    /// initialisation re-entrant). The latlong sweep's axis factors build without rayon.
+    pub fn warm(&self, masked: bool, by_rows: bool) {
+        if by_rows && !masked && self.sweeps() && self.row_tables().is_some() {
+            return;
+        }
+        if masked || !self.sweeps() {
+            self.tables();
+        }
+    }
+
     /// The fast path's `E(n)` (see [`sh`]): nine multiply-adds per channel once projected.
     pub fn irradiance_sh9(&self, n: DVec3) -> DVec3 {
         self.sh9

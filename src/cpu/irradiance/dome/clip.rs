@@ -258,7 +258,6 @@ fn substitute(a: f64, b: f64, u: f64, lo: bool, hi: bool) -> (f64, f64) {
 ///
 /// Sampling 16 points per edge for every clip was most of a masked latlong dome's crossed
 /// pieces' directions.
-#[allow(clippy::too_many_arguments)]
 fn edge_roots(g: &Geometry, face: u32, m: DVec3, ye: f64, x0: f64, x1: f64, out: &mut Vec<f64>) {
     match g.format {
         DomeFormat::LatLong => {

@@ -166,28 +166,30 @@ impl DomeIrradiance {
         self.axes.get_or_init(|| Axes::new(self))
     }
 
-    /// `E(n)` by the row rule (module docs "The row rule"); `None` where the sweep does not
-    /// apply or the tables would exceed [`ROWS_MAX_BYTES`].
-    pub fn irradiance_by_rows(&self, n: DVec3) -> Option<DVec3> {
-        if !self.sweeps() {
-            return None;
-        }
-        let (width, height) = (self.img.width, self.img.height);
-        let data = self
-            .row_tables
+    /// The row rule's f64 tables, built on first use; `None` over [`ROWS_MAX_BYTES`].
+    pub(super) fn row_tables(&self) -> Option<&[f64]> {
+        self.row_tables
             .get_or_init(|| {
-                let words = latlong_rows::words_len(width, height);
+                let words = latlong_rows::words_len(self.img.width, self.img.height);
                 (words.saturating_mul(8) <= ROWS_MAX_BYTES).then(|| {
                     let mut data = Vec::with_capacity(words);
                     latlong_rows::tables(&self.img, self.filter, |v| v, &mut data);
                     data
                 })
             })
-            .as_ref()?;
+            .as_deref()
+    }
+
+    /// `E(n)` by the row rule (module docs "The row rule"); `None` where the sweep does not
+    /// apply or the tables would exceed [`ROWS_MAX_BYTES`].
+    pub fn irradiance_by_rows(&self, n: DVec3) -> Option<DVec3> {
+        if !self.sweeps() {
+            return None;
+        }
         let rows = Rows {
-            data,
-            width,
-            height,
+            data: self.row_tables()?,
+            width: self.img.width,
+            height: self.img.height,
             bilinear: self.filter == Filter::Bilinear,
         };
         // Under a rotation times a uniform scale the dome-space integral is the world one, about
@@ -357,6 +359,36 @@ pub(crate) mod tests {
             }
         }
         out
+    }
+
+    /// `warm` builds what a batch's parallel loop would otherwise first build from inside it
+    /// (`DomeIrradiance::warm`): the row tables for a row-rule batch, the tile tables for a
+    /// masked dome or a format the sweep does not take, nothing for the sweep's own batches.
+    #[test]
+    fn warm_builds_what_the_batch_reads() {
+        let img = image(8, 4, 3, false);
+        let frame = || DomeFrame::new(DMat3::IDENTITY, DMat3::IDENTITY).unwrap();
+        let latlong = || {
+            DomeIrradiance::new(img.clone(), DomeFormat::LatLong, Filter::Bilinear, frame())
+                .unwrap()
+        };
+        let d = latlong();
+        d.warm(false, false);
+        assert!(d.row_tables.get().is_none() && d.tables.get().is_none());
+        d.warm(false, true);
+        assert!(d.row_tables.get().is_some_and(|t| t.is_some()) && d.tables.get().is_none());
+        let d = latlong();
+        d.warm(true, false);
+        assert!(d.tables.get().is_some() && d.row_tables.get().is_none());
+        let ball = DomeIrradiance::new(
+            img.clone(),
+            DomeFormat::MirroredBall,
+            Filter::Bilinear,
+            frame(),
+        )
+        .unwrap();
+        ball.warm(false, true);
+        assert!(ball.tables.get().is_some() && ball.row_tables.get().is_none());
     }
 
     /// The sweep against the tiles (the same moments and crossed pieces, summed another way:

@@ -61,27 +61,39 @@ enum Side {
     Crossed,
 }
 
-fn side(mhats: &[DVec3], centre: DVec3, radius: f64, sin_radius: f64) -> Side {
+/// Where a cap lies with respect to one half-space `m̂·d > 0` (Dark: outside it; a cap of
+/// radius ≥ 90° is taken as crossed).
+fn side_of(mhat: DVec3, centre: DVec3, radius: f64, sin_radius: f64) -> Side {
     if radius >= 0.5 * std::f64::consts::PI {
         return Side::Crossed;
     }
     let r = sin_radius + 1e-12;
+    let s = mhat.dot(centre);
+    if s < -r {
+        Side::Dark
+    } else if s > r {
+        Side::Lit
+    } else {
+        Side::Crossed
+    }
+}
+
+/// Where a cap lies with respect to the lit region, the intersection of the half-spaces.
+fn side(mhats: &[DVec3], centre: DVec3, radius: f64, sin_radius: f64) -> Side {
     let mut lit = true;
     for mhat in mhats {
-        let s = mhat.dot(centre);
-        if s < -r {
-            return Side::Dark;
-        }
-        if !(s > r) {
-            lit = false;
+        match side_of(*mhat, centre, radius, sin_radius) {
+            Side::Dark => return Side::Dark,
+            Side::Crossed => lit = false,
+            Side::Lit => {}
         }
     }
     if lit { Side::Lit } else { Side::Crossed }
 }
 
-/// The clips whose circle may meet a crossed cap ([`side`]'s test, clip by clip): a clip
-/// positive over the whole cap has no root in the piece, no crossing on its edges and no
-/// vertex inside it, so [`exact`] gives the same value without it, and the five clips of a
+/// The clips whose circle may meet a crossed cap (those [`side_of`] does not find wholly lit):
+/// a clip positive over the whole cap has no root in the piece, no crossing on its edges and
+/// no vertex inside it, so [`exact`] gives the same value without it, and the five clips of a
 /// portal piece (four edges and the horizon) cost a crossed piece along one edge one clip's
 /// roots per line rather than five.
 fn meeting<'a>(
@@ -91,14 +103,10 @@ fn meeting<'a>(
     radius: f64,
     sin_radius: f64,
 ) -> Vec<Clip<'a>> {
-    if radius >= 0.5 * std::f64::consts::PI {
-        return clips.to_vec();
-    }
-    let r = sin_radius + 1e-12;
     clips
         .iter()
         .zip(hats)
-        .filter(|(_, h)| !(h.dot(centre) > r))
+        .filter(|(_, h)| side_of(**h, centre, radius, sin_radius) != Side::Lit)
         .map(|(c, _)| *c)
         .collect()
 }
@@ -158,7 +166,7 @@ impl DomeIrradiance {
             _ => self.whole_piece(&p, dom, 0, &mut f),
         }
     }
-    fn tables(&self) -> &Tables {
+    pub(super) fn tables(&self) -> &Tables {
         self.tables.get_or_init(|| self.build())
     }
 
