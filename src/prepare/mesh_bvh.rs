@@ -131,7 +131,7 @@ impl MeshBvh {
             let split = (count > LEAF)
                 .then(|| split(&bvh.order[range.clone()], &boxes, &centroids))
                 .flatten();
-            let Some((axis, threshold)) = split else {
+            let Some(split) = split else {
                 bvh.order[range].sort_unstable();
                 bvh.nodes.push(Node {
                     bounds,
@@ -140,11 +140,15 @@ impl MeshBvh {
                 });
                 continue;
             };
-            // Partition: centroids below the threshold on the axis go left.
+            // Partition: the items of the bins left of the split go left. Both sides hold
+            // items, since the split was chosen between two non-empty groups of bins and the
+            // partition reads the same bins (not a threshold compared afresh, which rounding
+            // could put on either side of a bin's edge: all items on one side, the same node
+            // pushed again, for ever).
             let items = &mut bvh.order[range];
             let mut left = 0;
             for k in 0..items.len() {
-                if centroids[items[k] as usize][axis] < threshold {
+                if split.goes_left(centroids[items[k] as usize]) {
                     items.swap(k, left);
                     left += 1;
                 }
@@ -170,9 +174,28 @@ impl MeshBvh {
     }
 }
 
-/// The binned SAH split of `items` (axis, centroid threshold), or `None` where splitting does
-/// not beat a leaf or every centroid coincides.
-fn split(items: &[u32], boxes: &[Aabb], centroids: &[DVec3]) -> Option<(usize, f64)> {
+/// A split of a node's items: those whose centroid falls in a bin below `k` on `axis` (bins of
+/// `width / BINS` from `lo`) go left.
+struct Split {
+    axis: usize,
+    lo: f64,
+    width: f64,
+    k: usize,
+}
+
+impl Split {
+    fn bin(&self, c: f64) -> usize {
+        (((c - self.lo) / self.width * BINS as f64) as usize).min(BINS - 1)
+    }
+
+    fn goes_left(&self, centroid: DVec3) -> bool {
+        self.bin(centroid[self.axis]) < self.k
+    }
+}
+
+/// The binned SAH split of `items`, or `None` where splitting does not beat a leaf or every
+/// centroid coincides.
+fn split(items: &[u32], boxes: &[Aabb], centroids: &[DVec3]) -> Option<Split> {
     let cb = items
         .iter()
         .fold(Aabb::EMPTY, |b, &i| b.grow(centroids[i as usize]));
@@ -188,10 +211,15 @@ fn split(items: &[u32], boxes: &[Aabb], centroids: &[DVec3]) -> Option<(usize, f
     if !(width > 0.0) {
         return None;
     }
-    let bin_of = |c: f64| (((c - lo) / width * BINS as f64) as usize).min(BINS - 1);
+    let mut at = Split {
+        axis,
+        lo,
+        width,
+        k: 0,
+    };
     let mut bins = [(Aabb::EMPTY, 0usize); BINS];
     for &i in items {
-        let b = &mut bins[bin_of(centroids[i as usize][axis])];
+        let b = &mut bins[at.bin(centroids[i as usize][axis])];
         b.0 = b.0.union(boxes[i as usize]);
         b.1 += 1;
     }
@@ -216,8 +244,8 @@ fn split(items: &[u32], boxes: &[Aabb], centroids: &[DVec3]) -> Option<(usize, f
     }
     // A node larger than LEAF is always split (a leaf's cost grows with its size); the
     // heuristic only chooses where.
-    let (_, k) = best?;
-    Some((axis, lo + width * k as f64 / BINS as f64))
+    at.k = best?.1;
+    Some(at)
 }
 
 #[cfg(test)]
@@ -247,7 +275,13 @@ mod tests {
     #[test]
     fn leaves_partition_the_triangles_inside_their_boxes() {
         let tris = grid(23);
-        let bvh = MeshBvh::build(&tris);
+        check_leaves(&tris, &MeshBvh::build(&tris), false);
+    }
+
+    /// Every triangle in exactly one leaf, each inside every box on its path, leaves sorted and
+    /// of at most LEAF triangles (more only where `coincident` allows it and their centroids
+    /// coincide, which no split separates).
+    fn check_leaves(tris: &[MeshTriangle], bvh: &MeshBvh, coincident: bool) {
         let mut seen = vec![0; tris.len()];
         let mut stack = vec![(0usize, vec![])];
         while let Some((k, path)) = stack.pop() {
@@ -256,7 +290,13 @@ mod tests {
             path.push(node.bounds);
             if node.count > 0 {
                 let leaf = &bvh.order[node.first as usize..(node.first + node.count) as usize];
-                assert!(leaf.len() <= LEAF && leaf.windows(2).all(|w| w[0] < w[1]));
+                let centroid = |i: u32| {
+                    let b = Aabb::of_triangle(&tris[i as usize]);
+                    0.5 * (b.min + b.max)
+                };
+                let same = leaf.iter().all(|&i| centroid(i) == centroid(leaf[0]));
+                assert!(leaf.len() <= LEAF || (coincident && same));
+                assert!(leaf.windows(2).all(|w| w[0] < w[1]));
                 for &i in leaf {
                     seen[i as usize] += 1;
                     let b = Aabb::of_triangle(&tris[i as usize]);
@@ -270,6 +310,44 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&s| s == 1));
+    }
+
+    /// Centroids on and one ulp either side of the bins' edges `lo + width·j/16`, at scales
+    /// where those edges round: the partition reads the bins the split was chosen from, so
+    /// neither side is empty (a fuzzed mesh light's points once put every item on one side of
+    /// a threshold compared afresh: a debug assertion, and in release the same node pushed for
+    /// ever).
+    #[test]
+    fn centroids_on_the_bins_edges_split_into_two_sides() {
+        let mut rng = crate::synthetic::Rng::new(29);
+        for _ in 0..3000 {
+            let lo = rng.range(-1.0, 1.0) * 10f64.powi(rng.below(12) as i32 - 6);
+            let width = rng.range(0.1, 1.0) * 10f64.powi(rng.below(12) as i32 - 6);
+            let n = 5 + rng.below(24);
+            let tris: Vec<MeshTriangle> = (0..n)
+                .map(|i| {
+                    let edge = lo + width * rng.below(BINS + 1) as f64 / BINS as f64;
+                    let x = match rng.below(3) {
+                        0 => edge,
+                        1 => edge.next_up(),
+                        _ => edge.next_down(),
+                    };
+                    let x = if i == 0 {
+                        lo
+                    } else if i == 1 {
+                        lo + width
+                    } else {
+                        x
+                    };
+                    let p = DVec3::new(x, 0.0, 0.0);
+                    MeshTriangle {
+                        p: [p; 3],
+                        face: i as u32,
+                    }
+                })
+                .collect();
+            check_leaves(&tris, &MeshBvh::build(&tris), true);
+        }
     }
 
     #[test]
