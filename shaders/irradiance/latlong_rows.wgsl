@@ -14,8 +14,9 @@
 //    nothing: the integrand is C¹ there). The phases cos u_k, sin u_k are the tables' (f64,
 //    rounded once), as irradiance/pieces.wgsl and closed.wgsl use the builtins too.
 // 4. Every loop checks its condition after it ends and sets irr_cut when the device's loop
-//    budget cut it short (shared/record.wgsl): W + H + 4 intervals, at most MAX_SIDES + 4
-//    (prepare::latlong_rows::fits_device), each with IRR_GL_ROWS nodes.
+//    budget cut it short (shared/record.wgsl): W + H + 4 intervals, each with IRR_GL_ROWS
+//    nodes, inside lavapipe's budget up to W + H ≈ 5,900 (prepare::latlong_rows); a real GPU
+//    has no such budget.
 // 5. Everything here is the optional part TEXTURE (gpu::shaders::Features): an irradiance
 //    pipeline without a textured dome to integrate is built without it (lavapipe compiles
 //    code it never calls).

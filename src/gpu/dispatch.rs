@@ -155,7 +155,7 @@ impl GpuContext {
         // One atlas per scene, reduced to fit the binding limit (texture_atlas::scene_atlas) where
         // its textures allow; refused whole when it still does not fit.
         let tex_bytes = (tex_atlas.len() * 4) as u64;
-        if tex_bytes > self.limits.max_storage_buffer_binding_size {
+        if tex_bytes > self.atlas_limit() {
             let files: Vec<String> = tex_atlas
                 .entries
                 .iter()
@@ -171,10 +171,9 @@ impl GpuContext {
             return Err(LuxError::input(
                 "dome textures",
                 format!(
-                    "the scene's textures ({}) and latlong domes' irradiance tables ({} bytes, never halved) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes, and cannot be halved further (odd sizes); use smaller textures or --device cpu",
+                    "the scene's textures ({}) need {tex_bytes} bytes, over this device's storage binding limit of {} bytes, and cannot be halved further (odd sizes); use smaller textures or --device cpu",
                     files.join(", "),
-                    (tex_atlas.len() - tex_atlas.textures_len()) * 4,
-                    self.limits.max_storage_buffer_binding_size
+                    self.atlas_limit()
                 ),
             ));
         }

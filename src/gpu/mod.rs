@@ -556,6 +556,14 @@ impl GpuContext {
         (by_output.min(by_input).min(by_dispatch).max(1) as usize).min(cap)
     }
 
+    /// The most bytes the texture atlas (textures and latlong row tables, one storage binding)
+    /// may take on this device: its storage binding and buffer limits.
+    pub(crate) fn atlas_limit(&self) -> u64 {
+        self.limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size)
+    }
+
     /// Caps the rows of one chunk (tests: many chunks from a small batch).
     #[cfg(test)]
     pub(crate) fn cap_chunk_rows(&self, rows: usize) {

@@ -385,6 +385,77 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
     Ok((atlas, per_light, reduced))
 }
 
+/// Why a dome [`tables_beyond`] names takes its irradiance from the CPU reference.
+pub const TABLES_BEYOND: &str = "it is a textured latlong dome whose row tables do not fit this \
+     device's storage binding limit beside the scene's textures";
+
+/// The lights whose latlong row tables (`prepare::latlong_rows`: four times their texture's
+/// size, never halved) this device cannot hold: the scene's distinct textures, each at its
+/// smallest (halved as far as [`fit`] can halve it), and its distinct tables must fit
+/// `limit_bytes` together, and the largest tables are left out first until the rest do. Those
+/// domes take their irradiance from the CPU reference on this device ([`TABLES_BEYOND`];
+/// `query::PreparedScene` sets their `gpu_path` before [`scene_atlas`] packs the tables that
+/// fit). The limit is the device's, known once it is open, which is why this is not decided
+/// in `prepare` with the rest of `prepare::latlong_rows::gpu_path`.
+pub fn tables_beyond(lights: &[Prepared], limit_bytes: u64) -> Vec<usize> {
+    let mut textures: Vec<(*const Image, u32)> = Vec::new();
+    let mut texture_words = 0usize;
+    // (image, filter, words, the lights that read them)
+    let mut tables: Vec<(*const Image, Filter, usize, Vec<usize>)> = Vec::new();
+    for (k, p) in lights.iter().enumerate() {
+        let (image, code) = match (p.dome_texture(), p.rect_texture()) {
+            (Some(t), _) => (&t.image, t.format.code()),
+            (None, Some(t)) => (&t.image, FORMAT_RECT),
+            (None, None) => continue,
+        };
+        if !textures.contains(&(Arc::as_ptr(image), code)) {
+            textures.push((Arc::as_ptr(image), code));
+            let (mut w, mut h) = (image.width, image.height);
+            while reducible_size(w, h, code) {
+                (w, h) = (w / 2, h / 2);
+            }
+            // 3: the most alignment padding before it.
+            texture_words += 3 + HEADER_WORDS + 3 * w * h;
+        }
+        if let Some(t) = p.dome_texture().filter(|_| !p.irradiance_on_host()) {
+            let key = (Arc::as_ptr(&t.image), t.filter);
+            match tables.iter_mut().find(|e| (e.0, e.1) == key) {
+                Some(e) => e.3.push(k),
+                None => tables.push((
+                    key.0,
+                    key.1,
+                    3 + latlong_rows::words_len(t.image.width, t.image.height),
+                    vec![k],
+                )),
+            }
+        }
+    }
+    let words: Vec<usize> = tables.iter().map(|e| e.2).collect();
+    let mut beyond: Vec<usize> = left_out(texture_words, &words, limit_bytes)
+        .into_iter()
+        .flat_map(|i| tables[i].3.iter().copied())
+        .collect();
+    beyond.sort_unstable();
+    beyond
+}
+
+/// Which of the tables of `table_words` words to leave out, largest first, until the rest and
+/// `texture_words` fit `limit_bytes`.
+fn left_out(texture_words: usize, table_words: &[usize], limit_bytes: u64) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..table_words.len()).collect();
+    order.sort_by_key(|&i| std::cmp::Reverse(table_words[i]));
+    let mut total = texture_words + table_words.iter().sum::<usize>();
+    let mut out = Vec::new();
+    for i in order {
+        if (total as u64).saturating_mul(4) <= limit_bytes {
+            break;
+        }
+        total -= table_words[i];
+        out.push(i);
+    }
+    out
+}
+
 /// Halves the largest reducible texture of `distinct` until the packed atlas, with
 /// `extra_words` of row tables after it, needs at most `limit_bytes` (or none is reducible);
 /// returns what was reduced (see [`scene_atlas`]).
@@ -425,11 +496,13 @@ fn fit(distinct: &mut [(Arc<Image>, u32)], limit_bytes: u64, extra_words: usize)
 
 /// Whether [`halve`] keeps `img`'s format: even sizes, and an even face size for a cross.
 fn reducible(img: &Image, code: u32) -> bool {
-    let even = img.width.is_multiple_of(2)
-        && img.height.is_multiple_of(2)
-        && img.width >= 2
-        && img.height >= 2;
-    even && (code != FORMAT_CROSS || (img.width / 3).is_multiple_of(2))
+    reducible_size(img.width, img.height, code)
+}
+
+/// [`reducible`] of a `width × height` texture.
+fn reducible_size(width: usize, height: usize, code: u32) -> bool {
+    let even = width.is_multiple_of(2) && height.is_multiple_of(2) && width >= 2 && height >= 2;
+    even && (code != FORMAT_CROSS || (width / 3).is_multiple_of(2))
 }
 
 /// `img` at half the resolution: each texel the mean of the 2 × 2 texels it covers.
@@ -504,6 +577,21 @@ mod tests {
         let sizes: Vec<(usize, usize)> = d.iter().map(|(i, _)| (i.width, i.height)).collect();
         assert_eq!(sizes, [(2, 1), (3, 4), (3, 3)]);
         assert_eq!(r.len(), 2, "{r:?}");
+    }
+
+    /// Tables are left out largest first, only until the rest fit beside the textures; none
+    /// when all fit; all when the textures alone do not.
+    #[test]
+    fn the_largest_tables_are_left_out_until_the_rest_fit() {
+        let tables = [300, 1000, 200, 1000];
+        assert!(left_out(100, &tables, 4 * 2600).is_empty());
+        assert_eq!(left_out(100, &tables, 4 * 2599), vec![1]);
+        assert_eq!(left_out(100, &tables, 4 * 1600), vec![1]);
+        assert_eq!(left_out(100, &tables, 4 * 1599), vec![1, 3]);
+        assert_eq!(left_out(100, &tables, 4 * 300), vec![1, 3, 0]);
+        assert_eq!(left_out(100, &tables, 4 * 100), vec![1, 3, 0, 2]);
+        assert_eq!(left_out(100, &tables, 4 * 99), vec![1, 3, 0, 2]);
+        assert!(left_out(100, &[], 0).is_empty());
     }
 
     /// Row tables after the textures count toward the limit (the textures are halved to make

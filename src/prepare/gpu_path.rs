@@ -18,7 +18,8 @@ pub enum GpuPath {
     ///   device, its lines split at the profile's grid cones and planes).
     /// - Textured domes the kernel does not integrate by rows (`prepare::latlong_rows::gpu_path`:
     ///   mirroredBall, angular and cross maps, frames that are not a rotation times a uniform
-    ///   scale, maps over 2048 × 1024 texels): the exact integral of the filtered texture
+    ///   scale; on a given device, latlong maps whose row tables do not fit its storage binding
+    ///   beside the scene's textures, `gpu::texture_atlas::tables_beyond`): the exact integral of the filtered texture
     ///   (DESIGN.md §6 "what 'exact' means", src/cpu/irradiance/dome.rs) splits at texel-centre
     ///   lines and the horizon; a dome's irradiance depends on the normal only, so the reference
     ///   evaluates it once per distinct normal (one for a whole falloff map).

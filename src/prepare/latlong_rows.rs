@@ -19,9 +19,16 @@
 //!   then the row's value at piece `k`'s start (texel `k`; entry `W` repeats texel 0, the end of
 //!   the last bilinear piece under the columns' wrap).
 //!
-//! The device holds the tables only for textures of at most [`MAX_TEXELS`] texels and
-//! `W + H ≤` [`MAX_SIDES`] (`prepare::gpu_path`'s choice): the tables take four times the
-//! texture's memory, and the kernel's loop runs `W + H + 4` intervals (lavapipe's budget).
+//! The tables take four times the texture's memory (101 MB for 2048 × 1024, 403 MB for
+//! 4096 × 2048). The device holds them when they fit its storage binding limit beside the
+//! scene's textures, halved as far as they go; the domes whose tables do not fit take their
+//! irradiance from the CPU reference on that device (`gpu::texture_atlas::tables_beyond`, which
+//! `query::PreparedScene` applies: a device's limit is known only once it is open). The kernel's
+//! walk runs `W + H + 4` intervals of `rules::IRR_GL_ROWS` nodes: about `11(W + H)` loop
+//! iterations as lavapipe counts them, inside its 65,535 up to `W + H` ≈ 5,900 (measured:
+//! tests/dome_conformance.rs); a longer walk on lavapipe (a 4096 × 2048 map's 6,144) is cut
+//! short, detected and recomputed by the reference (`irr_cut` in
+//! shaders/shared/record.wgsl). A real GPU never cuts.
 
 use std::f64::consts::PI;
 
@@ -34,31 +41,17 @@ use super::texture::{DomeFormat, Filter, Image, PreparedTexture};
 pub const HEADER_WORDS: usize = 4;
 /// Words per row entry: prefix ∫R, ∫R sin u, ∫R cos u (RGB each), then the value.
 pub const ENTRY_WORDS: usize = 12;
-/// The most texels whose tables the device holds: a 2048 × 1024 map's tables take 101 MB
-/// (with its texels, 126 MB: under the 128 MiB storage binding every wgpu device offers).
-pub const MAX_TEXELS: usize = 2048 * 1024;
-/// The most `W + H` the kernel walks: its loop runs `W + H + 4` intervals of
-/// `rules::IRR_GL_ROWS` nodes each, well inside lavapipe's 65,535 loop iterations.
-pub const MAX_SIDES: usize = 4096;
-
-/// Whether the device can hold and walk the tables of a `width × height` texture.
-pub fn fits_device(width: usize, height: usize) -> bool {
-    width >= 1 && height >= 1 && width * height <= MAX_TEXELS && width + height <= MAX_SIDES
-}
 
 /// Where a textured dome's irradiance is integrated: on the device by rows for a latlong
 /// texture under a conformal frame (rotation × uniform scale, where the dome-space integral is
-/// the world one) whose tables fit; by the CPU reference otherwise, with the reason.
+/// the world one), where its tables fit the device (`gpu::texture_atlas::tables_beyond`); by
+/// the CPU reference otherwise, with the reason.
 pub fn gpu_path(t: &PreparedTexture) -> GpuPath {
     if t.format != DomeFormat::LatLong {
         GpuPath::HostIrradiance("it is a textured dome in a format other than latlong")
     } else if t.frame.conformal_weight().is_none() {
         GpuPath::HostIrradiance(
             "it is a textured dome whose transform is not a rotation times a uniform scale",
-        )
-    } else if !fits_device(t.image.width, t.image.height) {
-        GpuPath::HostIrradiance(
-            "it is a textured dome over 2048 × 1024 texels, whose row tables the device does not hold",
         )
     } else {
         GpuPath::Device
@@ -184,18 +177,9 @@ pub fn piece_moments(v0: f64, v1: f64, len: f64, tau: f64, cos_k: f64, sin_k: f6
 mod tests {
     use super::*;
 
-    /// The device's limits: 2048 × 1024 (luxtest's dome) fits, one more row or column does not,
-    /// nor a strip whose walk would be too long; the packed length is `words_len`, and the
-    /// last entry of a row holds its total.
+    /// The packed length is `words_len`, and the last entry of a row holds its total.
     #[test]
-    fn tables_fit_the_device_up_to_2048_by_1024() {
-        assert!(fits_device(2048, 1024));
-        assert!(fits_device(1, 1));
-        assert!(!fits_device(2048, 1025));
-        assert!(!fits_device(2049, 1024));
-        assert!(!fits_device(4096, 1));
-        assert!(fits_device(4095, 1));
-        assert!(!fits_device(0, 4));
+    fn tables_hold_each_rows_total() {
         let img = Image {
             width: 3,
             height: 2,

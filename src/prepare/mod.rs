@@ -104,7 +104,9 @@ pub struct Prepared {
     /// What only this kind of light carries.
     pub kind: KindData,
     /// Which of this light's queries the GPU path takes from the device and which from the CPU
-    /// reference, decided once here (see [`GpuPath`]).
+    /// reference, decided once here (see [`GpuPath`]); a GPU scene only moves the irradiance
+    /// of the latlong domes whose row tables its device has no room for to the reference
+    /// (`gpu::texture_atlas::tables_beyond`).
     pub gpu_path: GpuPath,
     /// The files on disk its assets were read from (IES profile, TILT file, texture, or the
     /// package holding them), so that no output is written over one of them.

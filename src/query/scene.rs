@@ -11,7 +11,7 @@ use crate::error::{LuxError, Result};
 use crate::gpu::record::LIGHTS_ALL;
 use crate::gpu::{GpuLights, Input, Kernel, Scratch, ies_atlas, mesh_atlas, record, texture_atlas};
 use crate::model::Light;
-use crate::prepare::{self, PortalMode, Prepared, TemperatureMode};
+use crate::prepare::{self, GpuPath, PortalMode, Prepared, TemperatureMode};
 
 mod irradiance;
 
@@ -80,14 +80,19 @@ impl PreparedScene {
 
     /// A scene of lights already prepared (the GPU records are packed from exactly these
     /// constants).
-    pub(crate) fn from_prepared(backend: Backend, lights: Vec<Prepared>) -> Result<Self> {
+    pub(crate) fn from_prepared(backend: Backend, mut lights: Vec<Prepared>) -> Result<Self> {
         let mut device_warnings = Vec::new();
         let gpu = match &backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => {
                 let (atlas, bases) = ies_atlas::scene_atlas(&lights)
                     .map_err(|e| LuxError::input("IES profiles", e.to_string()))?;
-                let limit = g.device_limits().max_storage_buffer_binding_size;
+                let limit = g.atlas_limit();
+                // Latlong domes whose row tables this device cannot hold beside the textures:
+                // their irradiance is the CPU reference's here (every query reads gpu_path).
+                for k in texture_atlas::tables_beyond(&lights, limit) {
+                    lights[k].gpu_path = GpuPath::HostIrradiance(texture_atlas::TABLES_BEYOND);
+                }
                 let (tex_atlas, offsets, reduced) = texture_atlas::scene_atlas(&lights, limit)
                     .map_err(|e| LuxError::input("textures", e.to_string()))?;
                 for r in reduced {
