@@ -35,9 +35,40 @@ pub(crate) struct GpuLights {
     irradiance_ies: bool,
     /// Whether some textured dome's irradiance is the device's (irradiance/latlong_rows.wgsl).
     irradiance_texture: bool,
+    /// The row tables reserved in the texture atlas and not yet written
+    /// ([`GpuLights::write_row_tables`]).
+    pending_rows: std::sync::Mutex<Vec<super::texture_atlas::RowTables>>,
 }
 
 impl GpuLights {
+    /// Builds and writes the latlong row tables the texture atlas reserves, on the first call
+    /// of the irradiance kernel (the only one that reads them, `texture_atlas::RowTables`): one
+    /// table at a time, each dropped once the queue holds its copy, ordered before every
+    /// submission that follows (wgpu's `Queue::write_buffer`), the caller's own encoder's
+    /// included.
+    pub(super) fn write_row_tables(&self, queue: &wgpu::Queue) {
+        let mut pending = self
+            .pending_rows
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        for t in pending.drain(..) {
+            queue.write_buffer(
+                &self.tex_atlas,
+                u64::from(t.offset) * 4,
+                bytemuck::cast_slice(&t.words()),
+            );
+        }
+    }
+
+    /// How many row tables wait for [`GpuLights::write_row_tables`].
+    #[cfg(test)]
+    pub(crate) fn rows_pending(&self) -> usize {
+        self.pending_rows
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .len()
+    }
+
     /// Whether some light's irradiance quadrature may run long on the device (an IES-shaped
     /// light it integrates, whose kinks multiply a line's pieces: GpuContext::lane_stride).
     pub(super) fn long_quadrature(&self) -> bool {
@@ -237,6 +268,7 @@ impl GpuContext {
                 r.flags & super::record::FLAG_DOME_TEXTURE != 0
                     && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
             }),
+            pending_rows: std::sync::Mutex::new(tex_atlas.rows.clone()),
         }))
     }
 
@@ -264,6 +296,9 @@ impl GpuContext {
             return Ok(out);
         }
         let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
+        if kernel == Kernel::Irradiance {
+            lights.write_row_tables(&self.queue);
+        }
         let capacity = self.chunk_capacity(count, per_light);
         let key = ScratchKey {
             chunk: n.next_power_of_two().min(capacity),

@@ -361,6 +361,9 @@ impl GpuContext {
         rows: super::RowShape,
     ) -> Result<()> {
         let pipeline = self.pipeline_with_rows(kernel, lights.variant(kernel), rows)?;
+        if kernel == Kernel::Irradiance {
+            lights.write_row_tables(&self.queue);
+        }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let params = self
             .device

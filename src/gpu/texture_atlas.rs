@@ -5,9 +5,10 @@
 //! Layout: textures one after another; a texture at offset `o` (f32 units, a multiple of 4) is
 //! `[width, height, format, 0]` as u32 bit patterns ([`HEADER_WORDS`] words), then
 //! `width × height` RGB f32 triplets, row-major, row 0 at the top: texel (i, j) at
-//! `o + 4 + 3(j·width + i)`. After every texture, the row tables of each textured latlong dome
-//! whose irradiance the device integrates (`prepare::latlong_rows`, read by
-//! `shaders/irradiance/latlong_rows.wgsl`; the sampling kernels' copy of the atlas stops before
+//! `o + 4 + 3(j·width + i)`. After every texture, room for the row tables of each textured latlong
+//! dome whose irradiance the device integrates (`prepare::latlong_rows`, read by
+//! `shaders/irradiance/latlong_rows.wgsl`), built and written only by the scene's first
+//! irradiance call ([`RowTables`]; the sampling kernels' copy of the atlas stops before
 //! them, [`Atlas::textures_len`]). A light record stores its texture's offset as a u32 (exact, unlike
 //! the IES atlas's f32 bases), so the atlas holds at most 2³² − 1 floats; the device's storage
 //! binding limit is usually far lower and is checked at upload
@@ -57,8 +58,8 @@ pub struct AtlasEntry {
 pub struct Atlas {
     pub entries: Vec<AtlasEntry>,
     /// Row tables of textured latlong domes whose irradiance the device integrates
-    /// (`prepare::latlong_rows`), after every texture: (offset, words).
-    pub rows: Vec<(u32, Arc<Vec<f32>>)>,
+    /// (`prepare::latlong_rows`), after every texture: reserved, not built.
+    pub rows: Vec<RowTables>,
     len: usize,
     /// Where the textures end (the sampling kernels copy only them, `gpu::sample`).
     textures_len: usize,
@@ -92,19 +93,23 @@ impl Atlas {
         Ok(offset as u32)
     }
 
-    /// Appends a latlong dome's row tables (after every texture: push them last) and returns
-    /// their offset (a record's `tex.z`).
-    pub fn push_rows(&mut self, words: Arc<Vec<f32>>, source: &Image) -> Result<u32, AtlasFull> {
+    /// Reserves room for the row tables of `image` read through `filter` (after every
+    /// texture: push them last) and returns their offset (a record's `tex.z`).
+    pub fn push_rows(&mut self, image: Arc<Image>, filter: Filter) -> Result<u32, AtlasFull> {
         let offset = self.len.next_multiple_of(4);
-        let end = offset + words.len();
+        let end = offset + latlong_rows::words_len(image.width, image.height);
         if end > u32::MAX as usize {
             return Err(AtlasFull {
-                path: source.source.display().to_string(),
-                width: source.width,
-                height: source.height,
+                path: image.source.display().to_string(),
+                width: image.width,
+                height: image.height,
             });
         }
-        self.rows.push((offset as u32, words));
+        self.rows.push(RowTables {
+            offset: offset as u32,
+            image,
+            filter,
+        });
         self.len = end;
         Ok(offset as u32)
     }
@@ -119,27 +124,28 @@ impl Atlas {
         self.textures_len
     }
 
-    /// What to upload where: (offset in f32 units, data), headers and texels, in order. Gaps
-    /// (alignment padding) are never read.
+    /// What to upload where: (offset in f32 units, data), headers and texels, in order (the
+    /// row tables are written later, [`RowTables`]). Gaps (alignment padding) are never read.
     pub fn chunks(&self) -> impl Iterator<Item = (usize, &[f32])> {
-        self.entries
-            .iter()
-            .flat_map(|e| {
-                let o = e.offset as usize;
-                [
-                    (o, &e.header[..]),
-                    (o + HEADER_WORDS, e.image.rgb.as_flattened()),
-                ]
-            })
-            .chain(self.rows.iter().map(|(o, w)| (*o as usize, &w[..])))
+        self.entries.iter().flat_map(|e| {
+            let o = e.offset as usize;
+            [
+                (o, &e.header[..]),
+                (o + HEADER_WORDS, e.image.rgb.as_flattened()),
+            ]
+        })
     }
 
-    /// Writes the whole buffer into `dst` (at least [`Self::len`] floats); padding words are
-    /// left as they are.
+    /// Writes the whole buffer into `dst` (at least [`Self::len`] floats), the row tables
+    /// built; padding words are left as they are.
     #[cfg(test)]
     pub fn write_into(&self, dst: &mut [f32]) {
         for (o, data) in self.chunks() {
             dst[o..o + data.len()].copy_from_slice(data);
+        }
+        for t in &self.rows {
+            let (o, words) = (t.offset as usize, t.words());
+            dst[o..o + words.len()].copy_from_slice(&words);
         }
     }
 
@@ -149,6 +155,26 @@ impl Atlas {
         let mut v = vec![0.0; self.len];
         self.write_into(&mut v);
         v
+    }
+}
+
+/// A latlong dome's row tables as the atlas reserves them: where they go and what they are
+/// built from. They take four times the texture's memory (403 MB for 4096 × 2048) and only the
+/// irradiance kernel reads them, so they are built and written by the scene's first irradiance
+/// call (`GpuLights::write_row_tables`), never for a scene asked only for emission, radiance,
+/// intensity or samples.
+#[derive(Debug, Clone)]
+pub struct RowTables {
+    /// Offset in f32 units.
+    pub offset: u32,
+    pub image: Arc<Image>,
+    pub filter: Filter,
+}
+
+impl RowTables {
+    /// The tables as the device reads them (`prepare::latlong_rows::device_words`).
+    pub fn words(&self) -> Vec<f32> {
+        latlong_rows::device_words(&self.image, self.filter)
     }
 }
 
@@ -321,19 +347,18 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
     // The distinct (image, format) pairs, and each light's index into them.
     let mut distinct: Vec<(Arc<Image>, u32)> = Vec::new();
     let mut which = Vec::with_capacity(lights.len());
-    // The distinct (image, filter) pairs of the domes whose irradiance the device integrates,
-    // with their row tables (prepare::latlong_rows), and each light's index into them.
-    let mut row_tables: Vec<(Arc<Image>, Filter, Arc<Vec<f32>>)> = Vec::new();
+    // The distinct (image, filter) pairs of the domes whose irradiance the device integrates
+    // (their row tables, prepare::latlong_rows), and each light's index into them.
+    let mut row_tables: Vec<(Arc<Image>, Filter)> = Vec::new();
     let mut which_rows = Vec::with_capacity(lights.len());
     for p in lights {
         which_rows.push(match p.dome_texture() {
             Some(t) if !p.irradiance_on_host() => {
                 let found = row_tables
                     .iter()
-                    .position(|(img, f, _)| Arc::ptr_eq(img, &t.image) && *f == t.filter);
+                    .position(|(img, f)| Arc::ptr_eq(img, &t.image) && *f == t.filter);
                 Some(found.unwrap_or_else(|| {
-                    let words = latlong_rows::device_words(&t.image, t.filter);
-                    row_tables.push((Arc::clone(&t.image), t.filter, Arc::new(words)));
+                    row_tables.push((Arc::clone(&t.image), t.filter));
                     row_tables.len() - 1
                 }))
             }
@@ -361,7 +386,10 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
         which.push(Some(k));
     }
     // The row tables are exact and never reduced; the textures make room for them.
-    let rows_words: usize = row_tables.iter().map(|(_, _, w)| w.len() + 3).sum();
+    let rows_words: usize = row_tables
+        .iter()
+        .map(|(img, _)| latlong_rows::words_len(img.width, img.height) + 3)
+        .sum();
     let reduced = fit(&mut distinct, limit_bytes, rows_words);
     let mut atlas = Atlas::new();
     let offsets: Vec<u32> = distinct
@@ -370,7 +398,7 @@ pub fn scene_atlas(lights: &[Prepared], limit_bytes: u64) -> Result<SceneAtlas, 
         .collect::<Result<_, _>>()?;
     let rows_offsets: Vec<u32> = row_tables
         .iter()
-        .map(|(img, _, words)| atlas.push_rows(Arc::clone(words), img))
+        .map(|(img, filter)| atlas.push_rows(Arc::clone(img), *filter))
         .collect::<Result<_, _>>()?;
     let per_light = which
         .into_iter()

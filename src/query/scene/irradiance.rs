@@ -230,6 +230,7 @@ impl PreparedScene {
 #[cfg(test)]
 mod tests {
     use crate::model::{Light, Texture, TextureFormat};
+    use crate::query::Accumulate;
 
     /// A 4 × 2 latlong dome texture (PNG bytes).
     fn textured_dome() -> Light {
@@ -277,5 +278,44 @@ mod tests {
         let cpu = crate::query::Evaluator::cpu();
         let scene = cpu.prepare(&[sphere, textured_dome()]).unwrap();
         assert!(scene.irradiance_plan(&repeated).is_none());
+    }
+
+    /// A textured latlong dome's row tables (four times its texture) are built and written by
+    /// the scene's first irradiance call, not when it is prepared nor by emission or radiance,
+    /// which do not read them; that call's values are the kernel's, within 1e-4 of the
+    /// reference.
+    #[test]
+    fn row_tables_wait_for_the_first_irradiance_call() {
+        let Some(eval) = crate::query::test_gpu() else {
+            return;
+        };
+        let scene = eval.prepare(&[textured_dome()]).unwrap();
+        let pending = || scene.gpu.as_ref().expect("a GPU scene").rows_pending();
+        assert_eq!(pending(), 1);
+        let dirs = [[0.0f32, 1.0, 0.0], [0.6, 0.0, -0.8]];
+        scene.emission(&dirs, Accumulate::Sum).unwrap();
+        scene
+            .radiance(&[[0.0; 3]; 2], &dirs, Accumulate::Sum)
+            .unwrap();
+        assert_eq!(pending(), 1);
+        let normals = [[0.0f32, 1.0, 0.0], [0.6, 0.0, -0.8], [0.0, -0.6, 0.8]];
+        let points = [[0.0f32; 3]; 3];
+        let got = scene
+            .irradiance(&points, &normals, Accumulate::Sum)
+            .unwrap();
+        assert_eq!(pending(), 0);
+        let want = crate::query::Evaluator::cpu()
+            .prepare(&[textured_dome()])
+            .unwrap()
+            .irradiance(&points, &normals, Accumulate::Sum)
+            .unwrap();
+        assert!(got != want, "the reference's rows");
+        for (g, w) in got.iter().zip(&want) {
+            let scale = w[0].max(w[1]).max(w[2]);
+            assert!(
+                (0..3).all(|c| (g[c] - w[c]).abs() <= 1e-4 * scale),
+                "{g:?} {w:?}"
+            );
+        }
     }
 }
