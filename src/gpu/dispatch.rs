@@ -40,24 +40,46 @@ pub(crate) struct GpuLights {
     pending_rows: std::sync::Mutex<Vec<super::texture_atlas::RowTables>>,
 }
 
+/// The most words of a latlong dome's row tables built and copied to the device at once
+/// ([`GpuLights::write_row_tables`]): 32 MiB.
+const ROW_TABLE_PIECE_WORDS: usize = 8 << 20;
+
 impl GpuLights {
     /// Builds and writes the latlong row tables the texture atlas reserves, on the first call
-    /// of the irradiance kernel (the only one that reads them, `texture_atlas::RowTables`): one
-    /// table at a time, each dropped once the queue holds its copy, ordered before every
-    /// submission that follows (wgpu's `Queue::write_buffer`), the caller's own encoder's
-    /// included.
-    pub(super) fn write_row_tables(&self, queue: &wgpu::Queue) {
+    /// of the irradiance kernel (the only one that reads them, `texture_atlas::RowTables`), in
+    /// pieces of at most [`ROW_TABLE_PIECE_WORDS`]: each piece is copied to the device and its
+    /// staging memory released (an empty submit, then a wait) before the next is built, so the
+    /// host holds one piece at a time, not the tables (1.6 GB for 8192 × 4096). The copies
+    /// precede every later submission, the caller's own encoder's included.
+    pub(super) fn write_row_tables(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<()> {
         let mut pending = self
             .pending_rows
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
         for t in pending.drain(..) {
-            queue.write_buffer(
-                &self.tex_atlas,
-                u64::from(t.offset) * 4,
-                bytemuck::cast_slice(&t.words()),
+            let pieces = crate::prepare::latlong_rows::device_chunks(
+                &t.image,
+                t.filter,
+                ROW_TABLE_PIECE_WORDS,
             );
+            for (o, words) in pieces {
+                queue.write_buffer(
+                    &self.tex_atlas,
+                    (u64::from(t.offset) + o as u64) * 4,
+                    bytemuck::cast_slice(&words),
+                );
+                drop(words);
+                queue.submit(std::iter::empty());
+                device
+                    .poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| LuxError::gpu("writing a latlong dome's row tables", e))?;
+            }
         }
+        Ok(())
     }
 
     /// How many row tables wait for [`GpuLights::write_row_tables`].
@@ -297,7 +319,7 @@ impl GpuContext {
         }
         let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
         if kernel == Kernel::Irradiance {
-            lights.write_row_tables(&self.queue);
+            lights.write_row_tables(&self.device, &self.queue)?;
         }
         let capacity = self.chunk_capacity(count, per_light);
         let key = ScratchKey {

@@ -362,7 +362,7 @@ impl GpuContext {
     ) -> Result<()> {
         let pipeline = self.pipeline_with_rows(kernel, lights.variant(kernel), rows)?;
         if kernel == Kernel::Irradiance {
-            lights.write_row_tables(&self.queue);
+            lights.write_row_tables(&self.device, &self.queue)?;
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let params = self

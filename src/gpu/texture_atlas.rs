@@ -172,7 +172,9 @@ pub struct RowTables {
 }
 
 impl RowTables {
-    /// The tables as the device reads them (`prepare::latlong_rows::device_words`).
+    /// The tables as the device reads them (`prepare::latlong_rows::device_words`; the device's
+    /// copy is written in pieces, `GpuLights::write_row_tables`).
+    #[cfg(test)]
     pub fn words(&self) -> Vec<f32> {
         latlong_rows::device_words(&self.image, self.filter)
     }

@@ -63,14 +63,44 @@ pub fn words_len(width: usize, height: usize) -> usize {
     HEADER_WORDS + 2 * width + ENTRY_WORDS * height * (width + 1)
 }
 
-/// The tables as the device reads them: the header, then [`tables`] in f32.
+/// The tables as the device reads them: the header, then [`tables`] in f32 (tests: the device's
+/// copy is written in pieces, [`device_chunks`]).
+#[cfg(test)]
 pub fn device_words(img: &Image, filter: Filter) -> Vec<f32> {
     let mut out = Vec::with_capacity(words_len(img.width, img.height));
-    let header = [img.width as u32, img.height as u32, filter.code(), 0];
-    out.extend(header.map(f32::from_bits));
-    tables(img, filter, |v| v as f32, &mut out);
+    for (_, words) in device_chunks(img, filter, usize::MAX) {
+        out.extend(words);
+    }
     debug_assert_eq!(out.len(), words_len(img.width, img.height));
     out
+}
+
+/// The tables as the device reads them (the header, then [`tables`] in f32) in pieces of at
+/// most `max_words` words where a row's entries allow (one row at least): (offset in the
+/// tables, words), the header and column phases first, then the rows in order. The device's
+/// copy is written a piece at a time, so that the host never holds the whole tables (1.6 GB
+/// for 8192 × 4096).
+pub fn device_chunks(
+    img: &Image,
+    filter: Filter,
+    max_words: usize,
+) -> impl Iterator<Item = (usize, Vec<f32>)> + '_ {
+    let (w, h) = (img.width, img.height);
+    let row_words = ENTRY_WORDS * (w + 1);
+    let rows_per_chunk = (max_words / row_words).clamp(1, h.max(1));
+    let head = {
+        let header = [w as u32, h as u32, filter.code(), 0];
+        let mut out: Vec<f32> = header.map(f32::from_bits).to_vec();
+        phases_into(w, filter, |v| v as f32, &mut out);
+        out
+    };
+    let first = head.len();
+    std::iter::once((0, head)).chain((0..h).step_by(rows_per_chunk).map(move |j0| {
+        let j1 = (j0 + rows_per_chunk).min(h);
+        let mut out = Vec::new();
+        rows_into(img, filter, |v| v as f32, j0..j1, &mut out);
+        (first + j0 * row_words, out)
+    }))
 }
 
 /// The row tables of `img` under `filter` after the header (the column phases, then the rows,
@@ -82,28 +112,52 @@ pub fn tables<T: Copy + Default + Send + Sync>(
     conv: impl Fn(f64) -> T + Sync,
     out: &mut Vec<T>,
 ) {
-    let (w, h) = (img.width, img.height);
-    let bilinear = filter == Filter::Bilinear;
-    let step = 2.0 * PI / w as f64;
-    let start = if bilinear { 0.5 * step } else { 0.0 };
-    let phases: Vec<(f64, f64)> = (0..w)
-        .map(|k| {
-            let (s, c) = (start + k as f64 * step).sin_cos();
-            (c, s)
-        })
-        .collect();
-    for &(c, s) in &phases {
+    phases_into(img.width, filter, &conv, out);
+    rows_into(img, filter, &conv, 0..img.height, out);
+}
+
+/// Piece `k`'s start `u_k` of a `width`-column texture under `filter`, as `(cos u_k, sin u_k)`.
+fn phases(width: usize, filter: Filter) -> impl Iterator<Item = (f64, f64)> {
+    let step = 2.0 * PI / width as f64;
+    let start = if filter == Filter::Bilinear {
+        0.5 * step
+    } else {
+        0.0
+    };
+    (0..width).map(move |k| {
+        let (s, c) = (start + k as f64 * step).sin_cos();
+        (c, s)
+    })
+}
+
+/// The column phases ([`phases`]), converted by `conv`, appended to `out`.
+fn phases_into<T>(width: usize, filter: Filter, conv: impl Fn(f64) -> T, out: &mut Vec<T>) {
+    for (c, s) in phases(width, filter) {
         out.push(conv(c));
         out.push(conv(s));
     }
+}
+
+/// The entries of rows `rows` (built in parallel), converted by `conv`, appended to `out`.
+fn rows_into<T: Copy + Default + Send + Sync>(
+    img: &Image,
+    filter: Filter,
+    conv: impl Fn(f64) -> T + Sync,
+    rows: std::ops::Range<usize>,
+    out: &mut Vec<T>,
+) {
+    let w = img.width;
+    let bilinear = filter == Filter::Bilinear;
+    let step = 2.0 * PI / w as f64;
+    let phases: Vec<(f64, f64)> = phases(w, filter).collect();
     // Every whole piece has τ = h: its J₀, J₁ once.
     let whole = PhaseIntegrals::new(step);
     let row_words = ENTRY_WORDS * (w + 1);
     let first = out.len();
-    out.resize(first + h * row_words, T::default());
+    out.resize(first + rows.len() * row_words, T::default());
     out[first..]
         .par_chunks_mut(row_words)
-        .zip(img.rgb.par_chunks(w))
+        .zip(img.rgb[rows.start * w..rows.end * w].par_chunks(w))
         .for_each(|(dst, row)| {
             let mut acc = [[0.0f64; 3]; 3];
             for (k, entry) in dst.chunks_exact_mut(ENTRY_WORDS).enumerate() {
@@ -176,6 +230,41 @@ pub fn piece_moments(v0: f64, v1: f64, len: f64, tau: f64, cos_k: f64, sin_k: f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The device's pieces, laid at their offsets, are the header and the tables built whole,
+    /// whatever the piece size (one row at least: a size under a row's entries gives one row
+    /// a piece).
+    #[test]
+    fn device_pieces_are_the_whole_tables() {
+        let img = Image {
+            width: 5,
+            height: 7,
+            rgb: (0..35)
+                .map(|k| [k as f32, 1.0 / (1.0 + k as f32), 2.0])
+                .collect(),
+            envmap: None,
+            source: "ramp.exr".into(),
+        };
+        for filter in [Filter::Bilinear, Filter::Nearest] {
+            let mut whole: Vec<f32> = [5u32, 7, filter.code(), 0].map(f32::from_bits).to_vec();
+            tables(&img, filter, |v| v as f32, &mut whole);
+            assert_eq!(whole.len(), words_len(5, 7));
+            let row = ENTRY_WORDS * 6;
+            for max in [1, row, 3 * row + 5, usize::MAX] {
+                let mut laid = vec![f32::NAN; whole.len()];
+                let mut pieces = 0;
+                for (o, words) in device_chunks(&img, filter, max) {
+                    assert!(words.len() <= max.max(row), "{max}: {}", words.len());
+                    laid[o..o + words.len()].copy_from_slice(&words);
+                    pieces += 1;
+                }
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&laid), bits(&whole), "{filter:?} {max}");
+                let rows_a_piece = (max / row).clamp(1, 7);
+                assert_eq!(pieces, 1 + 7usize.div_ceil(rows_a_piece), "{max}");
+            }
+        }
+    }
 
     /// The packed length is `words_len`, and the last entry of a row holds its total.
     #[test]
