@@ -109,7 +109,7 @@ pub fn irradiance_batch(
     for l in lights.iter().filter(|l| l.portals.is_some()) {
         // Before the parallel loop below (DomeIrradiance::warm).
         if let Some(t) = irradiance::dome::tables(l) {
-            t.warm(true, false);
+            t.warm(true, false, 0);
         }
     }
     let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
@@ -151,7 +151,7 @@ fn dome_by_normal(
         irradiance::Rule::texture_tolerance(rule).is_some() && keys.len() > DOME_ROWS_MIN_NORMALS;
     if let Some(t) = irradiance::dome::tables(light) {
         // Before the parallel loop below (DomeIrradiance::warm).
-        t.warm(false, by_rows);
+        t.warm(false, by_rows, keys.len());
     }
     keys.into_par_iter()
         .map(|key| {

@@ -90,6 +90,9 @@ pub struct DomeIrradiance {
     row_tables: OnceLock<Option<Vec<f64>>>,
     /// The 9-coefficient fast path, projected on first use.
     sh9: OnceLock<sh::IrradianceSh>,
+    /// A latlong map's block sums for the sweep's lit runs (latlong.rs "Runs"), built by
+    /// [`DomeIrradiance::warm`] for a batch of several normals.
+    run_prefix: OnceLock<latlong::RunPrefix>,
 }
 
 fn add<const K: usize>(acc: &mut [f64; K], v: &[f64; K]) {
@@ -134,6 +137,7 @@ impl DomeIrradiance {
             filter,
             row_tables: OnceLock::new(),
             sh9: OnceLock::new(),
+            run_prefix: OnceLock::new(),
         })
     }
 
@@ -216,17 +220,21 @@ impl DomeIrradiance {
 
     /// Builds the lazily built tables that a batch's parallel loop will read, here, before that
     /// loop: the tile tables for a masked dome (`masked`) or one the sweep does not take, and
-    /// the row rule's tables when the batch takes it (`by_rows`). Their builds run rayon jobs
+    /// the row rule's tables when the batch takes it (`by_rows`), and the sweep's block sums for
+    /// a batch of more than one distinct normal (`normals`) that the sweep integrates (one
+    /// normal, a falloff map of a plane, sums its lit pieces directly). Their builds run rayon jobs
     /// inside a `OnceLock`; first reached from inside a rayon loop, the builder, while it waits
     /// for a stolen job, may steal another iteration of that loop, which then waits on the same
     /// `OnceLock` for ever (rayon-rs/rayon#592 and #1251: work stealing makes the
     /// initialisation re-entrant). The latlong sweep's axis factors build without rayon.
-    pub fn warm(&self, masked: bool, by_rows: bool) {
+    pub fn warm(&self, masked: bool, by_rows: bool, normals: usize) {
         if by_rows && !masked && self.sweeps() && self.row_tables().is_some() {
             return;
         }
         if masked || !self.sweeps() {
             self.tables();
+        } else if normals > 1 {
+            self.run_prefix();
         }
     }
 
