@@ -68,17 +68,6 @@ pub fn irradiance_sh9(p: &Prepared, n: DVec3) -> Option<DVec3> {
     Some(p.base * t.irradiance_sh9(n) * p.light.inputs.diffuse)
 }
 
-/// An unmasked textured latlong dome's irradiance by the row rule
-/// ([`dome::DomeIrradiance::irradiance_by_rows`]: within ~1e-9 of [`irradiance`], for loose
-/// tolerances), `diffuse` applied; `None` for other lights and where the rule does not apply.
-pub fn dome_irradiance_by_rows(p: &Prepared, n: DVec3) -> Option<DVec3> {
-    if p.light.kind != LightType::Dome || p.portals.is_some() {
-        return None;
-    }
-    let e = dome::tables(p)?.irradiance_by_rows(n)?;
-    Some(p.base * e * p.light.inputs.diffuse)
-}
-
 /// [`irradiance`] with the quadrature's [`Rule`] chosen (closed forms are used either way).
 pub fn irradiance_with<R: Rule>(p: &Prepared, x: DVec3, n: DVec3, rule: &R) -> DVec3 {
     let e = match p.light.kind {

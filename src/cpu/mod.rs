@@ -109,7 +109,7 @@ pub fn irradiance_batch(
     for l in lights.iter().filter(|l| l.portals.is_some()) {
         // Before the parallel loop below (DomeIrradiance::warm).
         if let Some(t) = irradiance::dome::tables(l) {
-            t.warm(true, false, 0);
+            t.warm(true, 0);
         }
     }
     let by_normal: Vec<Option<HashMap<[u32; 3], DVec3>>> = lights
@@ -119,7 +119,7 @@ pub fn irradiance_batch(
             (matches!(l.light.kind, LightType::Dome)
                 && l.dome_texture().is_some()
                 && l.portals.is_none())
-            .then(|| dome_by_normal(l, normals, rule))
+            .then(|| dome_by_normal(l, normals))
         })
         .collect();
     batch(lights.len(), points.len(), per_light, |k, i| {
@@ -136,41 +136,28 @@ pub fn irradiance_batch(
 /// A textured dome's irradiance for each distinct normal among `normals` (keyed by their bits).
 /// A dome lies at infinity, so its irradiance depends on the normal alone (DESIGN.md §2), and
 /// its exact integral (irradiance/dome.rs) costs far more than a lookup: a falloff map, whose
-/// receivers share one normal, needs one evaluation instead of one per pixel. At a loose
-/// tolerance, more than [`DOME_ROWS_MIN_NORMALS`] distinct normals take the row rule where it
-/// applies ([`irradiance::dome_irradiance_by_rows`]).
-fn dome_by_normal(
-    light: &Prepared,
-    normals: &[[f32; 3]],
-    rule: &irradiance::Adaptive,
-) -> HashMap<[u32; 3], DVec3> {
+/// receivers share one normal, needs one evaluation instead of one per pixel. Every tolerance
+/// takes the exact integral: for a latlong dome under a conformal frame the sweep
+/// (irradiance/dome/latlong.rs) is faster than the row rule that loose tolerances once took
+/// for many normals (BENCHMARKS.md "The sweep's lit runs").
+fn dome_by_normal(light: &Prepared, normals: &[[f32; 3]]) -> HashMap<[u32; 3], DVec3> {
     let mut keys: Vec<[u32; 3]> = normals.iter().map(|n| n.map(f32::to_bits)).collect();
     keys.sort_unstable();
     keys.dedup();
-    let by_rows =
-        irradiance::Rule::texture_tolerance(rule).is_some() && keys.len() > DOME_ROWS_MIN_NORMALS;
     if let Some(t) = irradiance::dome::tables(light) {
         // Before the parallel loop below (DomeIrradiance::warm).
-        t.warm(false, by_rows, keys.len());
+        t.warm(false, keys.len());
     }
     keys.into_par_iter()
         .map(|key| {
             let e = match unit(key.map(f32::from_bits)) {
-                Some(n) => by_rows
-                    .then(|| irradiance::dome_irradiance_by_rows(light, n))
-                    .flatten()
-                    .unwrap_or_else(|| irradiance::irradiance(light, DVec3::ZERO, n)),
+                Some(n) => irradiance::irradiance(light, DVec3::ZERO, n),
                 None => DVec3::ZERO,
             };
             (key, e)
         })
         .collect()
 }
-
-/// Past this many distinct normals a loose-tolerance batch builds a latlong dome's row tables
-/// (0.18 s for a 2048 × 1024 map, then ~8 ms of one core per normal against the exact sweep's
-/// ~46 ms: BENCHMARKS.md "Textured latlong domes").
-const DOME_ROWS_MIN_NORMALS: usize = 16;
 
 #[cfg(test)]
 mod tests {
@@ -191,13 +178,12 @@ mod tests {
         Prepared::new(&light, TemperatureMode::Spec).expect("the dome prepares")
     }
 
-    /// A batch of more than [`DOME_ROWS_MIN_NORMALS`] distinct normals at a loose tolerance
-    /// gives the row rule's values, bit for bit; at the reference tolerance, or with that many
-    /// normals only, the exact integral's. The two differ (the rule is not the exact sum).
+    /// A batch of many distinct normals gives the exact integral's values at every tolerance,
+    /// bit for bit (the row rule is no longer taken), one per distinct normal.
     #[test]
-    fn dome_batches_take_the_row_rule_only_for_many_normals_at_loose_tolerances() {
+    fn dome_batches_take_the_exact_integral_at_every_tolerance() {
         let p = textured_dome();
-        let normals: Vec<[f32; 3]> = (0..DOME_ROWS_MIN_NORMALS + 4)
+        let normals: Vec<[f32; 3]> = (0..20)
             .map(|i| {
                 let z = 1.0 - (i as f32 + 0.5) / 10.0;
                 let phi = i as f32 * 2.4;
@@ -207,23 +193,13 @@ mod tests {
             .collect();
         let points = vec![[0.0f32; 3]; normals.len()];
         let lights = std::slice::from_ref(&p);
-        let loose = irradiance::Adaptive::for_tolerance(1e-4);
-        let rows = irradiance_batch(lights, &points, &normals, true, &loose);
-        let exact = irradiance_batch(
-            lights,
-            &points,
-            &normals,
-            true,
-            &irradiance::Adaptive::REFERENCE,
-        );
-        for ((n, r), e) in normals.iter().zip(&rows).zip(&exact) {
-            let n = unit(*n).expect("a unit normal");
-            assert_eq!(Some(*r), irradiance::dome_irradiance_by_rows(&p, n));
-            assert_eq!(*e, irradiance::irradiance(&p, DVec3::ZERO, n));
+        for rel in [1e-2, 1e-4, 1e-9] {
+            let rule = irradiance::Adaptive::for_tolerance(rel);
+            let got = irradiance_batch(lights, &points, &normals, true, &rule);
+            for (n, g) in normals.iter().zip(&got) {
+                let n = unit(*n).expect("a unit normal");
+                assert_eq!(*g, irradiance::irradiance(&p, DVec3::ZERO, n), "{rel}");
+            }
         }
-        assert_ne!(rows, exact);
-        let few = DOME_ROWS_MIN_NORMALS;
-        let some = irradiance_batch(lights, &points[..few], &normals[..few], true, &loose);
-        assert_eq!(some, exact[..few]);
     }
 }

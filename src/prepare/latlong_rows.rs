@@ -105,7 +105,8 @@ pub fn device_chunks(
 
 /// The row tables of `img` under `filter` after the header (the column phases, then the rows,
 /// built in parallel), each number converted by `conv` (f32 for the device, f64 for the twin),
-/// appended to `out`.
+/// appended to `out` (tests: the device's copy is built in pieces, [`device_chunks`]).
+#[cfg(test)]
 pub fn tables<T: Copy + Default + Send + Sync>(
     img: &Image,
     filter: Filter,

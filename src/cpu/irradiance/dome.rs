@@ -84,9 +84,12 @@ pub struct DomeIrradiance {
     tables: OnceLock<Tables>,
     /// A latlong map's per-axis moment factors (conformal frames only, latlong.rs).
     axes: OnceLock<latlong::Axes>,
+    /// The texture's filter (the row rule's tables read it).
+    #[cfg(test)]
     filter: Filter,
-    /// A latlong map's row tables in f64 for the row rule (latlong.rs "The row rule"); `None`
-    /// over [`latlong::ROWS_MAX_BYTES`].
+    /// A latlong map's row tables in f64 for the row rule (latlong.rs "The row rule", which
+    /// the tests hold against the sweep); `None` over [`latlong::ROWS_MAX_BYTES`].
+    #[cfg(test)]
     row_tables: OnceLock<Option<Vec<f64>>>,
     /// The 9-coefficient fast path, projected on first use.
     sh9: OnceLock<sh::IrradianceSh>,
@@ -134,7 +137,9 @@ impl DomeIrradiance {
             kappa: kappa.max(1.0),
             tables: OnceLock::new(),
             axes: OnceLock::new(),
+            #[cfg(test)]
             filter,
+            #[cfg(test)]
             row_tables: OnceLock::new(),
             sh9: OnceLock::new(),
             run_prefix: OnceLock::new(),
@@ -220,17 +225,13 @@ impl DomeIrradiance {
 
     /// Builds the lazily built tables that a batch's parallel loop will read, here, before that
     /// loop: the tile tables for a masked dome (`masked`) or one the sweep does not take, and
-    /// the row rule's tables when the batch takes it (`by_rows`), and the sweep's block sums for
-    /// a batch of more than one distinct normal (`normals`) that the sweep integrates (one
-    /// normal, a falloff map of a plane, sums its lit pieces directly). Their builds run rayon jobs
-    /// inside a `OnceLock`; first reached from inside a rayon loop, the builder, while it waits
-    /// for a stolen job, may steal another iteration of that loop, which then waits on the same
-    /// `OnceLock` for ever (rayon-rs/rayon#592 and #1251: work stealing makes the
+    /// the sweep's block sums for a batch of more than one distinct normal (`normals`; one
+    /// normal, a falloff map of a plane, sums its lit pieces directly). Their builds run rayon
+    /// jobs inside a `OnceLock`; first reached from inside a rayon loop, the builder, while it
+    /// waits for a stolen job, may steal another iteration of that loop, which then waits on the
+    /// same `OnceLock` for ever (rayon-rs/rayon#592 and #1251: work stealing makes the
     /// initialisation re-entrant). The latlong sweep's axis factors build without rayon.
-    pub fn warm(&self, masked: bool, by_rows: bool, normals: usize) {
-        if by_rows && !masked && self.sweeps() && self.row_tables().is_some() {
-            return;
-        }
+    pub fn warm(&self, masked: bool, normals: usize) {
         if masked || !self.sweeps() {
             self.tables();
         } else if normals > 1 {

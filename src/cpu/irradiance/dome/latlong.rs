@@ -70,27 +70,32 @@
 //!
 //! # The row rule
 //!
-//! At a loose tolerance (`Rule::texture_tolerance`, from 1e-4) and for many distinct normals,
-//! [`DomeIrradiance::irradiance_by_rows`] integrates by rows of the texture instead: the device
-//! path's method (`cpu::irradiance::latlong_rows`, its f64 twin, which carries the derivation:
-//! exact in the column angle from per-row prefix tables, Gauss–Legendre in θ between every
-//! point where the integrand is not smooth). Per normal it costs O(W + H) where the sweep costs
-//! O(W·H): about 8 ms of one core against 46 ms of core time on luxtest's 2048 × 1024 map, after
-//! building the f64 tables once (0.18 s, 12 numbers per texel: 192 MB; maps whose tables would
-//! exceed [`ROWS_MAX_BYTES`] keep the sweep). It is not an exact sum of pieces: against the
-//! sweep it differs by 1e-15 on that map and at most 2e-9 (of `π max L`) on 1 × 1 to 64 × 32
-//! maps with grazing normals, where a row spans up to 0.25 rad (the tests below).
+//! [`DomeIrradiance::irradiance_by_rows`] integrates by rows of the texture: the device path's
+//! method (`cpu::irradiance::latlong_rows`, its f64 twin, which carries the derivation: exact in
+//! the column angle from per-row prefix tables, Gauss–Legendre in θ between every point where
+//! the integrand is not smooth). The CPU path took it at loose tolerances for many distinct
+//! normals (O(W + H) a normal against the sweep's O(W·H), after 192 MB of f64 tables for
+//! 2048 × 1024) until the runs and the crossed pieces' closed form made the exact sweep
+//! faster (512 normals on luxtest's map: 0.92 s and 44 MB against 1.94 s and 236 MB, the
+//! outputs identical in f32); it is now the tests' independent check of the device's method:
+//! against the sweep it differs by 1e-15 on that map and at most 2e-9 (of `π max L`) on 1 × 1
+//! to 64 × 32 maps with grazing normals, where a row spans up to 0.25 rad (the tests below).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::DomeIrradiance;
 use super::quadrature::gl;
+#[cfg(test)]
 use crate::cpu::irradiance::latlong_rows::{Rows, latlong_irradiance};
+#[cfg(test)]
 use crate::prepare::latlong_rows;
-use crate::prepare::texture::{DomeFormat, Filter};
+use crate::prepare::texture::DomeFormat;
+#[cfg(test)]
+use crate::prepare::texture::Filter;
 
 /// The largest f64 row tables the row rule builds: a 2048 × 1024 map's take 192 MB.
+#[cfg(test)]
 pub(super) const ROWS_MAX_BYTES: usize = 256 << 20;
 
 /// The per-axis factors of a latlong map's piece moments, and the trigonometry of the pieces'
@@ -204,6 +209,7 @@ impl DomeIrradiance {
     }
 
     /// The row rule's f64 tables, built on first use; `None` over [`ROWS_MAX_BYTES`].
+    #[cfg(test)]
     pub(super) fn row_tables(&self) -> Option<&[f64]> {
         self.row_tables
             .get_or_init(|| {
@@ -219,6 +225,7 @@ impl DomeIrradiance {
 
     /// `E(n)` by the row rule (module docs "The row rule"); `None` where the sweep does not
     /// apply or the tables would exceed [`ROWS_MAX_BYTES`].
+    #[cfg(test)]
     pub fn irradiance_by_rows(&self, n: DVec3) -> Option<DVec3> {
         if !self.sweeps() {
             return None;
@@ -780,8 +787,8 @@ pub(crate) mod tests {
     }
 
     /// `warm` builds what a batch's parallel loop would otherwise first build from inside it
-    /// (`DomeIrradiance::warm`): the row tables for a row-rule batch, the tile tables for a
-    /// masked dome or a format the sweep does not take, nothing for the sweep's own batches.
+    /// (`DomeIrradiance::warm`): the tile tables for a masked dome or a format the sweep does
+    /// not take, the sweep's block sums for more than one normal, never the row rule's tables.
     #[test]
     fn warm_builds_what_the_batch_reads() {
         let img = image(8, 4, 3, false);
@@ -791,17 +798,14 @@ pub(crate) mod tests {
                 .unwrap()
         };
         let d = latlong();
-        d.warm(false, false, 1);
-        assert!(d.row_tables.get().is_none() && d.tables.get().is_none());
-        assert!(d.run_prefix.get().is_none());
-        d.warm(false, false, 2);
+        d.warm(false, 1);
+        assert!(d.tables.get().is_none() && d.run_prefix.get().is_none());
+        d.warm(false, 2);
         assert!(d.run_prefix.get().is_some() && d.tables.get().is_none());
-        d.warm(false, true, 20);
-        assert!(d.row_tables.get().is_some_and(|t| t.is_some()) && d.tables.get().is_none());
+        assert!(d.row_tables.get().is_none());
         let d = latlong();
-        d.warm(true, false, 20);
-        assert!(d.tables.get().is_some() && d.row_tables.get().is_none());
-        assert!(d.run_prefix.get().is_none());
+        d.warm(true, 20);
+        assert!(d.tables.get().is_some() && d.run_prefix.get().is_none());
         let ball = DomeIrradiance::new(
             img.clone(),
             DomeFormat::MirroredBall,
@@ -809,8 +813,8 @@ pub(crate) mod tests {
             frame(),
         )
         .unwrap();
-        ball.warm(false, true, 20);
-        assert!(ball.tables.get().is_some() && ball.row_tables.get().is_none());
+        ball.warm(false, 20);
+        assert!(ball.tables.get().is_some() && ball.run_prefix.get().is_none());
     }
 
     /// The sweep against the tiles (the same moments and crossed pieces, summed another way:
