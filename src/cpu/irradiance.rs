@@ -207,8 +207,7 @@ pub trait Rule {
         1e-9
     }
     /// The relative tolerance a textured rect's fast path ([`rect_fast`]) is run to; None: the
-    /// exact split path (`rect_texture`) runs. Some also lets a batch of many normals take a
-    /// latlong dome's row rule (`cpu::dome_by_normal`).
+    /// exact split path (`rect_texture`) runs.
     fn texture_tolerance(&self) -> Option<f64> {
         None
     }
