@@ -8,7 +8,10 @@ use crate::common;
 
 use luxeval::testkit::{Rng, ies::with_random_ies, random_light, synthetic_lights};
 use luxeval::wgpu;
-use luxeval::{Accumulate, Asset, Evaluator, Light, LuxError, RowLayout, Texture, TextureFormat};
+use luxeval::{
+    Accumulate, Asset, Evaluator, Light, LuxError, Reference, RowLayout, TemperatureMode, Texture,
+    TextureFormat,
+};
 
 /// What a renderer holds: its own device and queue.
 pub(crate) struct Renderer {
@@ -824,8 +827,27 @@ fn irradiance_tables_over_the_binding_limit_are_the_references() {
                 );
             }
             resident.unwrap();
+            if !halved {
+                // `check` compares all four queries.
+                let reference = Reference::new(&dome[0], TemperatureMode::Spec).unwrap();
+                let report = luxeval::check_against_reference(&eval, &[reference], 16, 3).unwrap();
+                assert!(report.host_only.is_empty(), "{:?}", report.host_only);
+                assert!(report.pass(), "{report:?}");
+            }
         } else {
             assert_eq!(got, want, "{w} × {h}");
+            // `check` compares its emission and radiance and says why not its irradiance.
+            let reference = Reference::new(&dome[0], TemperatureMode::Spec).unwrap();
+            let report = luxeval::check_against_reference(&eval, &[reference], 16, 3).unwrap();
+            assert!(
+                report
+                    .host_only
+                    .iter()
+                    .any(|(l, why)| l == "/Dome" && why.contains("row tables")),
+                "{:?}",
+                report.host_only
+            );
+            assert!(report.pass(), "{report:?}");
             match resident {
                 Err(LuxError::NotOnDevice { light, reason, .. }) => {
                     assert_eq!(light, "/Dome");

@@ -95,8 +95,9 @@ pub struct CheckReport {
     pub excluded: usize,
     pub rows: Vec<QueryReport>,
     /// The lights some or all of whose queries the CPU reference answers on every device
-    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`, `GpuPath::HostIntensity`: mesh lights),
-    /// with what is not compared and why.
+    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`, `GpuPath::HostIntensity`: mesh lights)
+    /// or on this one (a latlong dome whose row tables it cannot hold), with what is not
+    /// compared and why.
     pub host_only: Vec<(String, String)>,
 }
 
@@ -227,6 +228,20 @@ pub fn check_with(
                 format!("cannot check on this device: {w}"),
             ));
         }
+        // A latlong dome whose row tables this device cannot hold takes the reference's
+        // irradiance here (gpu::texture_atlas::tables_beyond): nothing to compare.
+        let irradiance_on_host = scene.prepared(0).irradiance_on_host();
+        if let crate::prepare::GpuPath::HostIrradiance(why) = scene.prepared(0).gpu_path
+            && !p.irradiance_on_host()
+        {
+            host_only.push((
+                p.light.path.clone(),
+                format!(
+                    "{why}, whose irradiance the CPU reference answers on this device (its \
+                     emission, intensity and radiance are compared)"
+                ),
+            ));
+        }
         // Emission (not for a light whose emission the host computes).
         let samples = if p.emission_on_host() {
             0
@@ -285,7 +300,7 @@ pub fn check_with(
         // whose irradiance the GPU path takes from the CPU reference (textured rects, textured
         // domes but the latlong ones the kernel integrates, bent IES profiles:
         // Prepared::irradiance_on_host), so there is nothing to compare.
-        let ni = if p.irradiance_on_host() {
+        let ni = if irradiance_on_host {
             0
         } else {
             counts.irradiance

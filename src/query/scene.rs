@@ -153,6 +153,12 @@ impl PreparedScene {
         &self.device_warnings
     }
 
+    /// Light `k` as this scene evaluates it (its `gpu_path` as this device leaves it:
+    /// `gpu::texture_atlas::tables_beyond`).
+    pub(crate) fn prepared(&self, k: usize) -> &Prepared {
+        &self.lights[k]
+    }
+
     /// The number of lights.
     pub fn len(&self) -> usize {
         self.lights.len()
