@@ -7,7 +7,8 @@
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
 // On the host: lights flagged FLAG_HOST_IRRADIANCE (textured rects, textured domes other than
-//   latlong ones under a conformal frame with tables the device holds, masked domes, mesh
+//   latlong ones under a conformal frame with tables the device holds, masked domes but the
+//   untextured ones whose portals cannot hide one another (irradiance/portals.wgsl), mesh
 //   lights whose triangles may hide one another, IES profiles bent by angleScale) give 0 here
 //   and the host adds the CPU reference's value (prepare::Prepared::irradiance_on_host gives the
 //   reasons). A textured latlong dome is integrated by rows of its texture
@@ -37,6 +38,7 @@
 // #import irradiance/chart.wgsl
 // #import irradiance/outer.wgsl
 // #import mesh/lambert.wgsl
+// #import irradiance/portals.wgsl
 // #import irradiance/latlong_rows.wgsl
 
 fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
@@ -53,6 +55,11 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     switch light.kind {
         case KIND_DOME: {
             e = base * PI;
+            if has_flag(light, FLAG_PORTALS) {
+                // Masked and untextured, its portals unable to hide one another
+                // (prepare::Prepared::apply_portal_mode): Lambert's formula summed over them.
+                e = base * portals_lambert(light.tex.w, x, n);
+            }
             // #if TEXTURE
             if has_flag(light, FLAG_DOME_TEXTURE) {
                 // A latlong dome under a conformal frame (prepare::gpu_path): the dome-space

@@ -28,7 +28,8 @@ pub enum LuxError {
 
     /// A light that a GPU-resident query (`PreparedScene::encode_*`) cannot evaluate on the
     /// device: its value is computed on the host (the irradiance of textured domes and rects,
-    /// and of IES profiles bent by angleScale), and the GPU-resident path has no host step.
+    /// of most masked domes, and of IES profiles bent by angleScale), and the GPU-resident path
+    /// has no host step.
     #[error("light {light}: {query} cannot be evaluated GPU-resident: {reason}")]
     NotOnDevice {
         light: String,

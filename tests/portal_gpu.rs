@@ -1,6 +1,7 @@
 //! A dome masked by portals (DESIGN.md §8 P2 mask mode) on a GPU evaluator: emission and
-//! radiance on the device (shaders/portal.wgsl), irradiance and intensity from the CPU
-//! reference (`GpuPath::HostIrradiance`). Radiance is compared with the reference within 1e-4
+//! radiance on the device (shaders/portal.wgsl); irradiance on the device for an untextured
+//! dome whose portals cannot hide one another (shaders/irradiance/portals.wgsl, the last
+//! test), else, with intensity, from the CPU reference (`GpuPath::HostIrradiance`). Radiance is compared with the reference within 1e-4
 //! relative away from the portals' edges and planes (a band of 1e-4 of the portal's size, the
 //! one `luxeval check` excludes, computed here from the portals' transforms); the excluded count
 //! is printed. Hint mode is bitwise the dome without portals.
@@ -321,4 +322,127 @@ fn invisible_portals_and_hint_mode_on_the_device() {
             reference.irradiance(&pts, &dirs, acc).unwrap()
         );
     }
+}
+
+/// An untextured dome seen through windows that cannot hide one another (a box room's walls and
+/// ceiling, several windows a wall, rotated and non-uniformly scaled in their plane, tinted):
+/// its irradiance is the device's (Lambert's formula summed over the portals,
+/// shaders/irradiance/portals.wgsl), within 1e-4 of the reference (its visible pieces,
+/// cpu::portal::irradiance) for receivers inside and outside the room, of every orientation,
+/// away from the portals' planes and horizon slivers (`check::irradiance_margin`); `luxeval
+/// check`'s comparison passes and lists nothing as host-only.
+#[test]
+fn masked_dome_irradiance_runs_on_the_device_where_portals_cannot_hide_one_another() {
+    use luxeval::testkit::check;
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let gpu = gpu.with_portal_mode(PortalMode::Mask);
+    let cpu = Evaluator::cpu().with_portal_mode(PortalMode::Mask);
+    // Windows (centre on the wall, in-plane rotation and scale) on the room [−3, 3]³: +Z out.
+    let walls = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z];
+    let specs = [
+        (0, 0.0, 0.8, 0.3, 1.4, 1.0),
+        (0, 1.9, -0.6, 1.0, 1.2, 0.6),
+        (1, 0.4, 0.2, 0.0, 2.0, 1.5),
+        (2, -1.5, 0.5, 0.7, 1.0, 2.2),
+        (3, 1.0, -1.0, 2.0, 1.6, 0.8),
+        (4, 0.0, 0.0, 0.4, 2.5, 2.5),
+        (4, 2.2, 2.0, 0.0, 0.8, 0.8),
+    ];
+    let dome = specs.iter().enumerate().fold(
+        Light::dome()
+            .with_path("/Sky")
+            .with_intensity(2.0)
+            .with_color(DVec3::new(0.9, 0.7, 1.0)),
+        |l, (i, &(wall, u, v, turn, w, h))| {
+            let out = walls[wall];
+            let (t1, t2) = out.any_orthonormal_pair();
+            let rot = DQuat::from_rotation_arc(DVec3::Z, out) * DQuat::from_rotation_z(turn);
+            let world = DMat4::from_rotation_translation(rot, out * 3.0 + t1 * u + t2 * v)
+                * DMat4::from_scale(DVec3::new(1.3, 0.8, 1.0));
+            l.with_portal(
+                Portal::new(w, h)
+                    .with_path(format!("/W{i}"))
+                    .with_transform(world)
+                    .with_intensity(0.5 + i as f64 * 0.4)
+                    .with_color(DVec3::new(1.0, 0.8 - 0.1 * i as f64, 0.5)),
+            )
+        },
+    );
+    let l = std::slice::from_ref(&dome);
+    let reference = luxeval::Reference::with_portal_mode(
+        &dome,
+        luxeval::TemperatureMode::Spec,
+        PortalMode::Mask,
+    )
+    .unwrap();
+    let mut rng = Rng::new(0xD0_0E);
+    let n = 3000;
+    let (mut pts, mut nrms) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        // Two in three inside the room, the rest around it; normals uniform, or up.
+        let r = if i % 3 == 2 { 5.0 } else { 2.9 };
+        let x = DVec3::new(rng.range(-r, r), rng.range(-r, r), rng.range(-r, r));
+        let nn = if i % 4 == 0 { DVec3::Z } else { rng.unit() };
+        pts.push(x.as_vec3().to_array());
+        nrms.push(nn.as_vec3().to_array());
+    }
+    let c = cpu
+        .prepare(l)
+        .unwrap()
+        .irradiance(&pts, &nrms, Accumulate::Sum)
+        .unwrap();
+    let g = gpu
+        .prepare(l)
+        .unwrap()
+        .irradiance(&pts, &nrms, Accumulate::Sum)
+        .unwrap();
+    let (mut excluded, mut lit, mut worst) = (0, 0, 0.0f64);
+    for i in 0..n {
+        let x = DVec3::from_array(pts[i].map(f64::from));
+        let nn = DVec3::from_array(nrms[i].map(f64::from));
+        if check::irradiance_margin(&reference, x, nn) < check::BAND {
+            excluded += 1;
+            continue;
+        }
+        if c[i] != [0.0; 3] {
+            lit += 1;
+        }
+        let e = rel(c[i], g[i]);
+        assert!(
+            e <= check::TOLERANCE,
+            "receiver {i} at {x} normal {nn}: cpu {:?} gpu {:?} ({e:e})",
+            c[i],
+            g[i]
+        );
+        worst = worst.max(e);
+    }
+    eprintln!(
+        "masked dome irradiance: {n} receivers, {excluded} excluded, {lit} lit, worst relative \
+         error {worst:e}"
+    );
+    assert!(lit > n / 3, "{lit} lit of {n}");
+    assert!(excluded < n / 50, "{excluded} excluded");
+    // The check compares the irradiance (nothing host-only) and passes.
+    let report = check::check_with(
+        &gpu,
+        std::slice::from_ref(&reference),
+        check::Samples {
+            emission: 64,
+            intensity: 0,
+            radiance: 256,
+            irradiance: 256,
+        },
+        3,
+    )
+    .unwrap();
+    assert!(report.host_only.is_empty(), "{:?}", report.host_only);
+    assert!(report.rows.iter().all(|r| r.pass), "{:?}", report.rows);
+    assert!(
+        report
+            .rows
+            .iter()
+            .any(|r| format!("{:?}", r.query) == "Irradiance" && r.samples == 256)
+    );
 }

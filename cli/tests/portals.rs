@@ -152,10 +152,11 @@ fn every_scene_command_takes_portal_mode() {
 }
 
 /// `check` on the window room in mask mode compares the masked dome's emission and radiance
-/// (on the device since the portal kernel, shaders/portal.wgsl) and lists it as not compared for
-/// nothing: its irradiance is the host's (nothing to compare), as for a textured rect.
+/// (on the device since the portal kernel, shaders/portal.wgsl) and, its dome untextured and
+/// its windows unable to hide one another, its irradiance (shaders/irradiance/portals.wgsl);
+/// nothing of it is host-only.
 #[test]
-fn check_compares_a_masked_domes_radiance() {
+fn check_compares_a_masked_domes_radiance_and_irradiance() {
     if crate::common::gpu().is_none() {
         return;
     }
@@ -184,12 +185,13 @@ fn check_compares_a_masked_domes_radiance() {
     );
     assert_eq!(radiance["pass"], true, "{radiance}");
     assert!(row("emission")["samples"].as_u64().unwrap() > 0);
-    // Irradiance is the host's (GpuPath::HostIrradiance): no row, or one of no samples.
+    let irradiance = row("irradiance");
+    assert!(irradiance["samples"].as_u64().unwrap() > 0, "{irradiance}");
     assert!(
-        rows.iter()
-            .all(|r| r["query"] != "irradiance" || r["samples"] == 0),
-        "{v}"
+        irradiance["nonzero"].as_u64().unwrap() > 0,
+        "nothing lit: {irradiance}"
     );
+    assert_eq!(irradiance["pass"], true, "{irradiance}");
     assert!(
         v["host_only"]
             .as_array()

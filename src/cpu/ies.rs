@@ -252,6 +252,122 @@ mod tests {
         assert_eq!(fold_mirror(-30.0, false), -30.0);
     }
 
+    /// Every place where a direction's bilinear cell changes (the grid intervals `(H', V')` of
+    /// the lookup falls in, or the range it leaves) lies on a surface that
+    /// `prepare::ies_kinks` lists, for types C and A under angleScale (their families stay
+    /// cones and planes, so the device splits at them) and every type without it: random arcs
+    /// walked in 4,000 steps, a cell change between two steps needing a listed surface that
+    /// changes sign between them. Fails when type A under angleScale lists nothing (the old
+    /// rule) or its cones are mirrored (`+cos θ`).
+    #[test]
+    fn listed_kinks_hold_every_cell_change_of_the_lookup() {
+        use crate::prepare::ies_kinks::ies_kinks;
+        use crate::prepare::ies_kinks::tests::profile;
+        use crate::synthetic::Rng;
+        let cases = [
+            profile(
+                PhotometricType::A,
+                &[0.0, 25.0, 60.0, 90.0],
+                &[0.0, 10.0, 45.0, 80.0],
+                HFold::Mirror,
+                VFold::Mirror,
+            ),
+            profile(
+                PhotometricType::A,
+                &[-70.0, -5.0, 40.0],
+                &[-85.0, -30.0, 20.0, 75.0],
+                HFold::AsGiven,
+                VFold::AsGiven,
+            ),
+            profile(
+                PhotometricType::A,
+                &[0.0],
+                &[-60.0, 0.0, 35.0],
+                HFold::Constant,
+                VFold::AsGiven,
+            ),
+            profile(
+                PhotometricType::C,
+                &[0.0, 30.0, 90.0],
+                &[0.0, 20.0, 70.0, 120.0],
+                HFold::Quadrant,
+                VFold::AsGiven,
+            ),
+            profile(
+                PhotometricType::B,
+                &[0.0, 20.0, 90.0],
+                &[0.0, 30.0, 90.0],
+                HFold::Mirror,
+                VFold::Mirror,
+            ),
+        ];
+        // The lookup's cell: how many grid angles lie at or below the folded (H', V'), or None
+        // outside angleScale's window.
+        let cell = |p: &Profile, e: DVec3, s: f64| {
+            let (h, v) = photometric_angles(p.kind, e, s)?;
+            let (hq, vq) = if p.kind == PhotometricType::C {
+                (fold_h_type_c(h, p.h_fold), v)
+            } else {
+                (
+                    fold_mirror(h, p.h_fold == HFold::Mirror),
+                    fold_mirror(v, p.v_fold == VFold::Mirror),
+                )
+            };
+            // Outside a grid's range the factor is 0 (one cell, whichever side).
+            let below = |g: &[f64], x: f64| {
+                (g[0] <= x && x <= g[g.len() - 1]).then(|| g.iter().filter(|&&a| a <= x).count())
+            };
+            let hc = if p.h_fold == HFold::Constant {
+                (p.kind == PhotometricType::C || hq.abs() <= 90.0).then_some(0)
+            } else {
+                below(&p.h, hq)
+            };
+            hc.zip(below(&p.v, vq))
+        };
+        let mut rng = Rng::new(0xA5CA1E);
+        let mut changes = 0;
+        for p in &cases {
+            let scales: &[f64] = if p.kind == PhotometricType::B {
+                &[0.0]
+            } else {
+                &[0.0, 0.8, 1.3, 0.45, -0.7, -1.4]
+            };
+            for &s in scales {
+                let k = ies_kinks(p, s);
+                let sides = |e: DVec3| -> Vec<f64> {
+                    let cones = k.cones.iter().map(|(a, c)| a.dot(e) - c);
+                    cones.chain(k.planes.iter().map(|m| m.dot(e))).collect()
+                };
+                for _ in 0..100 {
+                    let (a, b) = (rng.unit(), rng.unit());
+                    let steps = 4000;
+                    let at = |i: usize| a.lerp(b, i as f64 / steps as f64).normalize();
+                    let mut prev = (cell(p, at(0), s), sides(at(0)));
+                    for i in 1..=steps {
+                        let now = (cell(p, at(i), s), sides(at(i)));
+                        if now.0 != prev.0 {
+                            changes += 1;
+                            let listed = prev.1.iter().zip(&now.1).any(|(x, y)| {
+                                x.signum() != y.signum() || x.abs() < 1e-12 || y.abs() < 1e-12
+                            });
+                            assert!(
+                                listed,
+                                "{:?} s {s}: cell {:?} → {:?} between {} and {} on no listed kink",
+                                p.kind,
+                                prev.0,
+                                now.0,
+                                at(i - 1),
+                                at(i)
+                            );
+                        }
+                        prev = now;
+                    }
+                }
+            }
+        }
+        assert!(changes > 2000, "only {changes} cell changes crossed");
+    }
+
     #[test]
     fn angle_scale_formula() {
         assert_eq!(scale_polar_angle(60.0, 0.5), 120.0);

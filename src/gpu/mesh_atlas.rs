@@ -15,10 +15,12 @@
 //! The record's `tex` holds (nodes' offset, node count, triangles' offset, fronts' offset) and
 //! `FLAG_MESH_FRONTS` says the fronts are there.
 //!
-//! Per masked dome (`Prepared::portals`, DESIGN.md §8 P2; read by shaders/portal.wgsl): the
-//! portal count as u32 bits, then [`PORTAL_WORDS`] words a portal, in the `portals`
-//! relationship's order (ties go to the earlier): origin xyz, unit normal xyz, the world → local
-//! map's rows (3 × 3), half width and height, multiplier rgb. The record's `tex.w` holds the
+//! Per masked dome (`Prepared::portals`, DESIGN.md §8 P2; read by shaders/portal.wgsl and
+//! shaders/irradiance/portals.wgsl): the portal count as u32 bits, then [`PORTAL_WORDS`] words
+//! a portal, in the `portals` relationship's order (ties go to the earlier): origin xyz, unit
+//! normal xyz, the world → local map's rows (3 × 3), half width and height, multiplier rgb,
+//! then its parallelogram as corner `c0` (local −,−) and edges `c1 − c0`, `c3 − c0` (xyz each,
+//! subtracted in f64, then rounded). The record's `tex.w` holds the
 //! block's offset and `FLAG_PORTALS` says it is there (a textured dome keeps `tex.xyz`).
 
 use crate::prepare::{KindData, Prepared};
@@ -26,7 +28,7 @@ use crate::prepare::{KindData, Prepared};
 /// Words per node, per triangle and per portal.
 pub const NODE_WORDS: u32 = 8;
 pub const TRIANGLE_WORDS: u32 = 10;
-pub const PORTAL_WORDS: u32 = 20;
+pub const PORTAL_WORDS: u32 = 29;
 
 /// The constants shaders/mesh/ray.wgsl and shaders/portal.wgsl read from the WGSL prelude.
 pub fn wgsl_constants() -> [(&'static str, u32); 4] {
@@ -60,6 +62,10 @@ pub fn scene_atlas(lights: &[Prepared]) -> (Vec<f32>, Vec<Option<[u32; 4]>>) {
                     }
                     data.extend(q.half.to_array().map(|c| c as f32));
                     data.extend(q.multiplier.to_array().map(|c| c as f32));
+                    let c = q.corners;
+                    for v in [c[0], c[1] - c[0], c[3] - c[0]] {
+                        data.extend(v.to_array().map(|x| x as f32));
+                    }
                 }
                 return Some([0, 0, 0, at]);
             }
@@ -205,9 +211,10 @@ mod tests {
         let mut p = prep(&dome);
         p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
             .unwrap();
+        // The second portal's plane z = 0 lies below the first (z = 3): a ray up through both.
         assert_eq!(
             p.gpu_path,
-            GpuPath::HostIrradiance("it is masked by portals")
+            GpuPath::HostIrradiance("it is masked by portals that may hide one another")
         );
         let (data, words) = scene_atlas(&[prep(&fan(3)), p]);
         let at = words[1].unwrap()[3] as usize;
@@ -215,7 +222,12 @@ mod tests {
         assert_eq!(data[at].to_bits(), 2);
         let first = &data[at + 1..at + 1 + PORTAL_WORDS as usize];
         assert_eq!(&first[..6], &[0.0, 0.0, 3.0, 0.0, 0.0, 1.0]);
-        assert_eq!(&first[15..], &[1.0, 0.5, 2.0, 2.0, 2.0]);
+        assert_eq!(&first[15..20], &[1.0, 0.5, 2.0, 2.0, 2.0]);
+        // Corner (−1, −0.5, 3), edges along x (2) and y (1).
+        assert_eq!(
+            &first[20..],
+            &[-1.0, -0.5, 3.0, 2.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        );
         let second = &data[at + 1 + PORTAL_WORDS as usize..];
         assert_eq!(second.len(), PORTAL_WORDS as usize);
         // World → local of a uniform scale 2: rows of 0.5·I; half extents in local units.

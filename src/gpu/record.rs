@@ -357,7 +357,8 @@ pub fn pack(
             )
         }
         LightType::Dome => {
-            // A masked dome (GpuPath::HostIrradiance): its portals' offset in the mesh atlas.
+            // A masked dome: its portals' offset in the mesh atlas (radiance, portal.wgsl; and
+            // irradiance where it is the device's, irradiance/portals.wgsl).
             if let (Some(_), Some(words)) = (&p.portals, atlas) {
                 r.flags |= FLAG_PORTALS;
                 r.tex[3] = words[3];

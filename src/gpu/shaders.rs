@@ -97,6 +97,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         "irradiance/outer.wgsl",
         include_str!("../../shaders/irradiance/outer.wgsl"),
     ),
+    (
+        "irradiance/portals.wgsl",
+        include_str!("../../shaders/irradiance/portals.wgsl"),
+    ),
     ("sample.wgsl", include_str!("../../shaders/sample.wgsl")),
     (
         "sample/rng.wgsl",

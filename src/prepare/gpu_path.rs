@@ -12,7 +12,7 @@ pub enum GpuPath {
     Device,
     /// Every query on the device but irradiance, which is the CPU reference's until the f32
     /// quadrature can match it; the reason is a phrase ("it is a textured rect"):
-    /// - IES profiles of types A and B under angleScale: it bends their grid lines into
+    /// - IES profiles of type B under angleScale: it bends their grid lines into
     ///   surfaces that are neither cones nor planes, which the kernel cannot split at
     ///   (`PreparedIes::device_families`; every other IES-shaped light is integrated on the
     ///   device, its lines split at the profile's grid cones and planes).
@@ -26,10 +26,15 @@ pub enum GpuPath {
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
-    /// - Domes masked by portals (§8 P2 mask mode): emission is the dome's own and radiance
-    ///   tests the portal crossings on the device (shaders/portal.wgsl, the portals in the mesh
-    ///   atlas); irradiance needs the portals' visible pieces (cpu::portal::irradiance), which
-    ///   have no kernel. A dome's intensity is 0 on both paths.
+    /// - Textured domes masked by portals, and untextured ones whose portals may hide one
+    ///   another (§8 P2 mask mode): emission is the dome's own and radiance tests the portal
+    ///   crossings on the device (shaders/portal.wgsl, the portals in the mesh atlas);
+    ///   irradiance needs the portals' visible pieces (cpu::portal::irradiance), which have no
+    ///   kernel. An untextured dome whose portals cannot hide one another is [`Device`]
+    ///   (`Prepared::apply_portal_mode`: Lambert's formula summed over the portals,
+    ///   shaders/irradiance/portals.wgsl). A dome's intensity is 0 on both paths.
+    ///
+    ///   [`Device`]: GpuPath::Device
     HostIrradiance(&'static str),
     /// Emission and radiance on the device (the mesh's distinct front directions and its BVH in
     /// the mesh atlas: shaders/emission.wgsl, shaders/mesh/ray.wgsl); intensity and irradiance

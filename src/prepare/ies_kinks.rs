@@ -7,8 +7,10 @@
 //! - type B: V = const is a plane through Y; H = const the cone around −Y with cos = sin H;
 //! - type A: V = const is the cone around +Z with cos = sin V; H = const a plane through Z.
 //!
-//! angleScale maps type C's polar angle θ' = f(θ), which keeps cones cones (at θ = f⁻¹(V));
-//! for types B and A it bends their surfaces, which are then left to the adaptive rules.
+//! angleScale maps the polar angle θ about −Z to θ' = f(θ) and keeps the azimuth, which keeps
+//! cones around ±Z cones (at θ = f⁻¹(θ')) and planes through Z planes: types C and A keep
+//! their families. For type B it bends its surfaces (neither cones nor planes), which are then
+//! left to the adaptive rules.
 
 use glam::DVec3;
 
@@ -103,10 +105,26 @@ pub fn ies_kinks(profile: &Profile, s: f64) -> IesKinks {
                 }
             }
         }
-        PhotometricType::A if s == 0.0 => {
+        PhotometricType::A => {
+            // Type A is type C with V_A = θ' − 90° and H_A = −φ (§6 I2), and angleScale maps θ
+            // to θ' keeping φ (I4): V_A = const is the cone around −Z at θ = f⁻¹(V_A + 90°),
+            // i.e. around +Z with cos = −cos θ (= sin V_A when s = 0), and H_A = const the
+            // same plane through Z for every s.
             for &v in &profile.v {
                 for a in mirror(v, profile.v_fold == VFold::Mirror) {
-                    k.cone(DVec3::Z, a.to_radians().sin());
+                    if s == 0.0 {
+                        k.cone(DVec3::Z, a.to_radians().sin());
+                    } else if let Some(t) = unscaled(a + 90.0, s) {
+                        k.cone(DVec3::Z, -t.to_radians().cos());
+                    }
+                }
+            }
+            // angleScale's window θ' ∈ [0, 180], beyond which the factor is 0.
+            if s != 0.0 {
+                for edge in [0.0, 180.0] {
+                    if let Some(t) = unscaled(edge, s) {
+                        k.cone(DVec3::Z, -t.to_radians().cos());
+                    }
                 }
             }
             let hs: Vec<f64> = if profile.h_fold == HFold::Constant {
@@ -155,7 +173,7 @@ pub struct KinkFamilies {
 impl IesKinks {
     /// The kinks grouped as [`KinkFamilies`]; None when they are not one family of coaxial
     /// cones and one pencil of planes plus at most [`MAX_EXTRA_PLANES`] others (angleScale on
-    /// types B and A lists no kinks at all and gives an empty family; any other mixture cannot
+    /// type B lists no kinks at all and gives an empty family; any other mixture cannot
     /// come from [`ies_kinks`], and is refused rather than streamed wrongly).
     pub fn families(&self) -> Option<KinkFamilies> {
         let cone_axis = self.cones.first().map_or(DVec3::NEG_Z, |c| c.0);
@@ -208,10 +226,11 @@ impl IesKinks {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn profile(
+    /// A profile of unit candela on the given grids (its kinks depend on the grids alone).
+    pub(crate) fn profile(
         kind: PhotometricType,
         h: &[f64],
         v: &[f64],
@@ -335,8 +354,8 @@ mod tests {
         }
     }
 
-    /// angleScale bends the grid lines of types B and A: the light keeps its irradiance on the
-    /// host (PreparedIes::device_families), whose kinks list is empty for them.
+    /// angleScale bends the grid lines of type B: the light keeps its irradiance on the host
+    /// (PreparedIes::device_families), whose kinks list is empty for it.
     #[test]
     fn bent_profiles_list_no_kinks() {
         let p = profile(

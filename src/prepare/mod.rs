@@ -61,11 +61,11 @@ pub struct PreparedIes {
 
 impl PreparedIes {
     /// The profile's kinks as the GPU quadrature streams them ([`ies_kinks::KinkFamilies`]);
-    /// None where the kernel cannot split at them: angleScale on types B and A bends the grid
+    /// None where the kernel cannot split at them: angleScale on type B bends the grid
     /// lines into surfaces that are neither cones nor planes (the reference's adaptive rules
     /// take them, the f32 rule would miss them), so that light's irradiance is the host's.
     pub fn device_families(&self) -> Option<ies_kinks::KinkFamilies> {
-        let bent = self.angle_scale != 0.0 && self.profile.kind != ies::PhotometricType::C;
+        let bent = self.angle_scale != 0.0 && self.profile.kind == ies::PhotometricType::B;
         if bent { None } else { self.kinks.families() }
     }
 }
@@ -208,11 +208,16 @@ impl Prepared {
     }
 
     /// Whether this light's irradiance depends on the receiver's normal alone, not its
-    /// position: distant lights and domes (a masked dome's too, though its irradiance is the
-    /// host's). The irradiance kernel's `LIGHTS_NORMAL_ONLY` pass integrates these lights
-    /// (the record's `FLAG_NORMAL_ONLY` is set from this).
+    /// position: distant lights and domes, but not a dome masked by portals (what a receiver
+    /// sees through them depends on where it is). The irradiance kernel's
+    /// `LIGHTS_NORMAL_ONLY` pass integrates these lights (the record's `FLAG_NORMAL_ONLY` is
+    /// set from this).
     pub fn irradiance_is_normal_only(&self) -> bool {
-        matches!(self.light.kind, LightType::Distant { .. } | LightType::Dome)
+        match self.light.kind {
+            LightType::Distant { .. } => true,
+            LightType::Dome => self.portals.is_none(),
+            _ => false,
+        }
     }
 
     /// Whether the GPU path takes this light's irradiance from the CPU reference
@@ -253,7 +258,10 @@ impl Prepared {
 
     /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
     /// portals is masked; on a GPU evaluator its emission and radiance are the device's (the
-    /// radiance kernel tests the portal crossings) and its irradiance the CPU reference's
+    /// radiance kernel tests the portal crossings), and so is its irradiance where the dome is
+    /// untextured and its portals cannot hide one another
+    /// ([`portal::cannot_hide_one_another`]: a sum of Lambert's formula over the portals,
+    /// shaders/irradiance/portals.wgsl); else its irradiance is the CPU reference's
     /// ([`GpuPath::HostIrradiance`]). Hint mode changes nothing.
     pub fn apply_portal_mode(
         &mut self,
@@ -264,8 +272,12 @@ impl Prepared {
         if let Some(portals) = &self.portals {
             self.gpu_path = if portals.len() > PORTALS_ON_DEVICE {
                 GpuPath::Host("it is masked by more portals than the radiance kernel tests")
+            } else if self.dome_texture().is_some() {
+                GpuPath::HostIrradiance("it is a textured dome masked by portals")
+            } else if !portal::cannot_hide_one_another(portals) {
+                GpuPath::HostIrradiance("it is masked by portals that may hide one another")
             } else {
-                GpuPath::HostIrradiance("it is masked by portals")
+                GpuPath::Device
             };
         }
         Ok(())
@@ -444,9 +456,7 @@ impl Prepared {
                 GpuPath::HostIntensity("it is a mesh light")
             }
         } else if ies.as_ref().is_some_and(|i| i.device_families().is_none()) {
-            GpuPath::HostIrradiance(
-                "its IES profile's grid lines are bent by angleScale (types A and B)",
-            )
+            GpuPath::HostIrradiance("its IES profile's grid lines are bent by angleScale (type B)")
         } else {
             match &kind {
                 KindData::Dome { texture: Some(t) } => latlong_rows::gpu_path(t),

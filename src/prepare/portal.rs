@@ -94,3 +94,63 @@ pub fn prepare_portals(
     }
     Ok(Some(out))
 }
+
+/// How far (relative to its distance from the other portal's centre) a corner may lie on the
+/// passing side of another portal's plane and still count as behind it in
+/// [`cannot_hide_one_another`]: f64 rounding of coplanar portals' corners, ~1e-16 of it. A
+/// corner that far across lets only rays within ~1e-9 (relative) of both portals cross both.
+const BEHIND_SLACK: f64 = 1e-9;
+
+/// Whether no ray can pass through two of `portals` toward their +Z (P2's crossings), so that a
+/// masked dome's irradiance is the sum over the portals of each one's own (the visible pieces of
+/// `cpu::portal::irradiance` are then the portals themselves): true when every portal lies on
+/// the closed −Z side of every other one's plane (a convex room's windows, coplanar panes) and
+/// no two in one plane facing the same way overlap.
+/// Proof: a ray that crosses A toward +Z at t_A is strictly on A's +Z side for t > t_A, where
+/// no point of B lies, so it cannot cross B later; by symmetry it cannot cross B earlier. It
+/// meets both at once only where their planes meet: on a line (measure zero) unless the planes
+/// are one, where facing opposite ways it cannot move toward both +Z, and facing the same way
+/// it passes through both only where they overlap (the overlap counts once, for the earlier
+/// portal, so such sets are refused).
+/// Sufficient, not necessary: sets it rejects keep their irradiance on the host.
+pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
+    let behind = |a: &PreparedPortal, b: &PreparedPortal| {
+        b.corners.iter().all(|c| {
+            let d = *c - a.origin;
+            a.normal.dot(d) <= BEHIND_SLACK * d.length()
+        })
+    };
+    let coplanar = |a: &PreparedPortal, b: &PreparedPortal| {
+        b.corners.iter().all(|c| {
+            let d = *c - a.origin;
+            a.normal.dot(d).abs() <= BEHIND_SLACK * d.length()
+        })
+    };
+    portals.iter().enumerate().all(|(i, a)| {
+        portals.iter().enumerate().skip(i + 1).all(|(_, b)| {
+            behind(a, b)
+                && behind(b, a)
+                && !(coplanar(a, b) && a.normal.dot(b.normal) > 0.0 && overlap(a, b))
+        })
+    })
+}
+
+/// Whether two portals in one plane overlap (in more than an edge): no separating line along
+/// either parallelogram's edges (the separating axis theorem for convex polygons).
+fn overlap(a: &PreparedPortal, b: &PreparedPortal) -> bool {
+    let edges = |q: &PreparedPortal| [q.corners[1] - q.corners[0], q.corners[3] - q.corners[0]];
+    edges(a).into_iter().chain(edges(b)).all(|e| {
+        let axis = a.normal.cross(e);
+        let range = |q: &PreparedPortal| {
+            q.corners
+                .iter()
+                .map(|c| c.dot(axis))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                })
+        };
+        let ((alo, ahi), (blo, bhi)) = (range(a), range(b));
+        let slack = BEHIND_SLACK * ((ahi - alo) + (bhi - blo));
+        ahi > blo + slack && bhi > alo + slack
+    })
+}

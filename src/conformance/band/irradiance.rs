@@ -177,6 +177,76 @@ fn mesh_irradiance_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, n:
     scale(top, band).min(scale(edge_on, band))
 }
 
+/// A masked dome's (its irradiance on the device is Lambert's formula summed over the portals,
+/// shaders/irradiance/portals.wgsl), from the f32 error model of [`mesh_irradiance_margin`]
+/// applied to each portal x is on the −Z side of and weighed by its share of the irradiance: a
+/// portal whose highest point is at elevation t over the horizon, or seen from t above its own
+/// plane (from its nearest outline point), and whose f32 geometry x resolves to η_k, is off by
+/// up to
+/// `MESH_SLIVER_WIDER · 2.5 · η_k / t` of its own Lambert value E_k (a sliver's k = 5/2, as
+/// `IRRADIANCE_SLIVER_FACTOR`), so the sum is off by `Σ E_k · that / Σ E_k`; the receiver is
+/// within the band where that reaches half the tolerance. (Sized on the whole set, as for a
+/// mesh light, the band excluded receivers near one window of a room lit through the others.)
+/// Where nothing seen is lit, the whole set's sliver decides, as for a mesh; and x's distance
+/// to each portal's plane as `band::portal_margin` measures it for radiance (a fraction of the
+/// portal's larger half extent, in its local units): closer, the f32 side test may count that
+/// portal or not.
+fn portal_irradiance_margin(portals: &[crate::prepare::PreparedPortal], x: DVec3, n: DVec3) -> f64 {
+    let k = 16;
+    let (mut sum, mut off) = (0.0, 0.0);
+    let mut seen = Vec::new();
+    for q in portals.iter().filter(|q| q.normal.dot(x - q.origin) < 0.0) {
+        let c = q.corners;
+        let mut points = Vec::with_capacity(4 * k);
+        for e in 0..4 {
+            let (a, b) = (c[e], c[(e + 1) % 4]);
+            points.extend((0..k).map(|j| a + (b - a) * (j as f64 / k as f64)));
+        }
+        let nearest = points
+            .iter()
+            .map(|p| (*p - x).length())
+            .fold(f64::INFINITY, f64::min);
+        let size = (c[2] - c[0]).length().max((c[3] - c[1]).length());
+        let eta = F32_ROUNDING * (x.length() + q.origin.length() + size) / nearest;
+        // How thin the portal looks: its highest elevation over the horizon (π/2 where the
+        // normal's ray passes through it), and x's elevation above its plane seen from its
+        // nearest outline point (π/2 where x lies over the portal itself).
+        let inside = |xl: DVec3| xl.x.abs() <= q.half.x && xl.y.abs() <= q.half.y;
+        let xl = q.to_local * (x - q.origin);
+        let nl = q.to_local * n;
+        let top = if nl.z > 0.0 && inside(xl - xl.z / nl.z * nl) {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            points
+                .iter()
+                .map(|p| n.dot((*p - x).normalize()).clamp(-1.0, 1.0).asin())
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let h = (x - q.origin).dot(q.normal);
+        let edge_on = if inside(xl) {
+            std::f64::consts::FRAC_PI_2
+        } else {
+            (h.abs() / nearest).min(1.0).asin()
+        };
+        let e = crate::cpu::irradiance::closed::polygon_irradiance(&c.map(|v| v - x), n)
+            * q.multiplier.max_element();
+        let t = top.min(edge_on).max(0.0);
+        sum += e;
+        off += e * (MESH_SLIVER_WIDER * 2.5 * eta / t).min(1.0);
+        let t = |p: [DVec3; 3]| crate::model::MeshTriangle { p, face: 0 };
+        seen.extend([t([c[0], c[1], c[2]]), t([c[0], c[2], c[3]])]);
+    }
+    let m = if sum > 0.0 {
+        BAND * (0.5 * crate::conformance::TOLERANCE) / (off / sum)
+    } else {
+        mesh_irradiance_margin(&seen, x, n)
+    };
+    portals
+        .iter()
+        .map(|q| (q.to_local * (x - q.origin)).z.abs() / q.half.x.max(q.half.y))
+        .fold(m, f64::min)
+}
+
 /// Distance of an irradiance receiver from the places where f32 legitimately cannot resolve the
 /// answer to 1e-4 (dimensionless, compared with [`BAND`]).
 ///
@@ -202,7 +272,12 @@ pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
     let mut m = f64::INFINITY;
     let xl = p.to_local * (x - p.origin);
     match p.light.kind {
-        LightType::Dome => return f64::INFINITY,
+        LightType::Dome => {
+            return p
+                .portals
+                .as_deref()
+                .map_or(f64::INFINITY, |q| portal_irradiance_margin(q, x, n));
+        }
         LightType::Distant { .. } => {
             let band = IRRADIANCE_SLIVER_FACTOR * 2.0 * F32_ROUNDING;
             let top = n.dot(-p.axis).clamp(-1.0, 1.0).asin() + p.distant_half_angle();
@@ -318,6 +393,35 @@ pub fn irradiance_margin(r: &Reference, x: DVec3, n: DVec3) -> f64 {
             .fold(f64::NEG_INFINITY, f64::max);
         if lit_distance.is_finite() {
             m = m.min(scale(lit_distance, IES_JUMP_BAND.max(band)));
+        } else if ies.angle_scale != 0.0 && ies.profile.kind == PhotometricType::A {
+            // None of the outline lit: the reference is 0 or nearly, compared with the floor.
+            // Type A's angleScale window edges θ' = 0 and 180 are its frame's poles, where
+            // every azimuth meets and the lookup takes H = 0 (§6 I2, `type_a_angles`); the
+            // GPU's f32 θ' rounds a band ~1e-5° wide onto them, lit where H = 0 is in range
+            // and its neighbours are not (measured: a disk dark on the reference, lit on
+            // lavapipe along the window edge at ~1e-9 of its scale, above the floor). So a
+            // light whose polar angles θ seen from x reach across a window edge (within the
+            // f32 direction's rounding) is excluded. θ' is increasing in θ, and θ's extremes
+            // over what x sees are on the outline or at the poles θ = 0, 180.
+            let thetas = outline
+                .iter()
+                .map(|q| type_c_angles((p.to_local * (x - *q)).normalize()).1);
+            let (mut lo, mut hi) =
+                thetas.fold((180.0f64, 0.0f64), |(lo, hi), t| (lo.min(t), hi.max(t)));
+            if radiance::hits_emitting_surface(p, x, -p.axis) {
+                lo = 0.0;
+            }
+            if radiance::hits_emitting_surface(p, x, p.axis) {
+                hi = 180.0;
+            }
+            let slack = IES_DIRECTION_ROUNDING.to_degrees();
+            let (t_lo, t_hi) = (
+                scale_polar_angle(lo - slack, ies.angle_scale),
+                scale_polar_angle(hi + slack, ies.angle_scale),
+            );
+            if [0.0, 180.0].iter().any(|edge| (t_lo..=t_hi).contains(edge)) {
+                m = 0.0;
+            }
         }
     }
     m
