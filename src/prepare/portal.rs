@@ -95,41 +95,45 @@ pub fn prepare_portals(
     Ok(Some(out))
 }
 
-/// How far (relative to its distance from the other portal's centre) a corner may lie on the
-/// passing side of another portal's plane and still count as behind it in
-/// [`cannot_hide_one_another`]: f64 rounding of coplanar portals' corners, ~1e-16 of it. A
-/// corner that far across lets only rays within ~1e-9 (relative) of both portals cross both.
-const BEHIND_SLACK: f64 = 1e-9;
+/// How far (relative to its distance from the other portal's centre) a corner may lie off
+/// another portal's plane and still count as in it in [`cannot_hide_one_another`]: f64
+/// rounding of coplanar portals' corners, ~1e-16 of it. A corner that far across lets only
+/// rays within ~1e-9 (relative) of both portals cross both.
+const PLANE_SLACK: f64 = 1e-9;
 
 /// Whether no ray can pass through two of `portals` toward their +Z (P2's crossings), so that a
 /// masked dome's irradiance is the sum over the portals of each one's own (the visible pieces of
-/// `cpu::portal::irradiance` are then the portals themselves): true when every portal lies on
-/// the closed −Z side of every other one's plane (a convex room's windows, coplanar panes) and
-/// no two in one plane facing the same way overlap.
-/// Proof: a ray that crosses A toward +Z at t_A is strictly on A's +Z side for t > t_A, where
-/// no point of B lies, so it cannot cross B later; by symmetry it cannot cross B earlier. It
-/// meets both at once only where their planes meet: on a line (measure zero) unless the planes
-/// are one, where facing opposite ways it cannot move toward both +Z, and facing the same way
-/// it passes through both only where they overlap (the overlap counts once, for the earlier
-/// portal, so such sets are refused).
-/// Sufficient, not necessary: sets it rejects keep their irradiance on the host.
+/// `cpu::portal::irradiance` are then the portals themselves). For two portals A and B a ray
+/// crosses A toward +Z at t_A and then B at t_B > t_A exactly when some point of A lies
+/// strictly on B's −Z side and some point of B strictly on A's +Z side:
+/// - only if: the ray moves toward +Z_B, so before t_B (at A's point) it is on B's −Z side, and
+///   toward +Z_A, so after t_A (at B's point) on A's +Z side;
+/// - if: through such points a of A and b of B, the ray from just before a along b − a crosses
+///   A toward +Z (b is above A's plane) and then B toward +Z (a is below B's), as do the rays
+///   near it (the conditions are open).
+///
+/// For convex portals "some point" is "some corner". Rays meeting both at once pass through
+/// the line where their planes meet (measure zero) unless the planes are one: facing opposite
+/// ways no ray moves toward both +Z, facing the same way it passes through both where they
+/// overlap (that overlap counts once, for the earlier portal, so such sets are refused too).
+/// So this is exact: a convex room's windows and skylights, several panes in one wall, and
+/// windows facing each other across a courtyard pass; a pane in front of a window does not.
 pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
-    let behind = |a: &PreparedPortal, b: &PreparedPortal| {
-        b.corners.iter().all(|c| {
+    // Whether some corner of `b` lies beyond `a`'s plane on the side `sign` (+1: +Z).
+    let beyond = |a: &PreparedPortal, b: &PreparedPortal, sign: f64| {
+        b.corners.iter().any(|c| {
             let d = *c - a.origin;
-            a.normal.dot(d) <= BEHIND_SLACK * d.length()
+            sign * a.normal.dot(d) > PLANE_SLACK * d.length()
         })
     };
-    let coplanar = |a: &PreparedPortal, b: &PreparedPortal| {
-        b.corners.iter().all(|c| {
-            let d = *c - a.origin;
-            a.normal.dot(d).abs() <= BEHIND_SLACK * d.length()
-        })
-    };
+    let coplanar =
+        |a: &PreparedPortal, b: &PreparedPortal| !beyond(a, b, 1.0) && !beyond(a, b, -1.0);
     portals.iter().enumerate().all(|(i, a)| {
-        portals.iter().enumerate().skip(i + 1).all(|(_, b)| {
-            behind(a, b)
-                && behind(b, a)
+        portals.iter().skip(i + 1).all(|b| {
+            let a_then_b = beyond(b, a, -1.0) && beyond(a, b, 1.0);
+            let b_then_a = beyond(a, b, -1.0) && beyond(b, a, 1.0);
+            !a_then_b
+                && !b_then_a
                 && !(coplanar(a, b) && a.normal.dot(b.normal) > 0.0 && overlap(a, b))
         })
     })
@@ -150,7 +154,7 @@ fn overlap(a: &PreparedPortal, b: &PreparedPortal) -> bool {
                 })
         };
         let ((alo, ahi), (blo, bhi)) = (range(a), range(b));
-        let slack = BEHIND_SLACK * ((ahi - alo) + (bhi - blo));
+        let slack = PLANE_SLACK * ((ahi - alo) + (bhi - blo));
         ahi > blo + slack && bhi > alo + slack
     })
 }
