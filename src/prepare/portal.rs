@@ -132,9 +132,8 @@ pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
         portals.iter().skip(i + 1).all(|b| {
             let a_then_b = beyond(b, a, -1.0) && beyond(a, b, 1.0);
             let b_then_a = beyond(a, b, -1.0) && beyond(b, a, 1.0);
-            !a_then_b
-                && !b_then_a
-                && !(coplanar(a, b) && a.normal.dot(b.normal) > 0.0 && overlap(a, b))
+            let overlapping = coplanar(a, b) && a.normal.dot(b.normal) > 0.0 && overlap(a, b);
+            !(a_then_b || b_then_a || overlapping)
         })
     })
 }
