@@ -255,7 +255,8 @@ mod tests {
     /// Every place where a direction's bilinear cell changes (the grid intervals `(H', V')` of
     /// the lookup falls in, or the range it leaves) lies on a surface that
     /// `prepare::ies_kinks` lists, for types C and A under angleScale (their families stay
-    /// cones and planes, so the device splits at them) and every type without it: random arcs
+    /// cones and planes, so the device splits at them) and every type without it or at ±1
+    /// (θ' = θ): random arcs
     /// walked in 4,000 steps, a cell change between two steps needing a listed surface that
     /// changes sign between them. Fails when type A under angleScale lists nothing (the old
     /// rule) or its cones are mirrored (`+cos θ`).
@@ -328,9 +329,9 @@ mod tests {
         let mut changes = 0;
         for p in &cases {
             let scales: &[f64] = if p.kind == PhotometricType::B {
-                &[0.0]
+                &[0.0, 1.0, -1.0]
             } else {
-                &[0.0, 0.8, 1.3, 0.45, -0.7, -1.4]
+                &[0.0, 0.8, 1.3, 0.45, -0.7, -1.4, 1.0, -1.0]
             };
             for &s in scales {
                 let k = ies_kinks(p, s);

@@ -12,7 +12,7 @@ pub enum GpuPath {
     Device,
     /// Every query on the device but irradiance, which is the CPU reference's until the f32
     /// quadrature can match it; the reason is a phrase ("it is a textured rect"):
-    /// - IES profiles of type B under angleScale: it bends their grid lines into
+    /// - IES profiles of type B under angleScale (but ±1): it bends their grid lines into
     ///   surfaces that are neither cones nor planes, which the kernel cannot split at
     ///   (`PreparedIes::device_families`; every other IES-shaped light is integrated on the
     ///   device, its lines split at the profile's grid cones and planes).

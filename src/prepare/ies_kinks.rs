@@ -10,7 +10,7 @@
 //! angleScale maps the polar angle θ about −Z to θ' = f(θ) and keeps the azimuth, which keeps
 //! cones around ±Z cones (at θ = f⁻¹(θ')) and planes through Z planes: types C and A keep
 //! their families. For type B it bends its surfaces (neither cones nor planes), which are then
-//! left to the adaptive rules.
+//! left to the adaptive rules, unless it is ±1 (θ' = θ).
 
 use glam::DVec3;
 
@@ -90,7 +90,8 @@ pub fn ies_kinks(profile: &Profile, s: f64) -> IesKinks {
                 }
             }
         }
-        PhotometricType::B if s == 0.0 => {
+        // angleScale ±1 maps θ to itself (§6 I4): nothing is bent.
+        PhotometricType::B if s == 0.0 || s.abs() == 1.0 => {
             for &v in &profile.v {
                 for a in mirror(v, profile.v_fold == VFold::Mirror) {
                     let a = a.to_radians();
@@ -367,5 +368,8 @@ pub(crate) mod tests {
         );
         assert_eq!(ies_kinks(&p, 0.7), IesKinks::default());
         assert!(!ies_kinks(&p, 0.0).planes.is_empty());
+        // ±1 maps θ to itself: the same kinks as 0.
+        assert_eq!(ies_kinks(&p, 1.0), ies_kinks(&p, 0.0));
+        assert_eq!(ies_kinks(&p, -1.0), ies_kinks(&p, 0.0));
     }
 }

@@ -61,11 +61,12 @@ pub struct PreparedIes {
 
 impl PreparedIes {
     /// The profile's kinks as the GPU quadrature streams them ([`ies_kinks::KinkFamilies`]);
-    /// None where the kernel cannot split at them: angleScale on type B bends the grid
-    /// lines into surfaces that are neither cones nor planes (the reference's adaptive rules
+    /// None where the kernel cannot split at them: angleScale (but ±1, which maps θ to itself)
+    /// on type B bends the grid lines into surfaces that are neither cones nor planes (the reference's adaptive rules
     /// take them, the f32 rule would miss them), so that light's irradiance is the host's.
     pub fn device_families(&self) -> Option<ies_kinks::KinkFamilies> {
-        let bent = self.angle_scale != 0.0 && self.profile.kind == ies::PhotometricType::B;
+        let s = self.angle_scale;
+        let bent = s != 0.0 && s.abs() != 1.0 && self.profile.kind == ies::PhotometricType::B;
         if bent { None } else { self.kinks.families() }
     }
 }
