@@ -123,7 +123,8 @@ fn up(v: f64) -> f32 {
 mod tests {
     use super::*;
     use crate::model::{Light, MeshGeometry, MeshTopology, Portal};
-    use crate::prepare::{GpuPath, MESH_FRONTS_ON_DEVICE, PortalMode, Prepared, TemperatureMode};
+    use crate::prepare::gpu_path::{MESH_FRONTS_ON_DEVICE, PORTALS_ON_DEVICE};
+    use crate::prepare::{GpuPath, PortalMode, Prepared, TemperatureMode};
     use glam::{DMat4, DVec3};
 
     /// A fan of `k` triangles about the origin, each tilted differently: `k` distinct fronts.
@@ -182,7 +183,7 @@ mod tests {
     /// host on every query, and nothing of it goes to the atlas.
     #[test]
     fn a_dome_masked_by_too_many_portals_stays_on_the_host() {
-        let dome = (0..=crate::prepare::PORTALS_ON_DEVICE).fold(Light::dome(), |l, i| {
+        let dome = (0..=PORTALS_ON_DEVICE).fold(Light::dome(), |l, i| {
             l.with_portal(
                 Portal::new(0.5, 0.5)
                     .with_transform(DMat4::from_translation(DVec3::new(i as f64, 0.0, 3.0))),

@@ -2,6 +2,10 @@
 //! from the CPU reference (DESIGN.md §1: made once in `prepare`, read by both sides), and the
 //! limits it applies.
 
+use glam::DMat3;
+
+use super::{KindData, PreparedIes, PreparedPortal, latlong_rows, portal};
+
 /// Where the GPU path takes a light's values from: the one decision, made per light when it is
 /// prepared, that the record (`FLAG_HOST_IRRADIANCE`, `FLAG_MESH_FRONTS`, or a record that emits
 /// nothing), the mesh atlas, the host's sums in `query::PreparedScene`, the GPU-resident
@@ -60,6 +64,67 @@ pub enum GpuPath {
     /// singular transform), and domes masked by more than [`PORTALS_ON_DEVICE`] portals. The
     /// record the kernels see emits nothing.
     Host(&'static str),
+}
+
+/// A light's [`GpuPath`] from what prepare made of it (`Prepared::with_assets`): its kind's
+/// data, whether it is shaped, its IES profile and its world → local map.
+pub(super) fn decide(
+    kind: &KindData,
+    shaped: bool,
+    ies: Option<&PreparedIes>,
+    to_local: &DMat3,
+) -> GpuPath {
+    if let KindData::Mesh {
+        bvh,
+        fronts,
+        occlusion,
+        ..
+    } = kind
+    {
+        let bytes = 32 * bvh.nodes.len() as u64 + 40 * bvh.order.len() as u64;
+        if bvh.depth() > MESH_STACK {
+            GpuPath::Host("it is a mesh light whose BVH is deeper than the kernel's stack")
+        } else if bytes > MESH_DEVICE_BYTES {
+            GpuPath::Host("it is a mesh light too large for the device")
+        } else if !to_local.is_finite() {
+            GpuPath::Host("it is a mesh light with a singular transform")
+        } else if fronts.len() > MESH_FRONTS_ON_DEVICE {
+            GpuPath::RadianceOnDevice(
+                "it is a mesh light facing more directions than the emission kernel tests",
+            )
+        } else if occlusion.free() && !shaped {
+            GpuPath::HostIntensityOnly(
+                "it is a mesh light (its triangles cannot hide one another: irradiance on the device)",
+            )
+        } else {
+            GpuPath::HostIntensity("it is a mesh light")
+        }
+    } else if ies.is_some_and(|i| i.device_families().is_none()) {
+        GpuPath::HostIrradiance("its IES profile's grid lines are bent by angleScale (type B)")
+    } else {
+        match kind {
+            KindData::Dome { texture: Some(t) } => latlong_rows::gpu_path(t),
+            KindData::Rect { texture: Some(_) } => GpuPath::HostIrradiance("it is a textured rect"),
+            _ => GpuPath::Device,
+        }
+    }
+}
+
+/// A dome's [`GpuPath`] once it is masked by `portals` (`Prepared::apply_portal_mode`, DESIGN.md
+/// §8 P2): emission and radiance on the device (up to [`PORTALS_ON_DEVICE`] portals), and
+/// irradiance too where it is untextured and its portals cannot hide one another
+/// ([`portal::cannot_hide_one_another`]: Lambert's formula summed over them,
+/// shaders/irradiance/portals.wgsl).
+pub(super) fn masked(portals: &[PreparedPortal], textured: bool) -> GpuPath {
+    if portals.len() > PORTALS_ON_DEVICE {
+        GpuPath::Host("it is masked by more portals than the radiance kernel tests")
+    } else if textured {
+        GpuPath::HostIrradiance("it is a textured dome masked by portals")
+    } else if !portal::cannot_hide_one_another(portals) {
+        GpuPath::HostIrradiance("it is masked by portals that may hide one another")
+    } else {
+        GpuPath::Device
+    }
 }
 
 /// The most distinct front directions of a mesh light whose emission the kernel tests

@@ -53,25 +53,38 @@ fn unscaled(theta_prime: f64, s: f64) -> Option<f64> {
     (0.0..=180.0).contains(&t).then_some(t)
 }
 
+/// Whether angleScale `s` bends a `kind` profile's grid surfaces into ones that are neither
+/// cones nor planes: type B's (its planes hold Y, which the polar remap about Z does not
+/// keep), unless `s` is 0 or ±1 (θ' = θ). [`ies_kinks`] lists no kinks for such a profile,
+/// and the device cannot split at them (`PreparedIes::device_families`).
+pub fn bent(kind: PhotometricType, s: f64) -> bool {
+    kind == PhotometricType::B && s != 0.0 && s.abs() != 1.0
+}
+
 /// The kinks and jumps of `profile` looked up with angleScale `s`.
 pub fn ies_kinks(profile: &Profile, s: f64) -> IesKinks {
     let mut k = IesKinks::default();
     let mirror = |x: f64, on: bool| if on { vec![x, -x] } else { vec![x] };
+    // The cone of the directions whose θ' (their polar angle θ about −Z after angleScale) is
+    // `theta_prime`, on the family's `axis` (±Z, so its cosine is `∓cos θ`).
+    let polar = |k: &mut IesKinks, axis: DVec3, theta_prime: f64| {
+        if let Some(t) = unscaled(theta_prime, s) {
+            k.cone(axis, -axis.z * t.to_radians().cos());
+        }
+    };
+    // angleScale's window θ' ∈ [0, 180], beyond which the factor is 0.
+    let window = |k: &mut IesKinks, axis: DVec3| {
+        if s != 0.0 {
+            polar(k, axis, 0.0);
+            polar(k, axis, 180.0);
+        }
+    };
     match profile.kind {
         PhotometricType::C => {
             for &v in &profile.v {
-                if let Some(t) = unscaled(v, s) {
-                    k.cone(DVec3::NEG_Z, t.to_radians().cos());
-                }
+                polar(&mut k, DVec3::NEG_Z, v);
             }
-            // angleScale's window θ' ∈ [0, 180].
-            if s != 0.0 {
-                for edge in [0.0, 180.0] {
-                    if let Some(t) = unscaled(edge, s) {
-                        k.cone(DVec3::NEG_Z, t.to_radians().cos());
-                    }
-                }
-            }
+            window(&mut k, DVec3::NEG_Z);
             if profile.h_fold != HFold::Constant {
                 for &h in &profile.h {
                     // A plane through Z holds azimuths H and H + 180; the folds add the mirror
@@ -90,8 +103,7 @@ pub fn ies_kinks(profile: &Profile, s: f64) -> IesKinks {
                 }
             }
         }
-        // angleScale ±1 maps θ to itself (§6 I4): nothing is bent.
-        PhotometricType::B if s == 0.0 || s.abs() == 1.0 => {
+        PhotometricType::B if !bent(PhotometricType::B, s) => {
             for &v in &profile.v {
                 for a in mirror(v, profile.v_fold == VFold::Mirror) {
                     let a = a.to_radians();
@@ -114,20 +126,15 @@ pub fn ies_kinks(profile: &Profile, s: f64) -> IesKinks {
             for &v in &profile.v {
                 for a in mirror(v, profile.v_fold == VFold::Mirror) {
                     if s == 0.0 {
+                        // sin V_A, as it always was for unscaled profiles (−cos(V_A + 90°)
+                        // differs from it in the last bits).
                         k.cone(DVec3::Z, a.to_radians().sin());
-                    } else if let Some(t) = unscaled(a + 90.0, s) {
-                        k.cone(DVec3::Z, -t.to_radians().cos());
+                    } else {
+                        polar(&mut k, DVec3::Z, a + 90.0);
                     }
                 }
             }
-            // angleScale's window θ' ∈ [0, 180], beyond which the factor is 0.
-            if s != 0.0 {
-                for edge in [0.0, 180.0] {
-                    if let Some(t) = unscaled(edge, s) {
-                        k.cone(DVec3::Z, -t.to_radians().cos());
-                    }
-                }
-            }
+            window(&mut k, DVec3::Z);
             let hs: Vec<f64> = if profile.h_fold == HFold::Constant {
                 vec![90.0]
             } else {

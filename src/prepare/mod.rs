@@ -34,10 +34,7 @@ use assets::AssetCache;
 pub use blackbody::TemperatureMode;
 use blackbody::temperature_rgb;
 use fits_f32::check_fits_f32;
-pub use gpu_path::{
-    GpuPath, MESH_DEVICE_BYTES, MESH_FRONTS_ON_DEVICE, MESH_STACK, MESH_TRIANGLES_SUMMED,
-    PORTALS_ON_DEVICE,
-};
+pub use gpu_path::{GpuPath, MESH_STACK, MESH_TRIANGLES_SUMMED};
 pub use mesh_class::MeshOcclusion;
 pub use portal::{PortalMode, PreparedPortal};
 pub use profile::{Kink, Profile};
@@ -65,9 +62,11 @@ impl PreparedIes {
     /// on type B bends the grid lines into surfaces that are neither cones nor planes (the reference's adaptive rules
     /// take them, the f32 rule would miss them), so that light's irradiance is the host's.
     pub fn device_families(&self) -> Option<ies_kinks::KinkFamilies> {
-        let s = self.angle_scale;
-        let bent = s != 0.0 && s.abs() != 1.0 && self.profile.kind == ies::PhotometricType::B;
-        if bent { None } else { self.kinks.families() }
+        if ies_kinks::bent(self.profile.kind, self.angle_scale) {
+            None
+        } else {
+            self.kinks.families()
+        }
     }
 }
 
@@ -271,15 +270,7 @@ impl Prepared {
     ) -> Result<()> {
         self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
         if let Some(portals) = &self.portals {
-            self.gpu_path = if portals.len() > PORTALS_ON_DEVICE {
-                GpuPath::Host("it is masked by more portals than the radiance kernel tests")
-            } else if self.dome_texture().is_some() {
-                GpuPath::HostIrradiance("it is a textured dome masked by portals")
-            } else if !portal::cannot_hide_one_another(portals) {
-                GpuPath::HostIrradiance("it is masked by portals that may hide one another")
-            } else {
-                GpuPath::Device
-            };
+            self.gpu_path = gpu_path::masked(portals, self.dome_texture().is_some());
         }
         Ok(())
     }
@@ -431,42 +422,7 @@ impl Prepared {
                 KindData::Shape
             }
         };
-        let gpu_path = if let KindData::Mesh {
-            bvh,
-            fronts,
-            occlusion,
-            ..
-        } = &kind
-        {
-            let bytes = 32 * bvh.nodes.len() as u64 + 40 * bvh.order.len() as u64;
-            if bvh.depth() > MESH_STACK {
-                GpuPath::Host("it is a mesh light whose BVH is deeper than the kernel's stack")
-            } else if bytes > MESH_DEVICE_BYTES {
-                GpuPath::Host("it is a mesh light too large for the device")
-            } else if !to_local.is_finite() {
-                GpuPath::Host("it is a mesh light with a singular transform")
-            } else if fronts.len() > MESH_FRONTS_ON_DEVICE {
-                GpuPath::RadianceOnDevice(
-                    "it is a mesh light facing more directions than the emission kernel tests",
-                )
-            } else if occlusion.free() && shaping.is_none() {
-                GpuPath::HostIntensityOnly(
-                    "it is a mesh light (its triangles cannot hide one another: irradiance on the device)",
-                )
-            } else {
-                GpuPath::HostIntensity("it is a mesh light")
-            }
-        } else if ies.as_ref().is_some_and(|i| i.device_families().is_none()) {
-            GpuPath::HostIrradiance("its IES profile's grid lines are bent by angleScale (type B)")
-        } else {
-            match &kind {
-                KindData::Dome { texture: Some(t) } => latlong_rows::gpu_path(t),
-                KindData::Rect { texture: Some(_) } => {
-                    GpuPath::HostIrradiance("it is a textured rect")
-                }
-                _ => GpuPath::Device,
-            }
-        };
+        let gpu_path = gpu_path::decide(&kind, shaping.is_some(), ies.as_ref(), &to_local);
         // The files the assets above were loaded from (the profile's, the texture's).
         let files_read = [
             evaluated

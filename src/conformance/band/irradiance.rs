@@ -134,14 +134,10 @@ const MESH_SLIVER_WIDER: f64 = 4.0;
 /// its plane and 1.5 from its centre, measured on lavapipe).
 fn mesh_irradiance_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, n: DVec3) -> f64 {
     let scale = |v: f64, band: f64| v.abs() / band * BAND;
-    let k = 16;
-    let mut points = Vec::with_capacity(triangles.len() * 3 * k);
-    for t in triangles {
-        for e in 0..3 {
-            let (a, b) = (t.p[e], t.p[(e + 1) % 3]);
-            points.extend((0..k).map(|j| a + (b - a) * (j as f64 / k as f64)));
-        }
-    }
+    let points: Vec<DVec3> = triangles
+        .iter()
+        .flat_map(|t| outline_points(&t.p))
+        .collect();
     if points.is_empty() {
         return f64::INFINITY;
     }
@@ -177,37 +173,48 @@ fn mesh_irradiance_margin(triangles: &[crate::model::MeshTriangle], x: DVec3, n:
     scale(top, band).min(scale(edge_on, band))
 }
 
+/// Points along the edges of the polygon `corners` (closed), 16 an edge: where the
+/// irradiance margins look at what x sees of a mesh triangle or a portal.
+fn outline_points(corners: &[DVec3]) -> impl Iterator<Item = DVec3> + '_ {
+    let k = 16;
+    (0..corners.len()).flat_map(move |e| {
+        let (a, b) = (corners[e], corners[(e + 1) % corners.len()]);
+        (0..k).map(move |j| a + (b - a) * (j as f64 / k as f64))
+    })
+}
+
 /// A masked dome's (its irradiance on the device is Lambert's formula summed over the portals,
 /// shaders/irradiance/portals.wgsl), from the f32 error model of [`mesh_irradiance_margin`]
 /// applied to each portal x is on the −Z side of and weighed by its share of the irradiance: a
 /// portal whose highest point is at elevation t over the horizon, or seen from t above its own
 /// plane (from its nearest outline point), and whose f32 geometry x resolves to η_k, is off by
-/// up to
-/// `MESH_SLIVER_WIDER · 2.5 · η_k / t` of its own Lambert value E_k (a sliver's k = 5/2, as
-/// `IRRADIANCE_SLIVER_FACTOR`), so the sum is off by `Σ E_k · that / Σ E_k`; the receiver is
-/// within the band where that reaches half the tolerance. (Sized on the whole set, as for a
+/// up to `MESH_SLIVER_WIDER · 2.5 · η_k / t` of its own Lambert value E_k (a sliver's k = 5/2,
+/// the band `MESH_SLIVER_WIDER · IRRADIANCE_SLIVER_FACTOR · η_k` over t in units of half the
+/// tolerance), so the sum is off by `Σ E_k · that / Σ E_k`; the receiver is within the band
+/// where that reaches half the tolerance. (Sized on the whole set, as for a
 /// mesh light, the band excluded receivers near one window of a room lit through the others.)
 /// Where nothing seen is lit, the whole set's sliver decides, as for a mesh; and x's distance
 /// to each portal's plane as `band::portal_margin` measures it for radiance (a fraction of the
 /// portal's larger half extent, in its local units): closer, the f32 side test may count that
 /// portal or not.
 fn portal_irradiance_margin(portals: &[crate::prepare::PreparedPortal], x: DVec3, n: DVec3) -> f64 {
-    let k = 16;
+    // Σ E_k and Σ E_k · (portal k's error in units of half the tolerance, at most 1/(half the
+    // tolerance): all of it).
     let (mut sum, mut off) = (0.0, 0.0);
-    let mut seen = Vec::new();
-    for q in portals.iter().filter(|q| q.normal.dot(x - q.origin) < 0.0) {
+    let seen: Vec<_> = portals
+        .iter()
+        .filter(|q| q.normal.dot(x - q.origin) < 0.0)
+        .collect();
+    for q in &seen {
         let c = q.corners;
-        let mut points = Vec::with_capacity(4 * k);
-        for e in 0..4 {
-            let (a, b) = (c[e], c[(e + 1) % 4]);
-            points.extend((0..k).map(|j| a + (b - a) * (j as f64 / k as f64)));
-        }
+        let points: Vec<DVec3> = outline_points(&c).collect();
         let nearest = points
             .iter()
             .map(|p| (*p - x).length())
             .fold(f64::INFINITY, f64::min);
         let size = (c[2] - c[0]).length().max((c[3] - c[1]).length());
         let eta = F32_ROUNDING * (x.length() + q.origin.length() + size) / nearest;
+        let band = MESH_SLIVER_WIDER * IRRADIANCE_SLIVER_FACTOR * eta;
         // How thin the portal looks: its highest elevation over the horizon (π/2 where the
         // normal's ray passes through it), and x's elevation above its plane seen from its
         // nearest outline point (π/2 where x lies over the portal itself).
@@ -232,14 +239,20 @@ fn portal_irradiance_margin(portals: &[crate::prepare::PreparedPortal], x: DVec3
             * q.multiplier.max_element();
         let t = top.min(edge_on).max(0.0);
         sum += e;
-        off += e * (MESH_SLIVER_WIDER * 2.5 * eta / t).min(1.0);
-        let t = |p: [DVec3; 3]| crate::model::MeshTriangle { p, face: 0 };
-        seen.extend([t([c[0], c[1], c[2]]), t([c[0], c[2], c[3]])]);
+        off += e * (band / t).min(1.0 / (0.5 * crate::conformance::TOLERANCE));
     }
     let m = if sum > 0.0 {
-        BAND * (0.5 * crate::conformance::TOLERANCE) / (off / sum)
+        BAND / (off / sum)
     } else {
-        mesh_irradiance_margin(&seen, x, n)
+        let triangle = |p: [DVec3; 3]| crate::model::MeshTriangle { p, face: 0 };
+        let triangles: Vec<_> = seen
+            .iter()
+            .flat_map(|q| {
+                let c = q.corners;
+                [triangle([c[0], c[1], c[2]]), triangle([c[0], c[2], c[3]])]
+            })
+            .collect();
+        mesh_irradiance_margin(&triangles, x, n)
     };
     portals
         .iter()

@@ -151,30 +151,58 @@ fn node_value(t: &Rows, r: usize, hz: &Horizon, theta: f64) -> DVec3 {
 /// there, however close the interval comes to the tangency.
 fn interval_integral(t: &Rows, r: usize, hz: &Horizon, lo: f64, hi: f64, tangent: f64) -> DVec3 {
     let (x, w) = gauss_legendre(IRR_GL_ROWS);
+    about_tangent(lo, hi, tangent, (&x, &w), |theta| {
+        node_value(t, r, hz, theta)
+    })
+}
+
+/// `∫_lo^hi f(θ) dθ` by the Gauss–Legendre rule `(x, w)` on [0, 1] in `σ = √|θ − tangent|`
+/// (`θ = tangent ± σ²`, `dθ = 2σ dσ`), `tangent` outside (lo, hi): where the horizon is tangent
+/// to a row the lit arc's half-width has a square-root branch point, smooth in σ. Shared
+/// with the CPU sweep's crossed pieces (`dome/latlong/crossed.rs`).
+pub(crate) fn about_tangent(
+    lo: f64,
+    hi: f64,
+    tangent: f64,
+    (x, w): (&[f64], &[f64]),
+    mut f: impl FnMut(f64) -> DVec3,
+) -> DVec3 {
     let above = lo >= tangent;
     let (s0, s1) = if above {
-        ((lo - tangent).sqrt(), (hi - tangent).sqrt())
+        (
+            (lo - tangent).max(0.0).sqrt(),
+            (hi - tangent).max(0.0).sqrt(),
+        )
     } else {
-        ((tangent - hi).sqrt(), (tangent - lo).sqrt())
+        (
+            (tangent - hi).max(0.0).sqrt(),
+            (tangent - lo).max(0.0).sqrt(),
+        )
     };
     let len = s1 - s0;
     let mut sum = DVec3::ZERO;
-    for (g, wt) in x.iter().zip(&w) {
+    for (g, wt) in x.iter().zip(w) {
         let sigma = s0 + len * g;
         let theta = if above {
             tangent + sigma * sigma
         } else {
             tangent - sigma * sigma
         };
-        sum += node_value(t, r, hz, theta) * (wt * len * 2.0 * sigma);
+        sum += f(theta) * (wt * len * 2.0 * sigma);
     }
     sum
 }
 
 /// The θ at which the horizon crosses the meridian `u` with `cos(u − ψ) = c`.
 fn crossing_theta(hz: &Horizon, c: f64) -> f64 {
-    let sg = if hz.ny >= 0.0 { 1.0 } else { -1.0 };
-    hz.ny.abs().atan2(-hz.rho * c * sg)
+    horizon_crossing(hz.ny, hz.rho, c)
+}
+
+/// The θ ∈ [0, π] where `a cos θ + ρ sin θ c = 0`: where the horizon `m·d = a cos θ + ρ sin θ
+/// cos(φ − φ₀)` ends an arc at `cos(φ − φ₀) = c` (shared with `dome/latlong/crossed.rs`).
+pub(crate) fn horizon_crossing(a: f64, rho: f64, c: f64) -> f64 {
+    let sg = if a >= 0.0 { 1.0 } else { -1.0 };
+    a.abs().atan2(-rho * c * sg)
 }
 
 /// `E = ∫ tex(d) max(0, n·d) dd` for the dome-space unit normal `n` (module docs).

@@ -102,6 +102,36 @@ mod tests {
             .count()
     }
 
+    /// Uniform in the cube [−r, r]³.
+    fn in_cube(rng: &mut Rng, r: f64) -> DVec3 {
+        DVec3::new(rng.range(-r, r), rng.range(-r, r), rng.range(-r, r))
+    }
+
+    /// The most portals one of `rays` rays crosses toward their +Z ([`crossed`]): from points
+    /// uniform in [−r, r]³, half in uniform directions, half aimed at a uniform point of a
+    /// portal.
+    fn most_crossed(
+        rng: &mut Rng,
+        portals: &[crate::prepare::PreparedPortal],
+        r: f64,
+        rays: usize,
+    ) -> usize {
+        (0..rays)
+            .map(|_| {
+                let x = in_cube(rng, r);
+                let w = if rng.chance(0.5) {
+                    rng.unit()
+                } else {
+                    let c = portals[rng.below(portals.len())].corners;
+                    let (s, t) = (rng.f64(), rng.f64());
+                    (c[0] + (c[1] - c[0]) * s + (c[3] - c[0]) * t - x).normalize()
+                };
+                crossed(portals, x, w)
+            })
+            .max()
+            .unwrap_or(0)
+    }
+
     /// Windows on the walls of a box room (several a wall, coplanar) cannot hide one another
     /// unless two on one wall overlap; a window and a pane outside it, in front, can. Checked
     /// by brute force: no ray crosses two portals of a set the predicate accepts toward their
@@ -122,24 +152,7 @@ mod tests {
             let p = masked(ps);
             let portals = p.portals.as_ref().unwrap();
             let apart = cannot_hide_one_another(portals);
-            let mut most: usize = 0;
-            for _ in 0..3000 {
-                let x = DVec3::new(
-                    rng.range(-1.5, 1.5),
-                    rng.range(-1.5, 1.5),
-                    rng.range(-1.5, 1.5),
-                );
-                let w = if rng.chance(0.5) {
-                    rng.unit()
-                } else {
-                    // Aimed at a portal's inside.
-                    let q = &portals[rng.below(portals.len())];
-                    let s = (rng.range(0.0, 1.0), rng.range(0.0, 1.0));
-                    let c = q.corners;
-                    (c[0] + (c[1] - c[0]) * s.0 + (c[3] - c[0]) * s.1 - x).normalize()
-                };
-                most = most.max(crossed(portals, x, w));
-            }
+            let most = most_crossed(&mut rng, portals, 1.5, 3000);
             if apart {
                 accepted += 1;
                 assert!(most <= 1, "case {case}: a ray crosses {most} portals");
@@ -203,11 +216,7 @@ mod tests {
                 .map(|_| {
                     let rot = DQuat::from_rotation_arc(DVec3::Z, rng.unit())
                         * DQuat::from_rotation_z(rng.range(0.0, 6.3));
-                    let c = DVec3::new(
-                        rng.range(-3.0, 3.0),
-                        rng.range(-3.0, 3.0),
-                        rng.range(-3.0, 3.0),
-                    );
+                    let c = in_cube(&mut rng, 3.0);
                     Portal::new(rng.range(0.5, 3.0), rng.range(0.5, 3.0))
                         .with_transform(DMat4::from_rotation_translation(rot, c))
                 })
@@ -216,25 +225,11 @@ mod tests {
             let portals = p.portals.as_ref().unwrap();
             if cannot_hide_one_another(portals) {
                 accepted += 1;
-                for _ in 0..4000 {
-                    let x = DVec3::new(
-                        rng.range(-5.0, 5.0),
-                        rng.range(-5.0, 5.0),
-                        rng.range(-5.0, 5.0),
-                    );
-                    let w = if rng.chance(0.5) {
-                        rng.unit()
-                    } else {
-                        let q = &portals[rng.below(portals.len())];
-                        let c = q.corners;
-                        let (s, t) = (rng.f64(), rng.f64());
-                        (c[0] + (c[1] - c[0]) * s + (c[3] - c[0]) * t - x).normalize()
-                    };
-                    assert!(
-                        crossed(portals, x, w) <= 1,
-                        "case {case}: accepted, {x} {w}"
-                    );
-                }
+                let most = most_crossed(&mut rng, portals, 5.0, 4000);
+                assert!(
+                    most <= 1,
+                    "case {case}: accepted, a ray crosses {most} portals"
+                );
             } else {
                 refused += 1;
                 let centre = |q: &PreparedPortal| (q.corners[0] + q.corners[2]) * 0.5;
@@ -298,11 +293,7 @@ mod tests {
             }
             sets += 1;
             for _ in 0..40 {
-                let x = DVec3::new(
-                    rng.range(-2.5, 2.5),
-                    rng.range(-2.5, 2.5),
-                    rng.range(-2.5, 2.5),
-                );
+                let x = in_cube(&mut rng, 2.5);
                 let n = rng.unit();
                 let want = crate::cpu::portal::irradiance(&p, portals, x, n);
                 let got = p.base * portals_lambert(portals, x, n);

@@ -5,6 +5,7 @@ use glam::DVec3;
 
 use super::Axes;
 use crate::cpu::irradiance::dome::DomeIrradiance;
+use crate::cpu::irradiance::latlong_rows::{about_tangent, horizon_crossing};
 
 impl DomeIrradiance {
     /// A crossed piece's exact part, the value `DomeIrradiance::crossed` integrates with the
@@ -106,36 +107,14 @@ impl DomeIrradiance {
             if hi <= lo {
                 continue;
             }
-            // σ = √|θ − θ_t| about the nearer tangency (the arc's half-width has a square-root
-            // branch point there).
+            // The rule runs about the nearer tangency.
             let [t1, t2] = hz.tangents;
             let tangent = if lo >= t2 || lo - t1 > t2 - hi {
                 t2
             } else {
                 t1
             };
-            let above = lo >= tangent;
-            let (s0, s1) = if above {
-                (
-                    (lo - tangent).max(0.0).sqrt(),
-                    (hi - tangent).max(0.0).sqrt(),
-                )
-            } else {
-                (
-                    (tangent - hi).max(0.0).sqrt(),
-                    (tangent - lo).max(0.0).sqrt(),
-                )
-            };
-            let len = s1 - s0;
-            for (x, wt) in xs.iter().zip(ws) {
-                let sigma = s0 + len * x;
-                let theta = if above {
-                    tangent + sigma * sigma
-                } else {
-                    tangent - sigma * sigma
-                };
-                total += inner(theta) * (wt * len * 2.0 * sigma);
-            }
+            total += about_tangent(lo, hi, tangent, (xs, ws), &inner);
         }
         total * hz.weight
     }
@@ -178,8 +157,7 @@ impl Horizon {
 
     /// The θ ∈ [0, π] where `a cos θ + ρ sin θ c = 0` (the arc end at `cos ψ = c`).
     fn crossing(&self, c: f64) -> f64 {
-        let sg = if self.a >= 0.0 { 1.0 } else { -1.0 };
-        self.a.abs().atan2(-self.rho * c * sg)
+        horizon_crossing(self.a, self.rho, c)
     }
 }
 
