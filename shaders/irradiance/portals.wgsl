@@ -1,54 +1,164 @@
-// The irradiance of an untextured dome masked by portals that cannot hide one another
-// (DESIGN.md §8 P2 mask mode; prepare::portal::cannot_hide_one_another): the dome's radiance is
-// uniform and a ray passes through at most one portal, so the irradiance is the sum over the
-// portals x is on the −Z side of of the portal's multiplier times Lambert's formula on its
-// parallelogram clipped at the horizon. Twin of src/cpu/irradiance/portals.rs, which carries
-// the proof; a textured dome, or portals that may hide one another, keep their irradiance on
-// the host (GpuPath::HostIrradiance).
+// The irradiance of an untextured dome masked by portals (DESIGN.md §8 P2 mask mode) where the
+// device sums it (prepare::portal::overlaps): the dome's radiance is uniform, and a ray that
+// crosses several portals crosses portals of one multiplier, so the irradiance is the sum over
+// the portals x is on the −Z side of of the portal's multiplier times Lambert's formula on its
+// parallelogram clipped at the horizon, less (by inclusion–exclusion) the same over the
+// overlaps the mesh atlas lists after the portals, each the first portal's parallelogram
+// clipped to the cones from x over the others. Twin of src/cpu/irradiance/portals.rs, which
+// carries the proof; a textured dome, or portals that may hide one another with different
+// multipliers, keep their irradiance on the host (GpuPath::HostIrradiance).
 //
 // f32: the parallelogram is two triangles through mesh/lambert.wgsl's triangle_lambert (with
 //   its sliver form for portals low over the horizon); the CPU takes Lambert's formula on the
-//   four corners (the shared diagonal's terms cancel in exact arithmetic).
+//   four corners (the shared diagonal's terms cancel in exact arithmetic). An overlap's
+//   polygon is a fan of triangles on both.
 // f32: the side test is the f32 sign of normal·(x − origin), as the radiance kernel's
 //   (portal.wgsl); a receiver within ~1e-6 (relative) of a portal's plane may count it or not
 //   differently from the reference, where the portal is seen edge-on (the conformance check
 //   excludes that band, conformance::band::irradiance_margin).
+// f32: clip_to_cone writes at most PORTAL_OVERLAP_VERTICES vertices (gpu::mesh_atlas): a convex
+//   polygon gains at most one a clip (4 + 4·3 for four portals), and a rounded one that would gain more keeps the
+//   first ones (the CPU's Vec has no bound).
+// GPU-only portal_seen, portal_corners: they read a portal's words in the mesh atlas (the CPU
+//   reads PreparedPortal's fields).
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: a portal costs at
-//   most ~25 (two triangles), so up to ~2,600 portals stay inside it; the portal loop checks its
-//   own condition after it ends and sets irr_cut if it stopped short, and the host recomputes
+//   most ~25 (two triangles), an overlap of four at most ~360 (prepare::portal::MOST_OVERLAPS),
+//   so up to ~2,600 portals without overlaps stay inside it; each loop checks its own
+//   condition after it ends and sets irr_cut if it stopped short, and the host recomputes
 //   that receiver (shared/record.wgsl).
 
 // #import shared/record.wgsl
 // #import mesh/lambert.wgsl
 
+// A convex polygon (vectors from x) of `count` vertices.
+struct OverlapPolygon {
+    p: array<vec3<f32>, PORTAL_OVERLAP_VERTICES>,
+    count: u32,
+}
+
 // Σ multiplier · Lambert(portal clipped at n·ω ≥ 0) over the portals at `at` in the mesh atlas
-// (layout: src/gpu/mesh_atlas.rs) whose −Z side x is on.
+// (layout: src/gpu/mesh_atlas.rs) whose −Z side x is on, and ± multiplier · Lambert(overlap)
+// over the overlaps after them whose every portal x is on the −Z side of.
 fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let count = bitcast<u32>(mesh_atlas[at]);
     var sum = vec3<f32>(0.0);
     var k = 0u;
     for (; k < count; k++) {
         let q = at + 1u + k * PORTAL_WORDS;
-        let origin = vec3<f32>(mesh_atlas[q], mesh_atlas[q + 1u], mesh_atlas[q + 2u]);
-        let normal = vec3<f32>(mesh_atlas[q + 3u], mesh_atlas[q + 4u], mesh_atlas[q + 5u]);
-        if !(dot(normal, x - origin) < 0.0) {
+        if !portal_seen(q, x) {
             continue;
         }
-        let q0 = vec3<f32>(mesh_atlas[q + 20u], mesh_atlas[q + 21u], mesh_atlas[q + 22u]) - x;
-        let e1 = vec3<f32>(mesh_atlas[q + 23u], mesh_atlas[q + 24u], mesh_atlas[q + 25u]);
-        let e3 = vec3<f32>(mesh_atlas[q + 26u], mesh_atlas[q + 27u], mesh_atlas[q + 28u]);
-        let q1 = q0 + e1;
-        let q3 = q0 + e3;
-        let q2 = q1 + e3;
-        let above = max(max(dot(n, q0), dot(n, q1)), max(dot(n, q2), dot(n, q3))) > 0.0;
+        let c = portal_corners(q, x);
+        let above = max(max(dot(n, c[0]), dot(n, c[1])), max(dot(n, c[2]), dot(n, c[3]))) > 0.0;
         if above {
             let m = vec3<f32>(mesh_atlas[q + 17u], mesh_atlas[q + 18u], mesh_atlas[q + 19u]);
-            sum += m * (triangle_lambert(q0, q1, q2, n) + triangle_lambert(q0, q2, q3, n));
+            sum += m * (triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n));
         }
     }
     if k < count {
         // Cut short by the device's loop budget (see irr_cut).
         irr_cut = true;
     }
+    let sets_at = at + 1u + count * PORTAL_WORDS;
+    let sets = bitcast<u32>(mesh_atlas[sets_at]);
+    var s = 0u;
+    for (; s < sets; s++) {
+        let o = sets_at + 1u + s * PORTAL_OVERLAP_WORDS;
+        var size = 0u;
+        var all_seen = true;
+        for (var j = 0u; j < PORTAL_OVERLAP_WORDS; j++) {
+            let member = bitcast<u32>(mesh_atlas[o + j]);
+            if member == 0xffffffffu {
+                break;
+            }
+            size += 1u;
+            all_seen = all_seen && portal_seen(at + 1u + member * PORTAL_WORDS, x);
+        }
+        if all_seen {
+            let q = at + 1u + bitcast<u32>(mesh_atlas[o]) * PORTAL_WORDS;
+            let m = vec3<f32>(mesh_atlas[q + 17u], mesh_atlas[q + 18u], mesh_atlas[q + 19u]);
+            let sign = select(1.0, -1.0, size % 2u == 0u);
+            sum += sign * m * overlap_lambert(at, o, size, x, n);
+        }
+    }
+    if s < sets {
+        irr_cut = true;
+    }
     return sum;
+}
+
+// Lambert's formula (clipped at n·ω ≥ 0) on what x sees through each of the `size` portals
+// listed at `o`: the first one's parallelogram clipped to the cones over the others, as a fan.
+fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
+    let first = portal_corners(at + 1u + bitcast<u32>(mesh_atlas[o]) * PORTAL_WORDS, x);
+    var poly: OverlapPolygon;
+    poly.count = 4u;
+    for (var i = 0u; i < 4u; i++) {
+        poly.p[i] = first[i];
+    }
+    for (var j = 1u; j < size; j++) {
+        let cone = portal_corners(at + 1u + bitcast<u32>(mesh_atlas[o + j]) * PORTAL_WORDS, x);
+        poly = clip_to_cone(poly, cone);
+        if poly.count < 3u {
+            return 0.0;
+        }
+    }
+    var above = false;
+    for (var i = 0u; i < poly.count; i++) {
+        above = above || dot(n, poly.p[i]) > 0.0;
+    }
+    if !above {
+        return 0.0;
+    }
+    var sum = 0.0;
+    for (var i = 1u; i + 1u < poly.count; i++) {
+        sum += triangle_lambert(poly.p[0], poly.p[i], poly.p[i + 1u], n);
+    }
+    return sum;
+}
+
+// The part of `poly` inside the cone from x over the convex quadrilateral `cone` (vectors from
+// x): clipped to k·v ≥ 0 for each edge's plane through x, k toward the other corners.
+fn clip_to_cone(poly: OverlapPolygon, cone: array<vec3<f32>, 4>) -> OverlapPolygon {
+    var cur = poly;
+    for (var e = 0u; e < 4u; e++) {
+        var k = cross(cone[e], cone[(e + 1u) % 4u]);
+        if dot(k, cone[(e + 2u) % 4u]) < 0.0 {
+            k = -k;
+        }
+        var out: OverlapPolygon;
+        out.count = 0u;
+        for (var i = 0u; i < cur.count; i++) {
+            let p0 = cur.p[i];
+            let p1 = cur.p[(i + 1u) % cur.count];
+            let d0 = dot(k, p0);
+            let d1 = dot(k, p1);
+            if d0 >= 0.0 && out.count < PORTAL_OVERLAP_VERTICES {
+                out.p[out.count] = p0;
+                out.count += 1u;
+            }
+            if (d0 >= 0.0) != (d1 >= 0.0) && out.count < PORTAL_OVERLAP_VERTICES {
+                out.p[out.count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
+                out.count += 1u;
+            }
+        }
+        cur = out;
+    }
+    return cur;
+}
+
+// Whether x is on the −Z side of the portal whose words start at q.
+fn portal_seen(q: u32, x: vec3<f32>) -> bool {
+    let origin = vec3<f32>(mesh_atlas[q], mesh_atlas[q + 1u], mesh_atlas[q + 2u]);
+    let normal = vec3<f32>(mesh_atlas[q + 3u], mesh_atlas[q + 4u], mesh_atlas[q + 5u]);
+    return dot(normal, x - origin) < 0.0;
+}
+
+// The corners of the portal whose words start at q, as vectors from x: c0, c0 + e1,
+// c0 + e1 + e3, c0 + e3.
+fn portal_corners(q: u32, x: vec3<f32>) -> array<vec3<f32>, 4> {
+    let q0 = vec3<f32>(mesh_atlas[q + 20u], mesh_atlas[q + 21u], mesh_atlas[q + 22u]) - x;
+    let e1 = vec3<f32>(mesh_atlas[q + 23u], mesh_atlas[q + 24u], mesh_atlas[q + 25u]);
+    let e3 = vec3<f32>(mesh_atlas[q + 26u], mesh_atlas[q + 27u], mesh_atlas[q + 28u]);
+    return array<vec3<f32>, 4>(q0, q0 + e1, q0 + e1 + e3, q0 + e3);
 }

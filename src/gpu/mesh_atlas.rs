@@ -20,8 +20,11 @@
 //! a portal, in the `portals` relationship's order (ties go to the earlier): origin xyz, unit
 //! normal xyz, the world → local map's rows (3 × 3), half width and height, multiplier rgb,
 //! then its parallelogram as corner `c0` (local −,−) and edges `c1 − c0`, `c3 − c0` (xyz each,
-//! subtracted in f64, then rounded). The record's `tex.w` holds the
-//! block's offset and `FLAG_PORTALS` says it is there (a textured dome keeps `tex.xyz`).
+//! subtracted in f64, then rounded); then the overlaps whose irradiance terms the device sums
+//! (`Prepared::portal_overlaps`, read by shaders/irradiance/portals.wgsl): their count as u32
+//! bits, then [`OVERLAP_WORDS`] words each, the portals' indices ascending as u32 bits,
+//! `u32::MAX` past the last. The record's `tex.w` holds the block's offset and `FLAG_PORTALS`
+//! says it is there (a textured dome keeps `tex.xyz`).
 
 use crate::prepare::{KindData, Prepared};
 
@@ -29,14 +32,21 @@ use crate::prepare::{KindData, Prepared};
 pub const NODE_WORDS: u32 = 8;
 pub const TRIANGLE_WORDS: u32 = 10;
 pub const PORTAL_WORDS: u32 = 29;
+/// Words per overlap: the most portals one ray may cross that the kernel clips.
+pub const OVERLAP_WORDS: u32 = crate::prepare::portal::MOST_PORTALS_ONE_RAY_CROSSES as u32;
 
-/// The constants shaders/mesh/ray.wgsl and shaders/portal.wgsl read from the WGSL prelude.
-pub fn wgsl_constants() -> [(&'static str, u32); 4] {
+/// The constants shaders/mesh/ray.wgsl, shaders/portal.wgsl and shaders/irradiance/portals.wgsl
+/// read from the WGSL prelude.
+pub fn wgsl_constants() -> [(&'static str, u32); 6] {
     [
         ("MESH_NODE_WORDS", NODE_WORDS),
         ("MESH_TRIANGLE_WORDS", TRIANGLE_WORDS),
         ("MESH_STACK", crate::prepare::MESH_STACK as u32),
         ("PORTAL_WORDS", PORTAL_WORDS),
+        ("PORTAL_OVERLAP_WORDS", OVERLAP_WORDS),
+        // A convex polygon gains at most one vertex a clip: the first portal's four, then one
+        // for each edge of the others (shaders/irradiance/portals.wgsl).
+        ("PORTAL_OVERLAP_VERTICES", 4 * OVERLAP_WORDS),
     ]
 }
 
@@ -66,6 +76,13 @@ pub fn scene_atlas(lights: &[Prepared]) -> (Vec<f32>, Vec<Option<[u32; 4]>>) {
                     for v in [c[0], c[1] - c[0], c[3] - c[0]] {
                         data.extend(v.to_array().map(|x| x as f32));
                     }
+                }
+                data.push(f32::from_bits(p.portal_overlaps.len() as u32));
+                for set in &p.portal_overlaps {
+                    data.extend(
+                        (0..OVERLAP_WORDS as usize)
+                            .map(|k| f32::from_bits(set.get(k).copied().unwrap_or(u32::MAX))),
+                    );
                 }
                 return Some([0, 0, 0, at]);
             }
@@ -212,10 +229,14 @@ mod tests {
         let mut p = prep(&dome);
         p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
             .unwrap();
-        // The second portal's plane z = 0 lies below the first (z = 3): a ray up through both.
+        // The second portal's plane z = 0 lies below the first (z = 3): a ray up through both,
+        // and their multipliers differ.
         assert_eq!(
             p.gpu_path,
-            GpuPath::HostIrradiance("it is masked by portals that may hide one another")
+            GpuPath::HostIrradiance(
+                "it is masked by portals that may hide one another and differ in intensity or \
+                 colour"
+            )
         );
         let (data, words) = scene_atlas(&[prep(&fan(3)), p]);
         let at = words[1].unwrap()[3] as usize;
@@ -230,11 +251,43 @@ mod tests {
             &[-1.0, -0.5, 3.0, 2.0, 0.0, 0.0, 0.0, 1.0, 0.0]
         );
         let second = &data[at + 1 + PORTAL_WORDS as usize..];
-        assert_eq!(second.len(), PORTAL_WORDS as usize);
+        // Then no overlap: its irradiance is the host's.
+        assert_eq!(second.len(), PORTAL_WORDS as usize + 1);
+        assert_eq!(second[PORTAL_WORDS as usize].to_bits(), 0);
         // World → local of a uniform scale 2: rows of 0.5·I; half extents in local units.
         assert_eq!(
             &second[6..17],
             &[0.5, 0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 0.5, 2.0]
+        );
+    }
+
+    /// Three stacked panes of one multiplier and a window apart: the overlaps after the
+    /// portals, count then OVERLAP_WORDS each (indices ascending, u32::MAX past the last).
+    #[test]
+    fn overlaps_are_packed_after_the_portals() {
+        let pane = |z: f64| {
+            Portal::new(1.0, 1.0).with_transform(DMat4::from_translation(DVec3::new(0.0, 0.0, z)))
+        };
+        let side = Portal::new(1.0, 1.0).with_transform(DMat4::from_rotation_translation(
+            glam::DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2),
+            DVec3::new(5.0, 0.0, 0.0),
+        ));
+        let dome = [pane(1.0), side, pane(2.0), pane(3.0)]
+            .into_iter()
+            .fold(Light::dome(), |l, q| l.with_portal(q));
+        let mut p = prep(&dome);
+        p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
+            .unwrap();
+        assert_eq!(p.gpu_path, GpuPath::Device);
+        let (data, words) = scene_atlas(&[p]);
+        let at = words[0].unwrap()[3] as usize + 1 + 4 * PORTAL_WORDS as usize;
+        let bits: Vec<u32> = data[at..].iter().map(|v| v.to_bits()).collect();
+        let none = u32::MAX;
+        assert_eq!(
+            bits,
+            [
+                4, 0, 2, none, none, 0, 2, 3, none, 0, 3, none, none, 2, 3, none, none
+            ]
         );
     }
 

@@ -31,12 +31,14 @@ pub enum GpuPath {
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
     /// - Textured domes masked by portals, and untextured ones whose portals may hide one
-    ///   another (§8 P2 mask mode): emission is the dome's own and radiance tests the portal
-    ///   crossings on the device (shaders/portal.wgsl, the portals in the mesh atlas);
-    ///   irradiance needs the portals' visible pieces (cpu::portal::irradiance), which have no
-    ///   kernel. An untextured dome whose portals cannot hide one another is [`Device`]
-    ///   (`Prepared::apply_portal_mode`: Lambert's formula summed over the portals,
-    ///   shaders/irradiance/portals.wgsl). A dome's intensity is 0 on both paths.
+    ///   another with different multipliers or in more ways than the kernel sums
+    ///   (`portal::overlaps`; §8 P2 mask mode): emission is the dome's own and radiance tests
+    ///   the portal crossings on the device (shaders/portal.wgsl, the portals in the mesh
+    ///   atlas); irradiance needs the portals' visible pieces (cpu::portal::irradiance), which
+    ///   have no kernel. Other untextured masked domes are [`Device`]
+    ///   (`Prepared::apply_portal_mode`: Lambert's formula summed over the portals and, by
+    ///   inclusion–exclusion, their overlaps, shaders/irradiance/portals.wgsl). A dome's
+    ///   intensity is 0 on both paths.
     ///
     ///   [`Device`]: GpuPath::Device
     HostIrradiance(&'static str),
@@ -111,19 +113,26 @@ pub(super) fn decide(
 }
 
 /// A dome's [`GpuPath`] once it is masked by `portals` (`Prepared::apply_portal_mode`, DESIGN.md
-/// §8 P2): emission and radiance on the device (up to [`PORTALS_ON_DEVICE`] portals), and
-/// irradiance too where it is untextured and its portals cannot hide one another
-/// ([`portal::cannot_hide_one_another`]: Lambert's formula summed over them,
-/// shaders/irradiance/portals.wgsl).
-pub(super) fn masked(portals: &[PreparedPortal], textured: bool) -> GpuPath {
+/// §8 P2), and the overlaps the device sums: emission and radiance on the device (up to
+/// [`PORTALS_ON_DEVICE`] portals), and irradiance too where it is untextured and its portals
+/// cannot hide one another or those that may share one multiplier ([`portal::overlaps`]:
+/// Lambert's formula summed over them by inclusion–exclusion, shaders/irradiance/portals.wgsl).
+pub(super) fn masked(portals: &[PreparedPortal], textured: bool) -> (GpuPath, Vec<Vec<u32>>) {
     if portals.len() > PORTALS_ON_DEVICE {
-        GpuPath::Host("it is masked by more portals than the radiance kernel tests")
+        (
+            GpuPath::Host("it is masked by more portals than the radiance kernel tests"),
+            Vec::new(),
+        )
     } else if textured {
-        GpuPath::HostIrradiance("it is a textured dome masked by portals")
-    } else if !portal::cannot_hide_one_another(portals) {
-        GpuPath::HostIrradiance("it is masked by portals that may hide one another")
+        (
+            GpuPath::HostIrradiance("it is a textured dome masked by portals"),
+            Vec::new(),
+        )
     } else {
-        GpuPath::Device
+        match portal::overlaps(portals) {
+            Ok(sets) => (GpuPath::Device, sets),
+            Err(why) => (GpuPath::HostIrradiance(why), Vec::new()),
+        }
     }
 }
 

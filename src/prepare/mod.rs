@@ -119,6 +119,10 @@ pub struct Prepared {
     /// the device they are in the mesh atlas (`gpu::mesh_atlas`, shaders/portal.wgsl).
     /// `None`: not masked (hint mode, another type, a dome naming no visible portal).
     pub portals: Option<Vec<PreparedPortal>>,
+    /// Where a masked dome's irradiance is the device's: the sets of its portals one ray may
+    /// cross together ([`portal::overlaps`]), the inclusion–exclusion terms the kernel sums
+    /// beyond the portals' own (shaders/irradiance/portals.wgsl). Empty otherwise.
+    pub portal_overlaps: Vec<Vec<u32>>,
 }
 
 /// What one kind of light carries beyond the shared frame, base radiance and shaping of
@@ -259,9 +263,9 @@ impl Prepared {
     /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
     /// portals is masked; on a GPU evaluator its emission and radiance are the device's (the
     /// radiance kernel tests the portal crossings), and so is its irradiance where the dome is
-    /// untextured and its portals cannot hide one another
-    /// ([`portal::cannot_hide_one_another`]: a sum of Lambert's formula over the portals,
-    /// shaders/irradiance/portals.wgsl); else its irradiance is the CPU reference's
+    /// untextured and its portals cannot hide one another, or those that may have one
+    /// multiplier ([`portal::overlaps`]: an inclusion–exclusion sum of Lambert's formula over
+    /// the portals and their overlaps, shaders/irradiance/portals.wgsl); else its irradiance is the CPU reference's
     /// ([`GpuPath::HostIrradiance`]). Hint mode changes nothing.
     pub fn apply_portal_mode(
         &mut self,
@@ -270,7 +274,8 @@ impl Prepared {
     ) -> Result<()> {
         self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
         if let Some(portals) = &self.portals {
-            self.gpu_path = gpu_path::masked(portals, self.dome_texture().is_some());
+            (self.gpu_path, self.portal_overlaps) =
+                gpu_path::masked(portals, self.dome_texture().is_some());
         }
         Ok(())
     }
@@ -439,6 +444,7 @@ impl Prepared {
         .collect();
         Ok(Prepared {
             portals: None,
+            portal_overlaps: Vec::new(),
             warning,
             files_read,
             base,

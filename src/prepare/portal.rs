@@ -96,15 +96,27 @@ pub fn prepare_portals(
 }
 
 /// How far (relative to its distance from the other portal's centre) a corner may lie off
-/// another portal's plane and still count as in it in [`cannot_hide_one_another`]: f64
+/// another portal's plane and still count as in it in [`one_ray_may_cross_both`]: f64
 /// rounding of coplanar portals' corners, ~1e-16 of it. A corner that far across lets only
 /// rays within ~1e-9 (relative) of both portals cross both.
 const PLANE_SLACK: f64 = 1e-9;
 
-/// Whether no ray can pass through two of `portals` toward their +Z (P2's crossings), so that a
-/// masked dome's irradiance is the sum over the portals of each one's own (the visible pieces of
-/// `cpu::portal::irradiance` are then the portals themselves). For two portals A and B a ray
-/// crosses A toward +Z at t_A and then B at t_B > t_A exactly when some point of A lies
+/// Whether no ray can pass through two of `portals` toward their +Z: no pair
+/// [`one_ray_may_cross_both`] (then [`overlaps`] lists nothing, and a masked dome's irradiance
+/// is the sum over the portals of each one's own).
+#[cfg(test)]
+pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
+    portals.iter().enumerate().all(|(i, a)| {
+        portals
+            .iter()
+            .skip(i + 1)
+            .all(|b| !one_ray_may_cross_both(a, b))
+    })
+}
+
+/// Whether some ray passes through both `a` and `b` toward their +Z (P2's crossings; in a set
+/// of rays of positive measure): the edges of the graph whose cliques are [`overlaps`]. For
+/// two portals A and B a ray crosses A toward +Z at t_A and then B at t_B > t_A exactly when some point of A lies
 /// strictly on B's −Z side and some point of B strictly on A's +Z side:
 /// - only if: the ray moves toward +Z_B, so before t_B (at A's point) it is on B's −Z side, and
 ///   toward +Z_A, so after t_A (at B's point) on A's +Z side;
@@ -115,10 +127,11 @@ const PLANE_SLACK: f64 = 1e-9;
 /// For convex portals "some point" is "some corner". Rays meeting both at once pass through
 /// the line where their planes meet (measure zero) unless the planes are one: facing opposite
 /// ways no ray moves toward both +Z, facing the same way it passes through both where they
-/// overlap (that overlap counts once, for the earlier portal, so such sets are refused too).
-/// So this is exact: a convex room's windows and skylights, several panes in one wall, and
-/// windows facing each other across a courtyard pass; a pane in front of a window does not.
-pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
+/// overlap (that overlap counts once, for the earlier portal: such a pair is crossable too).
+/// So this is exact: no two of a convex room's windows and skylights, of several panes in one
+/// wall not overlapping, or of windows facing each other across a courtyard are crossable by
+/// one ray; a window and a pane in front of it are.
+pub(crate) fn one_ray_may_cross_both(a: &PreparedPortal, b: &PreparedPortal) -> bool {
     // Whether some corner of `b` lies beyond `a`'s plane on the side `sign` (+1: +Z).
     let beyond = |a: &PreparedPortal, b: &PreparedPortal, sign: f64| {
         b.corners.iter().any(|c| {
@@ -126,16 +139,85 @@ pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
             sign * a.normal.dot(d) > PLANE_SLACK * d.length()
         })
     };
-    let coplanar =
-        |a: &PreparedPortal, b: &PreparedPortal| !beyond(a, b, 1.0) && !beyond(a, b, -1.0);
-    portals.iter().enumerate().all(|(i, a)| {
-        portals.iter().skip(i + 1).all(|b| {
-            let a_then_b = beyond(b, a, -1.0) && beyond(a, b, 1.0);
-            let b_then_a = beyond(a, b, -1.0) && beyond(b, a, 1.0);
-            let overlapping = coplanar(a, b) && a.normal.dot(b.normal) > 0.0 && overlap(a, b);
-            !(a_then_b || b_then_a || overlapping)
-        })
-    })
+    let coplanar = !beyond(a, b, 1.0) && !beyond(a, b, -1.0);
+    let a_then_b = beyond(b, a, -1.0) && beyond(a, b, 1.0);
+    let b_then_a = beyond(a, b, -1.0) && beyond(b, a, 1.0);
+    let overlapping = coplanar && a.normal.dot(b.normal) > 0.0 && overlap(a, b);
+    a_then_b || b_then_a || overlapping
+}
+
+/// The most portals one ray may cross (toward their +Z) for the device to sum a masked dome's
+/// irradiance ([`overlaps`]): every set of that many pairwise-crossable portals is one
+/// inclusion–exclusion term, clipped by the others' edges in the kernel (4 portals: a polygon
+/// of at most 16 vertices).
+pub const MOST_PORTALS_ONE_RAY_CROSSES: usize = 4;
+
+/// The most inclusion–exclusion terms ([`overlaps`]) the kernel sums for one dome: a term of
+/// four portals costs ~360 loop iterations (12 clips of up to 16 vertices, 14 triangles), so
+/// 128 of them stay inside lavapipe's 65,535 iterations an invocation beside ~500 portals
+/// (more portals are still summed; an invocation cut short is recomputed on the host, as
+/// shaders/irradiance/portals.wgsl says).
+pub const MOST_OVERLAPS: usize = 128;
+
+/// The sets of two or more of `portals` that one ray may cross together (every pair of the set
+/// [`one_ray_may_cross_both`]: the cliques of that graph), each as ascending indices into
+/// `portals`, in lexicographic order: the terms beyond the portals' own of the
+/// inclusion–exclusion sum the device takes a masked untextured dome's irradiance by
+/// (`cpu::irradiance::portals`, which carries the proof). Empty exactly when no pair is
+/// crossable. `Err` with the reason the device cannot sum them: two portals
+/// one ray may cross with different multipliers (where P2's nearest-first rule picks one,
+/// which a union cannot express), more than [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise
+/// crossable portals, or more than [`MOST_OVERLAPS`] sets.
+pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>, &'static str> {
+    // Neighbours above each portal in the graph "one ray may cross both".
+    let mut above: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
+    for (i, a) in portals.iter().enumerate() {
+        for (j, b) in portals.iter().enumerate().skip(i + 1) {
+            if one_ray_may_cross_both(a, b) {
+                if a.multiplier != b.multiplier {
+                    return Err(
+                        "it is masked by portals that may hide one another and differ \
+                         in intensity or colour",
+                    );
+                }
+                above[i].push(j);
+            }
+        }
+    }
+    // Every clique, grown from its lowest member by common neighbours above its highest.
+    let mut sets = Vec::new();
+    let mut stack: Vec<(Vec<usize>, Vec<usize>)> = (0..portals.len())
+        .rev()
+        .map(|i| (vec![i], above[i].clone()))
+        .collect();
+    while let Some((set, common)) = stack.pop() {
+        if set.len() > 1 {
+            if sets.len() == MOST_OVERLAPS {
+                return Err(
+                    "it is masked by portals that overlap in more ways than the \
+                     irradiance kernel sums",
+                );
+            }
+            sets.push(set.iter().map(|&k| k as u32).collect());
+        }
+        if set.len() == MOST_PORTALS_ONE_RAY_CROSSES && !common.is_empty() {
+            return Err(
+                "it is masked by more portals than the irradiance kernel clips that \
+                 one ray may cross",
+            );
+        }
+        for &k in common.iter().rev() {
+            let next: Vec<usize> = common
+                .iter()
+                .copied()
+                .filter(|c| *c > k && above[k].binary_search(c).is_ok())
+                .collect();
+            let mut grown = set.clone();
+            grown.push(k);
+            stack.push((grown, next));
+        }
+    }
+    Ok(sets)
 }
 
 /// Whether two portals in one plane overlap (in more than an edge): no separating line along

@@ -183,8 +183,8 @@ fn outline_points(corners: &[DVec3]) -> impl Iterator<Item = DVec3> + '_ {
     })
 }
 
-/// A masked dome's (its irradiance on the device is Lambert's formula summed over the portals,
-/// shaders/irradiance/portals.wgsl), from the f32 error model of [`mesh_irradiance_margin`]
+/// A masked dome's (its irradiance on the device is Lambert's formula summed over the portals
+/// and, by inclusion–exclusion, their overlaps, shaders/irradiance/portals.wgsl), from the f32 error model of [`mesh_irradiance_margin`]
 /// applied to each portal x is on the −Z side of and weighed by its share of the irradiance: a
 /// portal whose highest point is at elevation t over the horizon, or seen from t above its own
 /// plane (from its nearest outline point), and whose f32 geometry x resolves to η_k, is off by
