@@ -1,12 +1,12 @@
 // The irradiance of an untextured dome masked by portals (DESIGN.md §8 P2 mask mode) where the
-// device sums it (prepare::portal::overlaps): the dome's radiance is uniform, and a ray that
-// crosses several portals crosses portals of one multiplier, so the irradiance is the sum over
-// the portals x is on the −Z side of of the portal's multiplier times Lambert's formula on its
-// parallelogram clipped at the horizon, less (by inclusion–exclusion) the same over the
-// overlaps the mesh atlas lists after the portals, each the first portal's parallelogram
-// clipped to the cones from x over the others. Twin of src/cpu/irradiance/portals.rs, which
-// carries the proof; a textured dome, or portals that may hide one another with different
-// multipliers, keep their irradiance on the host (GpuPath::HostIrradiance).
+// device sums it (prepare::portal::overlaps): the dome's radiance is uniform, so the irradiance
+// is the sum over the portals x is on the −Z side of of the portal's multiplier times Lambert's
+// formula on its parallelogram clipped at the horizon, and by inclusion–exclusion over the
+// overlaps the mesh atlas lists after the portals, ± the multiplier of the one each names
+// first times the same on the first portal's parallelogram clipped to the cones from x over
+// the others. Twin of src/cpu/irradiance/portals.rs, which carries the proof; a textured
+// dome, or portals of different multipliers that rays cross in either order, keep their
+// irradiance on the host (GpuPath::HostIrradiance).
 //
 // f32: the parallelogram is two triangles through mesh/lambert.wgsl's triangle_lambert (with
 //   its sliver form for portals low over the horizon); the CPU takes Lambert's formula on the

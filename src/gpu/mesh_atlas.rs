@@ -230,14 +230,9 @@ mod tests {
         p.apply_portal_mode(PortalMode::Mask, TemperatureMode::Spec)
             .unwrap();
         // The second portal's plane z = 0 lies below the first (z = 3): a ray up through both,
-        // and their multipliers differ.
-        assert_eq!(
-            p.gpu_path,
-            GpuPath::HostIrradiance(
-                "it is masked by portals that may hide one another and differ in intensity or \
-                 colour"
-            )
-        );
+        // the second first; their multipliers differ, so the first's counts for the overlap.
+        assert_eq!(p.gpu_path, GpuPath::Device);
+        assert_eq!(p.portal_overlaps, [vec![0, 1]]);
         let (data, words) = scene_atlas(&[prep(&fan(3)), p]);
         let at = words[1].unwrap()[3] as usize;
         assert!(at > 0);
@@ -251,9 +246,16 @@ mod tests {
             &[-1.0, -0.5, 3.0, 2.0, 0.0, 0.0, 0.0, 1.0, 0.0]
         );
         let second = &data[at + 1 + PORTAL_WORDS as usize..];
-        // Then no overlap: its irradiance is the host's.
-        assert_eq!(second.len(), PORTAL_WORDS as usize + 1);
-        assert_eq!(second[PORTAL_WORDS as usize].to_bits(), 0);
+        assert_eq!(
+            second.len(),
+            PORTAL_WORDS as usize + 1 + OVERLAP_WORDS as usize
+        );
+        // Then the one overlap, the farther portal first.
+        let bits: Vec<u32> = second[PORTAL_WORDS as usize..]
+            .iter()
+            .map(|v| v.to_bits())
+            .collect();
+        assert_eq!(bits, [1, 0, 1, u32::MAX, u32::MAX]);
         // World → local of a uniform scale 2: rows of 0.5·I; half extents in local units.
         assert_eq!(
             &second[6..17],

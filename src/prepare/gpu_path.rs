@@ -31,7 +31,7 @@ pub enum GpuPath {
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
     /// - Textured domes masked by portals, and untextured ones whose portals may hide one
-    ///   another with different multipliers or in more ways than the kernel sums
+    ///   another in either order with different multipliers, or in more ways than the kernel sums
     ///   (`portal::overlaps`; §8 P2 mask mode): emission is the dome's own and radiance tests
     ///   the portal crossings on the device (shaders/portal.wgsl, the portals in the mesh
     ///   atlas); irradiance needs the portals' visible pieces (cpu::portal::irradiance), which
@@ -115,7 +115,8 @@ pub(super) fn decide(
 /// A dome's [`GpuPath`] once it is masked by `portals` (`Prepared::apply_portal_mode`, DESIGN.md
 /// §8 P2), and the overlaps the device sums: emission and radiance on the device (up to
 /// [`PORTALS_ON_DEVICE`] portals), and irradiance too where it is untextured and its portals
-/// cannot hide one another or those that may share one multiplier ([`portal::overlaps`]:
+/// cannot hide one another or the portals of different multipliers are crossed in one order
+/// ([`portal::overlaps`]:
 /// Lambert's formula summed over them by inclusion–exclusion, shaders/irradiance/portals.wgsl).
 pub(super) fn masked(portals: &[PreparedPortal], textured: bool) -> (GpuPath, Vec<Vec<u32>>) {
     if portals.len() > PORTALS_ON_DEVICE {

@@ -263,8 +263,8 @@ impl Prepared {
     /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
     /// portals is masked; on a GPU evaluator its emission and radiance are the device's (the
     /// radiance kernel tests the portal crossings), and so is its irradiance where the dome is
-    /// untextured and its portals cannot hide one another, or those that may have one
-    /// multiplier ([`portal::overlaps`]: an inclusion–exclusion sum of Lambert's formula over
+    /// untextured and its portals of different multipliers are crossed by rays in one order
+    /// only ([`portal::overlaps`]: an inclusion–exclusion sum of Lambert's formula over
     /// the portals and their overlaps, shaders/irradiance/portals.wgsl); else its irradiance is the CPU reference's
     /// ([`GpuPath::HostIrradiance`]). Hint mode changes nothing.
     pub fn apply_portal_mode(

@@ -96,13 +96,13 @@ pub fn prepare_portals(
 }
 
 /// How far (relative to its distance from the other portal's centre) a corner may lie off
-/// another portal's plane and still count as in it in [`one_ray_may_cross_both`]: f64
+/// another portal's plane and still count as in it in [`crossing_orders`]: f64
 /// rounding of coplanar portals' corners, ~1e-16 of it. A corner that far across lets only
 /// rays within ~1e-9 (relative) of both portals cross both.
 const PLANE_SLACK: f64 = 1e-9;
 
 /// Whether no ray can pass through two of `portals` toward their +Z: no pair
-/// [`one_ray_may_cross_both`] (then [`overlaps`] lists nothing, and a masked dome's irradiance
+/// may be crossed in some order ([`crossing_orders`]; then [`overlaps`] lists nothing, and a masked dome's irradiance
 /// is the sum over the portals of each one's own).
 #[cfg(test)]
 pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
@@ -114,9 +114,18 @@ pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
     })
 }
 
-/// Whether some ray passes through both `a` and `b` toward their +Z (P2's crossings; in a set
-/// of rays of positive measure): the edges of the graph whose cliques are [`overlaps`]. For
-/// two portals A and B a ray crosses A toward +Z at t_A and then B at t_B > t_A exactly when some point of A lies
+/// Whether some ray passes through both `a` and `b` toward their +Z: either order of
+/// [`crossing_orders`].
+#[cfg(test)]
+pub(crate) fn one_ray_may_cross_both(a: &PreparedPortal, b: &PreparedPortal) -> bool {
+    let (a_first, b_first) = crossing_orders(a, b);
+    a_first || b_first
+}
+
+/// In which orders rays may cross `a`, then `b` (`.0`), and `b`, then `a` (`.1`), toward their
+/// +Z (P2's crossings; in a set of rays of positive measure), `a` being the earlier in the
+/// `portals` relationship; either is an edge of the graph whose cliques are [`overlaps`]. A
+/// ray crosses A toward +Z at t_A and then B at t_B > t_A exactly when some point of A lies
 /// strictly on B's −Z side and some point of B strictly on A's +Z side:
 /// - only if: the ray moves toward +Z_B, so before t_B (at A's point) it is on B's −Z side, and
 ///   toward +Z_A, so after t_A (at B's point) on A's +Z side;
@@ -127,11 +136,11 @@ pub fn cannot_hide_one_another(portals: &[PreparedPortal]) -> bool {
 /// For convex portals "some point" is "some corner". Rays meeting both at once pass through
 /// the line where their planes meet (measure zero) unless the planes are one: facing opposite
 /// ways no ray moves toward both +Z, facing the same way it passes through both where they
-/// overlap (that overlap counts once, for the earlier portal: such a pair is crossable too).
+/// overlap (that overlap counts once, for the earlier portal: it is the nearer there, `.0`).
 /// So this is exact: no two of a convex room's windows and skylights, of several panes in one
 /// wall not overlapping, or of windows facing each other across a courtyard are crossable by
 /// one ray; a window and a pane in front of it are.
-pub(crate) fn one_ray_may_cross_both(a: &PreparedPortal, b: &PreparedPortal) -> bool {
+pub(crate) fn crossing_orders(a: &PreparedPortal, b: &PreparedPortal) -> (bool, bool) {
     // Whether some corner of `b` lies beyond `a`'s plane on the side `sign` (+1: +Z).
     let beyond = |a: &PreparedPortal, b: &PreparedPortal, sign: f64| {
         b.corners.iter().any(|c| {
@@ -143,7 +152,7 @@ pub(crate) fn one_ray_may_cross_both(a: &PreparedPortal, b: &PreparedPortal) -> 
     let a_then_b = beyond(b, a, -1.0) && beyond(a, b, 1.0);
     let b_then_a = beyond(a, b, -1.0) && beyond(b, a, 1.0);
     let overlapping = coplanar && a.normal.dot(b.normal) > 0.0 && overlap(a, b);
-    a_then_b || b_then_a || overlapping
+    (a_then_b || overlapping, b_then_a)
 }
 
 /// The most portals one ray may cross (toward their +Z) for the device to sum a masked dome's
@@ -160,30 +169,46 @@ pub const MOST_PORTALS_ONE_RAY_CROSSES: usize = 4;
 pub const MOST_OVERLAPS: usize = 128;
 
 /// The sets of two or more of `portals` that one ray may cross together (every pair of the set
-/// [`one_ray_may_cross_both`]: the cliques of that graph), each as ascending indices into
-/// `portals`, in lexicographic order: the terms beyond the portals' own of the
-/// inclusion–exclusion sum the device takes a masked untextured dome's irradiance by
-/// (`cpu::irradiance::portals`, which carries the proof). Empty exactly when no pair is
-/// crossable. `Err` with the reason the device cannot sum them: two portals
-/// one ray may cross with different multipliers (where P2's nearest-first rule picks one,
-/// which a union cannot express), more than [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise
-/// crossable portals, or more than [`MOST_OVERLAPS`] sets.
+/// crossable in some order, [`crossing_orders`]: the cliques of that graph), in lexicographic order of their
+/// members, each as indices into `portals`: first the member whose multiplier the set's term
+/// takes (the farthest along the rays through all of them), then the others ascending. They
+/// are the terms beyond the portals' own of the inclusion–exclusion sum the device takes a
+/// masked untextured dome's irradiance by (`cpu::irradiance::portals`, which carries the
+/// proof). Empty exactly when no pair is crossable.
+///
+/// A pair with different multipliers must be crossed in one order only (P2 gives each ray the
+/// nearer one's); a set's first member is one that every member of another multiplier lies
+/// before on every ray (the farthest on any ray through them all: a set no ray passes through
+/// has none, and its term is 0 whichever is named). `Err` with the reason the device cannot
+/// sum them: two portals of different multipliers that rays cross in either order, more than
+/// [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise crossable portals, or more than [`MOST_OVERLAPS`]
+/// sets.
 pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>, &'static str> {
-    // Neighbours above each portal in the graph "one ray may cross both".
+    // Neighbours above each portal in the graph "one ray may cross both", and the pairs of
+    // different multipliers crossed in one order: `after[i]` holds the j that rays cross
+    // after i (never before).
     let mut above: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
+    let mut after: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
     for (i, a) in portals.iter().enumerate() {
         for (j, b) in portals.iter().enumerate().skip(i + 1) {
-            if one_ray_may_cross_both(a, b) {
-                if a.multiplier != b.multiplier {
-                    return Err(
-                        "it is masked by portals that may hide one another and differ \
-                         in intensity or colour",
-                    );
+            let (a_first, b_first) = crossing_orders(a, b);
+            if !(a_first || b_first) {
+                continue;
+            }
+            above[i].push(j);
+            if a.multiplier != b.multiplier {
+                match (a_first, b_first) {
+                    (true, false) => after[i].push(j),
+                    (false, true) => after[j].push(i),
+                    _ => {
+                        return Err("it is masked by portals of different intensity or colour \
+                             that rays cross in either order");
+                    }
                 }
-                above[i].push(j);
             }
         }
     }
+    let is_after = |j: usize, i: usize| after[i].contains(&j);
     // Every clique, grown from its lowest member by common neighbours above its highest.
     let mut sets = Vec::new();
     let mut stack: Vec<(Vec<usize>, Vec<usize>)> = (0..portals.len())
@@ -198,7 +223,22 @@ pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>
                      irradiance kernel sums",
                 );
             }
-            sets.push(set.iter().map(|&k| k as u32).collect());
+            let last = set
+                .iter()
+                .copied()
+                .find(|&l| {
+                    set.iter().all(|&z| {
+                        z == l || portals[z].multiplier == portals[l].multiplier || is_after(l, z)
+                    })
+                })
+                .unwrap_or(set[0]);
+            let rest = set.iter().copied().filter(|&k| k != last);
+            sets.push(
+                std::iter::once(last)
+                    .chain(rest)
+                    .map(|k| k as u32)
+                    .collect(),
+            );
         }
         if set.len() == MOST_PORTALS_ONE_RAY_CROSSES && !common.is_empty() {
             return Err(

@@ -457,8 +457,9 @@ fn bad_portals_refused_in_mask_mode_only() {
 }
 
 /// On a GPU evaluator a masked dome's emission and radiance are the device's (within f32
-/// rounding of the reference: these rays pass far from the portals' edges) and its
-/// irradiance and intensity the reference's (GpuPath::HostIrradiance).
+/// rounding of the reference: these rays pass far from the portals' edges), and so is its
+/// irradiance (this room's portals of different multipliers are crossed in one order each:
+/// `prepare::portal::overlaps`); its intensity is the reference's.
 #[test]
 fn gpu_takes_masked_domes_from_the_reference() {
     let Some(gpu) = crate::query::test_gpu() else {
@@ -487,9 +488,9 @@ fn gpu_takes_masked_domes_from_the_reference() {
             gpu.emission(&l, &dirs, acc).unwrap(),
             cpu.emission(&l, &dirs, acc).unwrap(),
         );
-        assert_eq!(
+        close(
             gpu.irradiance(&l, &points, &dirs, acc).unwrap(),
-            cpu.irradiance(&l, &points, &dirs, acc).unwrap()
+            cpu.irradiance(&l, &points, &dirs, acc).unwrap(),
         );
         assert_eq!(
             gpu.intensity(&l, &dirs, acc).unwrap(),
