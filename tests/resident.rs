@@ -1015,6 +1015,22 @@ fn masked_domes_run_on_the_device_and_refuse_irradiance_by_name_where_portals_ma
                     text.contains("/World/Sky") && text.contains("in either order"),
                     "{text}"
                 );
+                // `check` compares the rest and says why not its irradiance.
+                let reference = luxeval::Reference::with_portal_mode(
+                    &crossed,
+                    luxeval::TemperatureMode::Spec,
+                    mode,
+                )
+                .unwrap();
+                let report = luxeval::check_against_reference(&eval, &[reference], 16, 3).unwrap();
+                assert!(
+                    report.host_only.iter().any(|(l, why)| l == "/World/Sky"
+                        && why.contains("in either order")
+                        && why.contains("on every device")),
+                    "{:?}",
+                    report.host_only
+                );
+                assert!(report.pass(), "{report:?}");
             }
             (mode, other) => panic!("{mode:?}: {other:?}"),
         }

@@ -95,9 +95,10 @@ pub struct CheckReport {
     pub excluded: usize,
     pub rows: Vec<QueryReport>,
     /// The lights some or all of whose queries the CPU reference answers on every device
-    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`, `GpuPath::HostIntensity`: mesh lights)
-    /// or on this one (a latlong dome whose row tables it cannot hold), with what is not
-    /// compared and why.
+    /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`, `GpuPath::HostIntensity`: mesh lights;
+    /// `GpuPath::HostIrradiance`: textured rects, bent IES profiles, some textured and masked
+    /// domes) or on this one (a latlong dome whose row tables it cannot hold), with what is
+    /// not compared and why.
     pub host_only: Vec<(String, String)>,
 }
 
@@ -228,16 +229,20 @@ pub fn check_with(
                 format!("cannot check on this device: {w}"),
             ));
         }
-        // A latlong dome whose row tables this device cannot hold takes the reference's
-        // irradiance here (gpu::texture_atlas::tables_beyond): nothing to compare.
+        // A light whose irradiance the GPU path takes from the reference (on every device, or
+        // on this one: a latlong dome whose row tables it cannot hold,
+        // gpu::texture_atlas::tables_beyond): nothing to compare, and the report says so.
         let irradiance_on_host = scene.prepared(0).irradiance_on_host();
-        if let crate::prepare::GpuPath::HostIrradiance(why) = scene.prepared(0).gpu_path
-            && !p.irradiance_on_host()
-        {
+        if let crate::prepare::GpuPath::HostIrradiance(why) = scene.prepared(0).gpu_path {
+            let which = if p.irradiance_on_host() {
+                "every"
+            } else {
+                "this"
+            };
             host_only.push((
                 p.light.path.clone(),
                 format!(
-                    "{why}, whose irradiance the CPU reference answers on this device (its \
+                    "{why}, whose irradiance the CPU reference answers on {which} device (its \
                      emission, intensity and radiance are compared)"
                 ),
             ));
