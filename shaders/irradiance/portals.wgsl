@@ -23,9 +23,9 @@
 //   reads PreparedPortal's fields).
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: a portal costs at
 //   most ~25 (two triangles), an overlap of four at most ~360 (prepare::portal::MOST_OVERLAPS),
-//   so up to ~2,600 portals without overlaps stay inside it; each loop checks its own
-//   condition after it ends and sets irr_cut if it stopped short, and the host recomputes
-//   that receiver (shared/record.wgsl).
+//   so up to ~2,600 portals without overlaps stay inside it; the portal and overlap loops, each
+//   clip's vertex loop and the fan's check their own condition after they end and set irr_cut
+//   if they stopped short, and the host recomputes that receiver (shared/record.wgsl).
 
 // #import shared/record.wgsl
 // #import mesh/lambert.wgsl
@@ -111,8 +111,12 @@ fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f3
         return 0.0;
     }
     var sum = 0.0;
-    for (var i = 1u; i + 1u < poly.count; i++) {
+    var i = 1u;
+    for (; i + 1u < poly.count; i++) {
         sum += triangle_lambert(poly.p[0], poly.p[i], poly.p[i + 1u], n);
+    }
+    if i + 1u < poly.count {
+        irr_cut = true;
     }
     return sum;
 }
@@ -128,7 +132,8 @@ fn clip_to_cone(poly: OverlapPolygon, cone: array<vec3<f32>, 4>) -> OverlapPolyg
         }
         var out: OverlapPolygon;
         out.count = 0u;
-        for (var i = 0u; i < cur.count; i++) {
+        var i = 0u;
+        for (; i < cur.count; i++) {
             let p0 = cur.p[i];
             let p1 = cur.p[(i + 1u) % cur.count];
             let d0 = dot(k, p0);
@@ -141,6 +146,10 @@ fn clip_to_cone(poly: OverlapPolygon, cone: array<vec3<f32>, 4>) -> OverlapPolyg
                 out.p[out.count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
                 out.count += 1u;
             }
+        }
+        if i < cur.count {
+            // Cut short by the device's loop budget: so is the polygon.
+            irr_cut = true;
         }
         cur = out;
     }

@@ -168,6 +168,10 @@ pub const MOST_PORTALS_ONE_RAY_CROSSES: usize = 4;
 /// shaders/irradiance/portals.wgsl says).
 pub const MOST_OVERLAPS: usize = 128;
 
+/// [`overlaps`]' reason past [`MOST_OVERLAPS`].
+const TOO_MANY_OVERLAPS: &str =
+    "it is masked by portals that overlap in more ways than the irradiance kernel sums";
+
 /// The sets of two or more of `portals` that one ray may cross together (every pair of the set
 /// crossable in some order, [`crossing_orders`]: the cliques of that graph), in lexicographic order of their
 /// members, each as indices into `portals`: first the member whose multiplier the set's term
@@ -189,6 +193,7 @@ pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>
     // after i (never before).
     let mut above: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
     let mut after: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
+    let mut edges = 0;
     for (i, a) in portals.iter().enumerate() {
         for (j, b) in portals.iter().enumerate().skip(i + 1) {
             let (a_first, b_first) = crossing_orders(a, b);
@@ -196,6 +201,11 @@ pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>
                 continue;
             }
             above[i].push(j);
+            edges += 1;
+            if edges > MOST_OVERLAPS {
+                // Every crossable pair is a set: too many already (and no quadratic list).
+                return Err(TOO_MANY_OVERLAPS);
+            }
             if a.multiplier != b.multiplier {
                 match (a_first, b_first) {
                     (true, false) => after[i].push(j),

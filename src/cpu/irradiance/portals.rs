@@ -596,6 +596,40 @@ mod tests {
         let four = masked((0..4).map(|k| pane(1.0 + k as f64)).collect());
         assert_eq!(four.gpu_path, crate::prepare::GpuPath::Device);
         assert_eq!(four.portal_overlaps.len(), 11);
+        // k windows in a row and a pane 1 above each: every window and every pane are
+        // crossable (a ray slanting up from under one window through another's pane), no two
+        // windows nor two panes are: k² sets of two, up to MOST_OVERLAPS, each naming its pane
+        // first (of another multiplier, always crossed after the window).
+        let facade = |k: usize| {
+            let at = |i: usize, z: f64| {
+                Portal::new(1.0, 1.0).with_transform(DMat4::from_translation(DVec3::new(
+                    3.0 * i as f64,
+                    0.0,
+                    z,
+                )))
+            };
+            masked(
+                (0..k)
+                    .flat_map(|i| [at(i, 0.0), at(i, 1.0).with_intensity(2.0)])
+                    .collect(),
+            )
+        };
+        let eleven = facade(11);
+        assert_eq!(eleven.gpu_path, crate::prepare::GpuPath::Device);
+        assert_eq!(eleven.portal_overlaps.len(), 121);
+        assert!(
+            eleven
+                .portal_overlaps
+                .iter()
+                .all(|s| s.len() == 2 && s[0] % 2 == 1)
+        );
+        assert_eq!(
+            facade(12).gpu_path,
+            crate::prepare::GpuPath::HostIrradiance(
+                "it is masked by portals that overlap in more ways than the irradiance kernel \
+                 sums"
+            )
+        );
     }
 
     /// Where the device sums a masked dome's irradiance with overlaps (portals that rays may
