@@ -56,8 +56,8 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         case KIND_DOME: {
             e = base * PI;
             if has_flag(light, FLAG_PORTALS) {
-                // Masked and untextured, its portals unable to hide one another
-                // (prepare::Prepared::apply_portal_mode): Lambert's formula summed over them.
+                // Masked and untextured where the device sums it (prepare::portal::overlaps):
+                // Lambert's formula over the portals and, by inclusion–exclusion, their overlaps.
                 e = base * portals_lambert(light.tex.w, x, n);
             }
             // #if TEXTURE

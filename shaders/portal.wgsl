@@ -1,8 +1,9 @@
 // A dome masked by its portals (DESIGN.md §8 P2, mask mode): which portal a ray passes through.
 // Twin of src/cpu/portal.rs, which carries the rule (nearest crossing toward the portal's +Z,
 // edges inclusive, ties to the earlier portal). Its irradiance: irradiance/portals.wgsl for an
-// untextured dome whose portals cannot hide one another, else the CPU reference's, which the
-// host adds (GpuPath::HostIrradiance).
+// untextured dome (but portals of different multipliers crossed in either order,
+// prepare::portal::overlaps), else the CPU reference's, which the host adds
+// (GpuPath::HostIrradiance).
 //
 // f32: a ray within ~1e-6 (relative) of a portal's edge, or from a point within that of a
 //   portal's plane, may cross it or not differently from the reference (the conformance check

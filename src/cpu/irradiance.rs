@@ -37,7 +37,7 @@ pub mod latlong_rows;
 pub mod line;
 pub mod outer;
 pub mod pieces;
-// The device's sum for masked untextured domes whose portals cannot hide one another, checked
+// The device's sum for masked untextured domes (prepare::portal::overlaps), checked
 // against the visible pieces of cpu::portal::irradiance by its tests (its only callers).
 #[cfg_attr(not(test), allow(dead_code))]
 pub mod portals;

@@ -1,7 +1,8 @@
 //! A dome masked by its portals (DESIGN.md §8 P2, mask mode) on the CPU (f64). Twin of
 //! `shaders/portal.wgsl` (`crossing`); the irradiance kernel sums Lambert's formula over the
-//! portals of an untextured dome whose portals cannot hide one another
-//! (`irradiance/portals.rs`, checked against [`irradiance`]); every other masked dome's
+//! portals of an untextured dome and, by inclusion–exclusion, their overlaps
+//! (`irradiance/portals.rs`, checked against [`irradiance`]; `prepare::portal::overlaps` says
+//! where); every other masked dome's
 //! irradiance is this module's on the GPU path too (`GpuPath::HostIrradiance`).
 //!
 //! - `radiance(x, ω)`: the dome's radiance along ω ⊙ the multiplier of the nearest portal the

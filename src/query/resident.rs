@@ -175,8 +175,9 @@ impl PreparedScene {
     ///
     /// Refused with [`LuxError::NotOnDevice`] naming the first such light when the scene holds
     /// a light whose irradiance the host path computes on the CPU (textured rects, textured
-    /// domes but latlong ones the kernel integrates, masked domes but untextured ones whose
-    /// portals cannot hide one another, IES profiles of type B under angleScale:
+    /// domes but latlong ones the kernel integrates, textured masked domes and untextured ones
+    /// with portals of different multipliers crossed in either order, IES profiles of type B
+    /// under angleScale:
     /// `prepare::latlong_rows::gpu_path` and `prepare::gpu_path::GpuPath`): the kernel gives 0
     /// for them, which this path would return as if it were the answer. Prepare those lights in a scene
     /// of their own and use [`PreparedScene::irradiance`] for them.
