@@ -1036,3 +1036,86 @@ fn masked_domes_run_on_the_device_and_refuse_irradiance_by_name_where_portals_ma
         }
     }
 }
+
+/// A grid of portals: 20 long thin windows across x (z = 0) and 20 long thin panes of another
+/// multiplier across y above them (z = 1), so that from below the middle every window's cone
+/// crosses every pane's: 400 overlaps of two, the most that `prepare::portal::
+/// OVERLAP_ITERATIONS` admits, most of them clipped for real at each receiver. The kernel sums
+/// them within lavapipe's loop budget: `encode_irradiance` (which has no host step, and gives
+/// NaN where the kernel is cut short) matches the host path and the reference within 1e-4.
+#[test]
+fn a_masked_dome_with_the_most_overlaps_the_budget_admits_finishes_on_the_device() {
+    let Some(r) = renderer() else { return };
+    let strips = 20;
+    let strip = |i: usize, z: f64, k: f64| {
+        let c = 1.5 * i as f64 - 0.75 * (strips - 1) as f64;
+        let (w, h, at) = if z == 0.0 {
+            (40.0, 0.5, glam::DVec3::new(0.0, c, z))
+        } else {
+            (0.5, 40.0, glam::DVec3::new(c, 0.0, z))
+        };
+        luxeval::Portal::new(w, h)
+            .with_path(format!("/World/P{i}_{z}"))
+            .with_intensity(k)
+            .with_transform(glam::DMat4::from_translation(at))
+    };
+    let dome = (0..strips).fold(Light::dome().with_path("/World/Sky"), |l, i| {
+        l.with_portal(strip(i, 0.0, 1.0))
+            .with_portal(strip(i, 1.0, 2.0))
+    });
+    let n = 64;
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|i| {
+            [
+                -4.0 + (i % 8) as f32,
+                -4.0 + (i / 8) as f32,
+                -1.0 - (i % 3) as f32 * 0.5,
+            ]
+        })
+        .collect();
+    let normals: Vec<[f32; 3]> = (0..n)
+        .map(|i| {
+            let t = i as f32 * 0.37;
+            let v = [0.3 * t.sin(), 0.3 * t.cos(), 1.0];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|c| c / l)
+        })
+        .collect();
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone())
+        .unwrap()
+        .with_portal_mode(luxeval::PortalMode::Mask);
+    let scene = eval.prepare(std::slice::from_ref(&dome)).unwrap();
+    let pts = r.buffer(&points, wgpu::BufferUsages::STORAGE);
+    let nrm = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    scene
+        .encode_irradiance(&mut enc, &pts, &nrm, &out, n as u32, Accumulate::Sum)
+        .unwrap();
+    let got = r.finish(enc, &out, n);
+    let want = scene
+        .irradiance(&points, &normals, Accumulate::Sum)
+        .unwrap();
+    let reference = Evaluator::cpu()
+        .with_portal_mode(luxeval::PortalMode::Mask)
+        .prepare(std::slice::from_ref(&dome))
+        .unwrap()
+        .irradiance(&points, &normals, Accumulate::Sum)
+        .unwrap();
+    for i in 0..n {
+        let (g, w, c) = (got[i], want[i], reference[i]);
+        let scale = c.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{i}: dark");
+        for k in 0..3 {
+            assert!(g[k].is_finite(), "{i}: cut short: {g:?}");
+            assert!(
+                (g[k] - w[k]).abs() <= 1e-4 * scale,
+                "{i}: {g:?} vs host path {w:?}"
+            );
+            assert!(
+                (g[k] - c[k]).abs() <= 1e-4 * scale,
+                "{i}: {g:?} vs reference {c:?}"
+            );
+        }
+    }
+}

@@ -22,8 +22,9 @@
 // GPU-only portal_seen, portal_corners: they read a portal's words in the mesh atlas (the CPU
 //   reads PreparedPortal's fields).
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: a portal costs at
-//   most ~25 (two triangles), an overlap of four at most ~360 (prepare::portal::MOST_OVERLAPS),
-//   so up to ~2,600 portals without overlaps stay inside it; the portal and overlap loops, each
+//   most ~25 (two triangles), an overlap of two, three or four at most 120, 237 or 386, and
+//   prepare::portal::overlaps keeps a dome's overlaps within 48,000 (OVERLAP_ITERATIONS), so
+//   up to ~2,600 portals without overlaps stay inside it; the portal and overlap loops, each
 //   clip's vertex loop and the fan's check their own condition after they end and set irr_cut
 //   if they stopped short, and the host recomputes that receiver (shared/record.wgsl).
 

@@ -161,20 +161,30 @@ pub(crate) fn crossing_orders(a: &PreparedPortal, b: &PreparedPortal) -> (bool, 
 /// of at most 16 vertices).
 pub const MOST_PORTALS_ONE_RAY_CROSSES: usize = 4;
 
-/// The most inclusion–exclusion terms ([`overlaps`]) the kernel sums for one dome: a term of
-/// four portals costs ~360 loop iterations (12 clips of up to 16 vertices, 14 triangles), so
-/// 128 of them stay inside lavapipe's 65,535 iterations an invocation beside ~500 portals
-/// (more portals are still summed; an invocation cut short is recomputed on the host, as
-/// shaders/irradiance/portals.wgsl says).
-pub const MOST_OVERLAPS: usize = 128;
+/// The most loop iterations the kernel may spend on one dome's overlaps ([`overlaps`]) for a
+/// receiver that sees every portal: three quarters of lavapipe's 65,535 an invocation, the rest
+/// left to the portals themselves (~25 each) and the scene's other lights. Past it a receiver
+/// would be cut short and recomputed on the host (shaders/irradiance/portals.wgsl), so the dome
+/// keeps the host's irradiance instead.
+pub const OVERLAP_ITERATIONS: usize = 48_000;
 
-/// [`overlaps`]' reason past [`MOST_OVERLAPS`].
+/// The kernel's loop iterations for one overlap of `k` portals at most
+/// (shaders/irradiance/portals.wgsl): the overlap loop's own, the members' side tests (and
+/// the end of the list), the first parallelogram's 4 corners, `4(k − 1)` clips of up to `4k`
+/// vertices, the above-horizon test of up to `4k` vertices, and a fan of up to `4k − 2`
+/// triangles of at most 12 each (mesh/lambert.wgsl's count): 120 for two, 237 for three, 386
+/// for four.
+pub const fn overlap_iterations(k: usize) -> usize {
+    1 + (k + 1) + 4 + 4 * (k - 1) * 4 * k + 4 * k + (4 * k - 2) * 12
+}
+
+/// [`overlaps`]' reason past [`OVERLAP_ITERATIONS`].
 const TOO_MANY_OVERLAPS: &str =
     "it is masked by portals that overlap in more ways than the irradiance kernel sums";
 
 /// The sets of two or more of `portals` that one ray may cross together (every pair of the set
-/// crossable in some order, [`crossing_orders`]: the cliques of that graph), in lexicographic order of their
-/// members, each as indices into `portals`: first the member whose multiplier the set's term
+/// crossable in some order, [`crossing_orders`]: the cliques of that graph), in lexicographic
+/// order of their members, each as indices into `portals`: first the member whose multiplier the set's term
 /// takes (the farthest along the rays through all of them), then the others ascending. They
 /// are the terms beyond the portals' own of the inclusion–exclusion sum the device takes a
 /// masked untextured dome's irradiance by (`cpu::irradiance::portals`, which carries the
@@ -185,15 +195,15 @@ const TOO_MANY_OVERLAPS: &str =
 /// before on every ray (the farthest on any ray through them all: a set no ray passes through
 /// has none, and its term is 0 whichever is named). `Err` with the reason the device cannot
 /// sum them: two portals of different multipliers that rays cross in either order, more than
-/// [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise crossable portals, or more than [`MOST_OVERLAPS`]
-/// sets.
+/// [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise crossable portals, or sets costing the kernel more
+/// than [`OVERLAP_ITERATIONS`] ([`overlap_iterations`]).
 pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>, &'static str> {
     // Neighbours above each portal in the graph "one ray may cross both", and the pairs of
     // different multipliers crossed in one order: `after[i]` holds the j that rays cross
     // after i (never before).
     let mut above: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
     let mut after: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
-    let mut edges = 0;
+    let mut cost = 0;
     for (i, a) in portals.iter().enumerate() {
         for (j, b) in portals.iter().enumerate().skip(i + 1) {
             let (a_first, b_first) = crossing_orders(a, b);
@@ -201,9 +211,9 @@ pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>
                 continue;
             }
             above[i].push(j);
-            edges += 1;
-            if edges > MOST_OVERLAPS {
-                // Every crossable pair is a set: too many already (and no quadratic list).
+            // Every crossable pair is a set: past the budget already (and no quadratic list).
+            cost += overlap_iterations(2);
+            if cost > OVERLAP_ITERATIONS {
                 return Err(TOO_MANY_OVERLAPS);
             }
             if a.multiplier != b.multiplier {
@@ -227,11 +237,12 @@ pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>
         .collect();
     while let Some((set, common)) = stack.pop() {
         if set.len() > 1 {
-            if sets.len() == MOST_OVERLAPS {
-                return Err(
-                    "it is masked by portals that overlap in more ways than the \
-                     irradiance kernel sums",
-                );
+            // The pairs are counted already.
+            if set.len() > 2 {
+                cost += overlap_iterations(set.len());
+                if cost > OVERLAP_ITERATIONS {
+                    return Err(TOO_MANY_OVERLAPS);
+                }
             }
             let last = set
                 .iter()

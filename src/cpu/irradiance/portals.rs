@@ -499,7 +499,8 @@ mod tests {
     #[test]
     fn overlaps_are_the_cliques_of_the_crossable_pairs() {
         use crate::prepare::portal::{
-            MOST_OVERLAPS, MOST_PORTALS_ONE_RAY_CROSSES, one_ray_may_cross_both, overlaps,
+            MOST_PORTALS_ONE_RAY_CROSSES, OVERLAP_ITERATIONS, one_ray_may_cross_both,
+            overlap_iterations, overlaps,
         };
         let mut rng = Rng::new(0x0E_C11);
         let (mut listed, mut triples, mut fours, mut refused) = (0, 0, 0, 0);
@@ -537,7 +538,11 @@ mod tests {
                     refused += 1;
                     assert!(
                         want.iter().any(|s| s.len() > MOST_PORTALS_ONE_RAY_CROSSES)
-                            || want.len() > MOST_OVERLAPS,
+                            || want
+                                .iter()
+                                .map(|s| overlap_iterations(s.len()))
+                                .sum::<usize>()
+                                > OVERLAP_ITERATIONS,
                         "case {case}: refused ({why}) with {} sets, the largest {}",
                         want.len(),
                         want.iter().map(Vec::len).max().unwrap_or(0)
@@ -598,7 +603,8 @@ mod tests {
         assert_eq!(four.portal_overlaps.len(), 11);
         // k windows in a row and a pane 1 above each: every window and every pane are
         // crossable (a ray slanting up from under one window through another's pane), no two
-        // windows nor two panes are: k² sets of two, up to MOST_OVERLAPS, each naming its pane
+        // windows nor two panes are: k² sets of two, up to OVERLAP_ITERATIONS (20² · 120 =
+        // 48,000; 21² · 120 = 52,920), each naming its pane
         // first (of another multiplier, always crossed after the window).
         let facade = |k: usize| {
             let at = |i: usize, z: f64| {
@@ -614,17 +620,16 @@ mod tests {
                     .collect(),
             )
         };
-        let eleven = facade(11);
-        assert_eq!(eleven.gpu_path, crate::prepare::GpuPath::Device);
-        assert_eq!(eleven.portal_overlaps.len(), 121);
+        let many = facade(20);
+        assert_eq!(many.gpu_path, crate::prepare::GpuPath::Device);
+        assert_eq!(many.portal_overlaps.len(), 400);
         assert!(
-            eleven
-                .portal_overlaps
+            many.portal_overlaps
                 .iter()
                 .all(|s| s.len() == 2 && s[0] % 2 == 1)
         );
         assert_eq!(
-            facade(12).gpu_path,
+            facade(21).gpu_path,
             crate::prepare::GpuPath::HostIrradiance(
                 "it is masked by portals that overlap in more ways than the irradiance kernel \
                  sums"
