@@ -157,12 +157,76 @@ fn every_scene_command_takes_portal_mode() {
 /// nothing of it is host-only.
 #[test]
 fn check_compares_a_masked_domes_radiance_and_irradiance() {
+    check_compares_the_masked_dome(&asset("window_room.usda"));
+}
+
+/// The same for a skylight under glazing tilted 5° and turned in its plane (the glazing's own
+/// intensity and colour; a ray up crosses the skylight, then the glazing, never the other way)
+/// beside a window, read from a stage: the
+/// device sums its irradiance by inclusion–exclusion over the overlap
+/// (prepare::portal::overlaps), and `check` compares it.
+#[test]
+fn check_compares_a_domes_irradiance_through_glazing() {
+    let dir = tempfile::tempdir().unwrap();
+    let stage = dir.path().join("glazed.usda");
+    std::fs::write(
+        &stage,
+        r#"#usda 1.0
+(
+    upAxis = "Y"
+)
+
+def Xform "World"
+{
+    def DomeLight "Sky"
+    {
+        rel portals = [</World/Skylight>, </World/Glazing>, </World/Window>]
+    }
+
+    def PortalLight "Skylight"
+    {
+        float inputs:width = 2
+        float inputs:height = 2
+        double3 xformOp:translate = (0, 3, 0)
+        float3 xformOp:rotateXYZ = (-90, 0, 0)
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateXYZ"]
+    }
+
+    def PortalLight "Glazing"
+    {
+        float inputs:width = 2.5
+        float inputs:height = 2.2
+        float inputs:intensity = 0.8
+        color3f inputs:color = (0.9, 0.95, 1)
+        double3 xformOp:translate = (0.2, 3.4, 0.1)
+        float xformOp:rotateX = -95
+        float xformOp:rotateZ = 25
+        uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateX", "xformOp:rotateZ"]
+    }
+
+    def PortalLight "Window"
+    {
+        float inputs:width = 2
+        float inputs:height = 1.5
+        double3 xformOp:translate = (0, 1.75, 3)
+        uniform token[] xformOpOrder = ["xformOp:translate"]
+    }
+}
+"#,
+    )
+    .unwrap();
+    check_compares_the_masked_dome(stage.to_str().unwrap());
+}
+
+/// `check --portal-mode mask` on `stage` compares /World/Sky's emission, radiance and
+/// irradiance (something lit in each) and passes, listing nothing of it as host-only.
+fn check_compares_the_masked_dome(stage: &str) {
     if crate::common::gpu().is_none() {
         return;
     }
     let o = luxeval(&[
         "check",
-        &asset("window_room.usda"),
+        stage,
         "--portal-mode",
         "mask",
         "--samples",
@@ -201,7 +265,14 @@ fn check_compares_a_masked_domes_radiance_and_irradiance() {
         "{v}"
     );
     eprintln!(
-        "window room, mask mode: radiance {} samples, {} excluded, {} lit, worst {}",
-        radiance["samples"], radiance["excluded"], radiance["nonzero"], radiance["max_rel_error"]
+        "{stage}, mask mode: radiance {} samples, {} excluded, {} lit, worst {}; irradiance {} \
+         samples, {} excluded, worst {}",
+        radiance["samples"],
+        radiance["excluded"],
+        radiance["nonzero"],
+        radiance["max_rel_error"],
+        irradiance["samples"],
+        irradiance["excluded"],
+        irradiance["max_rel_error"]
     );
 }
