@@ -16,11 +16,11 @@
 //   (portal.wgsl); a receiver within ~1e-6 (relative) of a portal's plane may count it or not
 //   differently from the reference, where the portal is seen edge-on (the conformance check
 //   excludes that band, conformance::band::irradiance_margin).
-// f32: clip_to_cone writes at most PORTAL_OVERLAP_VERTICES vertices (gpu::mesh_atlas): a convex
-//   polygon gains at most one a clip (4 + 4·3 for four portals), and a rounded one that would gain more keeps the
-//   first ones (the CPU's Vec has no bound).
-// GPU-only portal_seen, portal_corners: they read a portal's words in the mesh atlas (the CPU
-//   reads PreparedPortal's fields).
+// f32: clip_to_cone writes at most PORTAL_OVERLAP_VERTICES vertices (gpu::mesh_atlas): a
+//   convex polygon gains at most one a clip (4 + 4·3 for four portals), and a rounded one that
+//   would gain more keeps the first ones (the CPU's Vec has no bound).
+// GPU-only portal_at, portal_multiplier, portal_seen, portal_corners: they read a portal's
+//   words in the mesh atlas (the CPU reads PreparedPortal's fields).
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: a portal costs at
 //   most ~25 (two triangles), an overlap of two, three or four at most 120, 237 or 386, and
 //   prepare::portal::overlaps keeps a dome's overlaps within 48,000 (OVERLAP_ITERATIONS), so
@@ -45,22 +45,23 @@ fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     var k = 0u;
     for (; k < count; k++) {
-        let q = at + 1u + k * PORTAL_WORDS;
+        let q = portal_at(at, k);
         if !portal_seen(q, x) {
             continue;
         }
         let c = portal_corners(q, x);
         let above = max(max(dot(n, c[0]), dot(n, c[1])), max(dot(n, c[2]), dot(n, c[3]))) > 0.0;
         if above {
-            let m = vec3<f32>(mesh_atlas[q + 17u], mesh_atlas[q + 18u], mesh_atlas[q + 19u]);
-            sum += m * (triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n));
+            let e = triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n);
+            sum += portal_multiplier(q) * e;
         }
     }
     if k < count {
         // Cut short by the device's loop budget (see irr_cut).
         irr_cut = true;
     }
-    let sets_at = at + 1u + count * PORTAL_WORDS;
+    // The overlaps follow the last portal.
+    let sets_at = portal_at(at, count);
     let sets = bitcast<u32>(mesh_atlas[sets_at]);
     var s = 0u;
     for (; s < sets; s++) {
@@ -73,11 +74,10 @@ fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
                 break;
             }
             size += 1u;
-            all_seen = all_seen && portal_seen(at + 1u + member * PORTAL_WORDS, x);
+            all_seen = all_seen && portal_seen(portal_at(at, member), x);
         }
         if all_seen {
-            let q = at + 1u + bitcast<u32>(mesh_atlas[o]) * PORTAL_WORDS;
-            let m = vec3<f32>(mesh_atlas[q + 17u], mesh_atlas[q + 18u], mesh_atlas[q + 19u]);
+            let m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
             let sign = select(1.0, -1.0, size % 2u == 0u);
             sum += sign * m * overlap_lambert(at, o, size, x, n);
         }
@@ -91,14 +91,14 @@ fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // Lambert's formula (clipped at n·ω ≥ 0) on what x sees through each of the `size` portals
 // listed at `o`: the first one's parallelogram clipped to the cones over the others, as a fan.
 fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
-    let first = portal_corners(at + 1u + bitcast<u32>(mesh_atlas[o]) * PORTAL_WORDS, x);
+    let first = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o])), x);
     var poly: OverlapPolygon;
     poly.count = 4u;
     for (var i = 0u; i < 4u; i++) {
         poly.p[i] = first[i];
     }
     for (var j = 1u; j < size; j++) {
-        let cone = portal_corners(at + 1u + bitcast<u32>(mesh_atlas[o + j]) * PORTAL_WORDS, x);
+        let cone = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o + j])), x);
         poly = clip_to_cone(poly, cone);
         if poly.count < 3u {
             return 0.0;
@@ -155,6 +155,16 @@ fn clip_to_cone(poly: OverlapPolygon, cone: array<vec3<f32>, 4>) -> OverlapPolyg
         cur = out;
     }
     return cur;
+}
+
+// Where the words of portal k of the block at `at` start.
+fn portal_at(at: u32, k: u32) -> u32 {
+    return at + 1u + k * PORTAL_WORDS;
+}
+
+// The multiplier of the portal whose words start at q.
+fn portal_multiplier(q: u32) -> vec3<f32> {
+    return vec3<f32>(mesh_atlas[q + 17u], mesh_atlas[q + 18u], mesh_atlas[q + 19u]);
 }
 
 // Whether x is on the −Z side of the portal whose words start at q.
