@@ -7,8 +7,8 @@
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
 // On the host: lights flagged FLAG_HOST_IRRADIANCE (textured rects, textured domes other than
-//   latlong ones under a conformal frame with tables the device holds, masked domes but the
-//   untextured ones whose portals cannot hide one another (irradiance/portals.wgsl), mesh
+//   latlong ones under a conformal frame with tables the device holds, masked domes whose
+//   portals of different multipliers rays cross in either order (irradiance/portals.wgsl), mesh
 //   lights whose triangles may hide one another, IES profiles bent by angleScale) give 0 here
 //   and the host adds the CPU reference's value (prepare::Prepared::irradiance_on_host gives the
 //   reasons). A textured latlong dome is integrated by rows of its texture
@@ -40,6 +40,7 @@
 // #import mesh/lambert.wgsl
 // #import irradiance/portals.wgsl
 // #import irradiance/latlong_rows.wgsl
+// #import irradiance/latlong_polygon.wgsl
 
 fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let base = light.base.xyz;
@@ -55,19 +56,19 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     switch light.kind {
         case KIND_DOME: {
             e = base * PI;
+            // A textured dome is latlong under a conformal frame (prepare::gpu_path): the
+            // dome-space normal is A_eff⁻¹ n normalised (src/cpu/irradiance/latlong_rows.rs).
+            let inv = mat3x3<f32>(light.tex_inv0.xyz, light.tex_inv1.xyz, light.tex_inv2.xyz);
+            let textured = has_flag(light, FLAG_DOME_TEXTURE);
             if has_flag(light, FLAG_PORTALS) {
-                // Masked and untextured where the device sums it (prepare::portal::overlaps):
-                // Lambert's formula over the portals and, by inclusion–exclusion, their overlaps.
-                e = base * portals_lambert(light.tex.w, x, n);
-            }
-            // #if TEXTURE
-            if has_flag(light, FLAG_DOME_TEXTURE) {
-                // A latlong dome under a conformal frame (prepare::gpu_path): the dome-space
-                // normal is A_eff⁻¹ n normalised (src/cpu/irradiance/latlong_rows.rs).
-                let inv = mat3x3<f32>(light.tex_inv0.xyz, light.tex_inv1.xyz, light.tex_inv2.xyz);
+                // Masked where the device sums it (prepare::gpu_path::masked): E over the
+                // portals and, by inclusion–exclusion, their overlaps.
+                e = base * portals_irradiance(light.tex.w, x, n, PortalDome(textured, light.tex.z, inv));
+            } else if textured {
+                // #if TEXTURE
                 e = base * latlong_irradiance(rows_info(light.tex.z), normalize(inv * n));
+                // #endif
             }
-            // #endif
         }
         case KIND_DISTANT: {
             let c = -light.axis.xyz;

@@ -227,6 +227,10 @@ pub const IRR_OUTER_DEPTH: usize = 5;
 /// Irradiance kernel: Gauss–Legendre points per θ interval of a textured latlong dome's row
 /// integral (`shaders/irradiance/latlong_rows.wgsl`; the intervals end at every kink).
 pub const IRR_GL_ROWS: usize = 6;
+/// Irradiance kernel: Gauss–Legendre points per θ interval and arc end of a textured latlong
+/// dome's integral through a portal (`shaders/irradiance/latlong_polygon.wgsl`): 6 left
+/// 2.7e-9 of the reference on the twin's polygons, 8 and 10 leave 2e-10.
+pub const IRR_GL_POLYGON: usize = 8;
 /// Irradiance kernel: the longest θ interval of that integral (coarse textures' intervals are
 /// cut in equal parts no longer than this).
 pub const IRR_ROWS_MAX_SPAN: f64 = 0.2;
@@ -261,6 +265,7 @@ pub fn wgsl_u32_constants() -> Vec<(&'static str, u32)> {
         ("IRR_OUTER_DEPTH", IRR_OUTER_DEPTH as u32),
         ("IRR_ARC_SAMPLES", IRR_ARC_SAMPLES),
         ("IRR_GL_ROWS", IRR_GL_ROWS as u32),
+        ("IRR_GL_POLYGON", IRR_GL_POLYGON as u32),
     ]
 }
 
@@ -283,9 +288,12 @@ pub fn wgsl_f32_arrays() -> Vec<(&'static str, Vec<f64>)> {
     let (xi, wi) = gauss_legendre(IRR_GL_INNER);
     let gk = gk15_unit();
     let (xr, wr) = gauss_legendre(IRR_GL_ROWS);
+    let (xp, wp) = gauss_legendre(IRR_GL_POLYGON);
     vec![
         ("IRR_GL_ROWS_X", xr),
         ("IRR_GL_ROWS_W", wr),
+        ("IRR_GL_POLYGON_X", xp),
+        ("IRR_GL_POLYGON_W", wp),
         ("IRR_GL_CAP_X", xo),
         ("IRR_GL_CAP_W", wo),
         ("IRR_GL_INNER_X", xi),

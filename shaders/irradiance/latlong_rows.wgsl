@@ -20,7 +20,7 @@
 // 5. Everything here is the optional part TEXTURE (gpu::shaders::Features): an irradiance
 //    pipeline without a textured dome to integrate is built without it (lavapipe compiles
 //    code it never calls).
-// GPU-only RowsInfo, RowMoments, RowEntry: structs standing in for the twin's Rows and tuples.
+// GPU-only RowsInfo, RowMoments, RowEntry, RowPair: structs standing in for the twin's Rows and tuples.
 // GPU-only rows_info: reads the tables' header (the twin's Rows holds the numbers).
 // GPU-only piece_moments: its f64 form is prepare::latlong_rows::piece_moments, which builds the
 //   tables.
@@ -45,6 +45,12 @@ struct RowMoments {
 struct RowEntry {
     m: RowMoments,
     v: vec3<f32>,
+}
+
+struct RowPair {
+    j0: u32,
+    j1: u32,
+    fy: f32,
 }
 
 struct Horizon {
@@ -139,20 +145,23 @@ fn row_value(t: RowsInfo, j: u32, hz: Horizon, cos_t: f32, sin_t: f32) -> vec3<f
     return a * q.q0 + sin_t * (hz.p * q.qs + hz.q * q.qc);
 }
 
+// The texture rows (j0, j1) the filtered texture blends at θ in piece row r, and j1's weight.
+fn row_pair(t: RowsInfo, r: u32, theta: f32) -> RowPair {
+    let py = theta / PI * f32(t.height);
+    let j1 = min(r, t.height - 1u);
+    if t.bilinear {
+        return RowPair(min(max(r, 1u) - 1u, t.height - 1u), j1, clamp(py - f32(r) + 0.5, 0.0, 1.0));
+    }
+    return RowPair(j1, j1, 0.0);
+}
+
 fn node_value(t: RowsInfo, r: u32, hz: Horizon, theta: f32) -> vec3<f32> {
     let sin_t = sin(theta);
     let cos_t = cos(theta);
-    let py = theta / PI * f32(t.height);
-    var j0 = min(r, t.height - 1u);
-    var j1 = j0;
-    var fy = 0.0;
-    if t.bilinear {
-        j0 = min(max(r, 1u) - 1u, t.height - 1u);
-        fy = clamp(py - f32(r) + 0.5, 0.0, 1.0);
-    }
-    var v = row_value(t, j0, hz, cos_t, sin_t);
-    if j1 != j0 {
-        v += (row_value(t, j1, hz, cos_t, sin_t) - v) * fy;
+    let rp = row_pair(t, r, theta);
+    var v = row_value(t, rp.j0, hz, cos_t, sin_t);
+    if rp.j1 != rp.j0 {
+        v += (row_value(t, rp.j1, hz, cos_t, sin_t) - v) * rp.fy;
     }
     return sin_t * v;
 }

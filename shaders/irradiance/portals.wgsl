@@ -1,12 +1,14 @@
-// The irradiance of an untextured dome masked by portals (DESIGN.md §8 P2 mask mode) where the
-// device sums it (prepare::portal::overlaps): the dome's radiance is uniform, so the irradiance
-// is the sum over the portals x is on the −Z side of of the portal's multiplier times Lambert's
-// formula on its parallelogram clipped at the horizon, and by inclusion–exclusion over the
-// overlaps the mesh atlas lists after the portals, ± the multiplier of the one each names
-// first times the same on the first portal's parallelogram clipped to the cones from x over
-// the others. Twin of src/cpu/irradiance/portals.rs, which carries the proof; a textured
-// dome, or portals of different multipliers that rays cross in either order, keep their
-// irradiance on the host (GpuPath::HostIrradiance).
+// The irradiance of a dome masked by portals (DESIGN.md §8 P2 mask mode) where the device sums
+// it (prepare::portal::overlaps, prepare::gpu_path::masked): the sum over the portals x is on
+// the −Z side of of the portal's multiplier times E on its parallelogram clipped at the
+// horizon, and by inclusion–exclusion over the overlaps the mesh atlas lists after the
+// portals, ± the multiplier of the one each names first times E on the first portal's
+// parallelogram clipped to the cones from x over the others. E is Lambert's formula for a
+// uniform dome and the texture's exact integral over the polygon for a textured latlong one
+// (irradiance/latlong_polygon.wgsl). Twin of src/cpu/irradiance/portals.rs, which carries the
+// proof; portals of different multipliers that rays cross in either order, and textured
+// domes of other formats or non-conformal frames, keep their irradiance on the host
+// (GpuPath::HostIrradiance).
 //
 // f32: the parallelogram is two triangles through mesh/lambert.wgsl's triangle_lambert (with
 //   its sliver form for portals low over the horizon); the CPU takes Lambert's formula on the
@@ -16,20 +18,26 @@
 //   (portal.wgsl); a receiver within ~1e-6 (relative) of a portal's plane may count it or not
 //   differently from the reference, where the portal is seen edge-on (the conformance check
 //   excludes that band, conformance::band::irradiance_margin).
-// f32: clip_to_cone writes at most PORTAL_OVERLAP_VERTICES vertices (gpu::mesh_atlas): a
-//   convex polygon gains at most one a clip (4 + 4·3 for four portals), and a rounded one that
-//   would gain more keeps the first ones (the CPU's Vec has no bound).
+// f32: clip_polygon writes at most PORTAL_OVERLAP_VERTICES vertices (gpu::mesh_atlas): a
+//   convex polygon gains at most one a clip (4 + 4·3 for four portals, and one more at the
+//   horizon for a textured dome), and a rounded one that would gain more keeps the first ones
+//   (the CPU's Vec has no bound).
+// GPU-only PortalDome: the twin's Option<&TexturedDome>.
+// GPU-only clip_polygon: the twin's closed::clip_above, on the device's fixed-size polygon.
 // GPU-only portal_at, portal_multiplier, portal_seen, portal_corners: they read a portal's
 //   words in the mesh atlas (the CPU reads PreparedPortal's fields).
-// f32: lavapipe stops an invocation's loops after 65,535 iterations in all: a portal costs at
-//   most ~25 (two triangles), an overlap of two, three or four at most 120, 237 or 386, and
-//   prepare::portal::overlaps keeps a dome's overlaps within 48,000 (OVERLAP_ITERATIONS), so
-//   up to ~2,600 portals without overlaps stay inside it; the portal and overlap loops, each
+// f32: lavapipe stops an invocation's loops after 65,535 iterations in all: for a uniform dome
+//   a portal costs at most ~25 (two triangles), an overlap of two, three or four at most 120,
+//   237 or 386, and prepare::portal::overlaps keeps a dome's overlaps within 48,000
+//   (OVERLAP_ITERATIONS), so up to ~2,600 portals without overlaps stay inside it; a textured
+//   dome's polygons cost far more (latlong_polygon.wgsl). The portal and overlap loops, each
 //   clip's vertex loop and the fan's check their own condition after they end and set irr_cut
 //   if they stopped short, and the host recomputes that receiver (shared/record.wgsl).
 
 // #import shared/record.wgsl
 // #import mesh/lambert.wgsl
+// #import irradiance/latlong_rows.wgsl
+// #import irradiance/latlong_polygon.wgsl
 
 // A convex polygon (vectors from x) of `count` vertices.
 struct OverlapPolygon {
@@ -37,10 +45,19 @@ struct OverlapPolygon {
     count: u32,
 }
 
-// Σ multiplier · Lambert(portal clipped at n·ω ≥ 0) over the portals at `at` in the mesh atlas
-// (layout: src/gpu/mesh_atlas.rs) whose −Z side x is on, and ± multiplier · Lambert(overlap)
-// over the overlaps after them whose every portal x is on the −Z side of.
-fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// The masked dome's texture where the kernel integrates it: its row tables' offset in the
+// texture atlas and its world → dome map A_eff⁻¹ (textured: false for a uniform dome).
+struct PortalDome {
+    textured: bool,
+    rows: u32,
+    inv: mat3x3<f32>,
+}
+
+// Σ multiplier · E(portal clipped at n·ω ≥ 0) over the portals at `at` in the mesh atlas
+// (layout: src/gpu/mesh_atlas.rs) whose −Z side x is on, and ± multiplier · E(overlap) over
+// the overlaps after them whose every portal x is on the −Z side of; E is Lambert's formula
+// for a uniform dome, the texture's integral (latlong_polygon.wgsl) for a textured one.
+fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     let count = bitcast<u32>(mesh_atlas[at]);
     var sum = vec3<f32>(0.0);
     var k = 0u;
@@ -52,8 +69,7 @@ fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         let c = portal_corners(q, x);
         let above = max(max(dot(n, c[0]), dot(n, c[1])), max(dot(n, c[2]), dot(n, c[3]))) > 0.0;
         if above {
-            let e = triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n);
-            sum += portal_multiplier(q) * e;
+            sum += portal_multiplier(q) * portal_value(c, n, dome);
         }
     }
     if k < count {
@@ -79,7 +95,7 @@ fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         if all_seen {
             let m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
             let sign = select(1.0, -1.0, size % 2u == 0u);
-            sum += sign * m * overlap_lambert(at, o, size, x, n);
+            sum += sign * m * overlap_value(at, o, size, x, n, dome);
         }
     }
     if s < sets {
@@ -88,9 +104,24 @@ fn portals_lambert(at: u32, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return sum;
 }
 
-// Lambert's formula (clipped at n·ω ≥ 0) on what x sees through each of the `size` portals
-// listed at `o`: the first one's parallelogram clipped to the cones over the others, as a fan.
-fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f32 {
+// E on one portal's parallelogram (corners c, vectors from x): two triangles through Lambert's
+// formula, or the texture's integral.
+fn portal_value(c: array<vec3<f32>, 4>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
+    if dome.textured {
+        var poly: OverlapPolygon;
+        poly.count = 4u;
+        for (var i = 0u; i < 4u; i++) {
+            poly.p[i] = c[i];
+        }
+        return polygon_texture(poly, n, dome);
+    }
+    return vec3<f32>(triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n));
+}
+
+// E on what x sees through each of the `size` portals listed at `o`: the first one's
+// parallelogram clipped to the cones over the others, as a fan of Lambert's triangles or
+// through the texture's integral.
+fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     let first = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o])), x);
     var poly: OverlapPolygon;
     poly.count = 4u;
@@ -101,7 +132,7 @@ fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f3
         let cone = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o + j])), x);
         poly = clip_to_cone(poly, cone);
         if poly.count < 3u {
-            return 0.0;
+            return vec3<f32>(0.0);
         }
     }
     var above = false;
@@ -109,7 +140,10 @@ fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f3
         above = above || dot(n, poly.p[i]) > 0.0;
     }
     if !above {
-        return 0.0;
+        return vec3<f32>(0.0);
+    }
+    if dome.textured {
+        return polygon_texture(poly, n, dome);
     }
     var sum = 0.0;
     var i = 1u;
@@ -119,7 +153,7 @@ fn overlap_lambert(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>) -> f3
     if i + 1u < poly.count {
         irr_cut = true;
     }
-    return sum;
+    return vec3<f32>(sum);
 }
 
 // The part of `poly` inside the cone from x over the convex quadrilateral `cone` (vectors from
@@ -131,30 +165,52 @@ fn clip_to_cone(poly: OverlapPolygon, cone: array<vec3<f32>, 4>) -> OverlapPolyg
         if dot(k, cone[(e + 2u) % 4u]) < 0.0 {
             k = -k;
         }
-        var out: OverlapPolygon;
-        out.count = 0u;
-        var i = 0u;
-        for (; i < cur.count; i++) {
-            let p0 = cur.p[i];
-            let p1 = cur.p[(i + 1u) % cur.count];
-            let d0 = dot(k, p0);
-            let d1 = dot(k, p1);
-            if d0 >= 0.0 && out.count < PORTAL_OVERLAP_VERTICES {
-                out.p[out.count] = p0;
-                out.count += 1u;
-            }
-            if (d0 >= 0.0) != (d1 >= 0.0) && out.count < PORTAL_OVERLAP_VERTICES {
-                out.p[out.count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
-                out.count += 1u;
-            }
-        }
-        if i < cur.count {
-            // Cut short by the device's loop budget: so is the polygon.
-            irr_cut = true;
-        }
-        cur = out;
+        cur = clip_polygon(cur, k);
     }
     return cur;
+}
+
+// The texture's integral over the convex polygon `poly` (vectors from x) clipped at the
+// horizon n·ω ≥ 0 and mapped to dome space (latlong_rows.wgsl's frame: conformal, so the
+// dome-space polygon is the image's and the normal A_eff⁻¹ n normalised).
+fn polygon_texture(poly: OverlapPolygon, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
+    var e = vec3<f32>(0.0);
+    // #if TEXTURE
+    var d = clip_polygon(poly, n);
+    for (var i = 0u; i < d.count; i++) {
+        d.p[i] = dome.inv * d.p[i];
+    }
+    if d.count >= 3u {
+        e = latlong_polygon(rows_info(dome.rows), d, normalize(dome.inv * n));
+    }
+    // #endif
+    return e;
+}
+
+// `poly` clipped to k·v ≥ 0 (Sutherland–Hodgman; the twin's closed::clip_above).
+fn clip_polygon(poly: OverlapPolygon, k: vec3<f32>) -> OverlapPolygon {
+    var out: OverlapPolygon;
+    out.count = 0u;
+    var i = 0u;
+    for (; i < poly.count; i++) {
+        let p0 = poly.p[i];
+        let p1 = poly.p[(i + 1u) % poly.count];
+        let d0 = dot(k, p0);
+        let d1 = dot(k, p1);
+        if d0 >= 0.0 && out.count < PORTAL_OVERLAP_VERTICES {
+            out.p[out.count] = p0;
+            out.count += 1u;
+        }
+        if (d0 >= 0.0) != (d1 >= 0.0) && out.count < PORTAL_OVERLAP_VERTICES {
+            out.p[out.count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
+            out.count += 1u;
+        }
+    }
+    if i < poly.count {
+        // Cut short by the device's loop budget: so is the polygon.
+        irr_cut = true;
+    }
+    return out;
 }
 
 // Where the words of portal k of the block at `at` start.

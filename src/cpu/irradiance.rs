@@ -34,10 +34,12 @@ pub mod dome;
 // callers: the reference integrates by pieces, dome.rs).
 #[cfg_attr(not(test), allow(dead_code))]
 pub mod latlong_rows;
+#[cfg_attr(not(test), allow(dead_code))]
+pub mod latlong_polygon;
 pub mod line;
 pub mod outer;
 pub mod pieces;
-// The device's sum for masked untextured domes (prepare::portal::overlaps), checked
+// The device's sum for masked domes (prepare::portal::overlaps), checked
 // against the visible pieces of cpu::portal::irradiance by its tests (its only callers).
 #[cfg_attr(not(test), allow(dead_code))]
 pub mod portals;

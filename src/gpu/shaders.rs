@@ -86,6 +86,10 @@ pub const SOURCES: &[(&str, &str)] = &[
         include_str!("../../shaders/irradiance/kinks.wgsl"),
     ),
     (
+        "irradiance/latlong_polygon.wgsl",
+        include_str!("../../shaders/irradiance/latlong_polygon.wgsl"),
+    ),
+    (
         "irradiance/latlong_rows.wgsl",
         include_str!("../../shaders/irradiance/latlong_rows.wgsl"),
     ),

@@ -4,6 +4,7 @@
 
 use glam::DMat3;
 
+use super::texture::PreparedTexture;
 use super::{KindData, PreparedIes, PreparedPortal, latlong_rows, portal};
 
 /// Where the GPU path takes a light's values from: the one decision, made per light when it is
@@ -114,21 +115,25 @@ pub(super) fn decide(
 
 /// A dome's [`GpuPath`] once it is masked by `portals` (`Prepared::apply_portal_mode`, DESIGN.md
 /// §8 P2), and the overlaps the device sums: emission and radiance on the device (up to
-/// [`PORTALS_ON_DEVICE`] portals), and irradiance too where it is untextured and its portals
-/// cannot hide one another or the portals of different multipliers are crossed in one order
-/// ([`portal::overlaps`]:
-/// Lambert's formula summed over them by inclusion–exclusion, shaders/irradiance/portals.wgsl).
-pub(super) fn masked(portals: &[PreparedPortal], textured: bool) -> (GpuPath, Vec<Vec<u32>>) {
+/// [`PORTALS_ON_DEVICE`] portals), and irradiance too where the dome is uniform or latlong
+/// under a conformal frame ([`latlong_rows::gpu_path`]) and its portals cannot hide one another
+/// or the portals of different multipliers are crossed in one order ([`portal::overlaps`]:
+/// Lambert's formula or the texture's row integral summed over them by inclusion–exclusion,
+/// shaders/irradiance/portals.wgsl).
+pub(super) fn masked(
+    portals: &[PreparedPortal],
+    textured: Option<&PreparedTexture>,
+) -> (GpuPath, Vec<Vec<u32>>) {
     if portals.len() > PORTALS_ON_DEVICE {
         (
             GpuPath::Host("it is masked by more portals than the radiance kernel tests"),
             Vec::new(),
         )
-    } else if textured {
-        (
-            GpuPath::HostIrradiance("it is a textured dome masked by portals"),
-            Vec::new(),
-        )
+    } else if let Some(t) = textured
+        && let path @ GpuPath::HostIrradiance(_) = latlong_rows::gpu_path(t)
+    {
+        // Another format or a non-conformal frame: no row tables to integrate through them.
+        (path, Vec::new())
     } else {
         match portal::overlaps(portals) {
             Ok(sets) => (GpuPath::Device, sets),

@@ -275,7 +275,7 @@ impl Prepared {
         self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
         if let Some(portals) = &self.portals {
             (self.gpu_path, self.portal_overlaps) =
-                gpu_path::masked(portals, self.dome_texture().is_some());
+                gpu_path::masked(portals, self.dome_texture());
         }
         Ok(())
     }

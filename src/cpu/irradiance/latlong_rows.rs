@@ -55,7 +55,7 @@ pub struct Rows<'a> {
 }
 
 /// `∫ R_j {1, sin u, cos u} du` per channel.
-type Moments = [DVec3; 3];
+pub(crate) type Moments = [DVec3; 3];
 
 /// The receiver's horizon in the texture's angles (module docs).
 struct Horizon {
@@ -67,7 +67,7 @@ struct Horizon {
 }
 
 /// Row `j`'s entry `k` (prefix moments, then the value at the piece's start).
-fn row_entry(t: &Rows, j: usize, k: usize) -> (Moments, DVec3) {
+pub(crate) fn row_entry(t: &Rows, j: usize, k: usize) -> (Moments, DVec3) {
     let o = 2 * t.width + ENTRY_WORDS * (j * (t.width + 1) + k);
     let v = |i: usize| DVec3::new(t.data[o + i], t.data[o + i + 1], t.data[o + i + 2]);
     ([v(0), v(3), v(6)], v(9))
@@ -95,7 +95,7 @@ fn piece_partial(t: &Rows, j: usize, k: usize, tau: f64) -> Moments {
 
 /// `C_j(u)`: the integral from the first piece's start `u₀` to `u` (any real `u`: whole turns
 /// add the row's total).
-fn cumulative(t: &Rows, j: usize, u: f64) -> Moments {
+pub(crate) fn cumulative(t: &Rows, j: usize, u: f64) -> Moments {
     let w = t.width as f64;
     let step = 2.0 * PI / w;
     let u0 = if t.bilinear { 0.5 * step } else { 0.0 };
@@ -127,18 +127,23 @@ fn row_value(t: &Rows, j: usize, hz: &Horizon, cos_t: f64, sin_t: f64) -> DVec3 
     a * q[0] + sin_t * (hz.p * q[1] + hz.q * q[2])
 }
 
-/// The integrand `sin θ [(1 − f_y) I_{j₀} + f_y I_{j₁}]` at θ in piece row `r`.
-fn node_value(t: &Rows, r: usize, hz: &Horizon, theta: f64) -> DVec3 {
-    let (sin_t, cos_t) = theta.sin_cos();
-    let h = t.height as f64;
-    let py = theta / PI * h;
-    let (j0, j1, fy) = if t.bilinear {
+/// The texture rows `(j₀, j₁)` the filtered texture blends at θ in piece row `r`, and the
+/// weight `f_y` of `j₁` (§6 D1's bilinear rows, clamped; nearest: one row, weight 0).
+pub(crate) fn row_pair(t: &Rows, r: usize, theta: f64) -> (usize, usize, f64) {
+    let py = theta / PI * t.height as f64;
+    if t.bilinear {
         let j0 = r.saturating_sub(1).min(t.height - 1);
         let j1 = r.min(t.height - 1);
         (j0, j1, (py - r as f64 + 0.5).clamp(0.0, 1.0))
     } else {
         (r.min(t.height - 1), r.min(t.height - 1), 0.0)
-    };
+    }
+}
+
+/// The integrand `sin θ [(1 − f_y) I_{j₀} + f_y I_{j₁}]` at θ in piece row `r`.
+fn node_value(t: &Rows, r: usize, hz: &Horizon, theta: f64) -> DVec3 {
+    let (sin_t, cos_t) = theta.sin_cos();
+    let (j0, j1, fy) = row_pair(t, r, theta);
     let mut v = row_value(t, j0, hz, cos_t, sin_t);
     if j1 != j0 {
         v += (row_value(t, j1, hz, cos_t, sin_t) - v) * fy;

@@ -1,9 +1,11 @@
-//! The irradiance of an untextured dome masked by portals (DESIGN.md §8 P2 mask mode) where the
-//! device sums it ([`overlaps`]): twin of `shaders/irradiance/portals.wgsl`, the device's form
-//! of [`crate::cpu::portal::irradiance`] for such domes.
+//! The irradiance of a dome masked by portals (DESIGN.md §8 P2 mask mode) where the device sums
+//! it ([`overlaps`]): twin of `shaders/irradiance/portals.wgsl`, the device's form of
+//! [`crate::cpu::portal::irradiance`] for such domes (uniform, or textured latlong under a
+//! conformal frame: the same sum with the texture's integral over each polygon,
+//! [`polygon_texture`]).
 //!
-//! Why the sum is exact: the dome's radiance is `base` along every direction, and x receives it
-//! along the rays that pass through a portal toward its +Z, that is through a portal whose −Z
+//! Why the sum is exact: the dome's radiance along ω is `L(ω)` (`base`, or `base` times the
+//! filtered texture), and x receives it along the rays that pass through a portal toward its +Z, that is through a portal whose −Z
 //! side x is on (every ray from there through the portal crosses it toward +Z), times the
 //! multiplier of the nearest such portal. Where no ray crosses two portals
 //! ([`crossing_orders`] says when, for each pair), those directions are the disjoint
@@ -13,7 +15,7 @@
 //! farthest member along a ray through all of S) satisfy `Σ_{∅≠S⊆T} c(S) = m_{first(T)}` for
 //! every T: with T = {t₁, …, t_k} nearest first, the sets whose last member is t_j are {t_j} ∪ R
 //! for R ⊆ {t₁, …, t_{j−1}}, and `Σ_R (−1)^{|R|}` is 1 for j = 1 and 0 otherwise. So
-//! `E = Σ_S c(S) ∫_{∩S} n·ω dω` over the nonempty sets S of portals seen from x. A set with two
+//! `E = Σ_S c(S) ∫_{∩S} L(ω) n·ω dω` over the nonempty sets S of portals seen from x. A set with two
 //! members no ray crosses together meets in measure zero, so the sum runs over the portals and
 //! the cliques of the "crossable" graph that [`overlaps`] lists, each with the multiplier of
 //! the member it names first; that member's multiplier is the same on every ray through the
@@ -21,27 +23,40 @@
 //! Each intersection, seen from x, is the first portal's parallelogram clipped by the planes
 //! through x and the other portals' edges (a convex polygon: convex sets' intersection), and
 //! the irradiance of a uniform convex polygon clipped at the receiver's horizon is Lambert's
-//! formula ([`polygon_irradiance`]: Lambert 1760; Arvo 1995). `crate::cpu::portal::irradiance`,
+//! formula ([`polygon_irradiance`]: Lambert 1760; Arvo 1995); a textured latlong dome's is
+//! the exact row integral over the polygon ([`latlong_polygon`]). `crate::cpu::portal::irradiance`,
 //! which cuts the portals into their visible pieces nearest first for any set, is this sum's
-//! independent check (`tests::the_inclusion_exclusion_sum_is_the_visible_pieces_where_portals_overlap`).
+//! independent check (`tests::the_inclusion_exclusion_sum_is_the_visible_pieces_where_portals_overlap`,
+//! and for textured domes `tests::textured_sum_is_the_visible_pieces`).
 //!
 //! [`crossing_orders`]: crate::prepare::portal::crossing_orders
 //! [`overlaps`]: crate::prepare::portal::overlaps
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 
 use super::closed::{clip_above, polygon_irradiance};
+use super::latlong_polygon::latlong_polygon;
+use super::latlong_rows::Rows;
 use crate::prepare::PreparedPortal;
 
-/// `Σ multiplier · Lambert(portal clipped at n·ω ≥ 0)` over the portals whose −Z side x is on,
-/// and `(−1)^{|S|+1} multiplier(S's first member) · Lambert(∩S clipped)` over the `overlaps` S
+/// A textured latlong dome under a conformal frame, as the device integrates it through its
+/// portals: its row tables and its world → dome map `A_eff⁻¹` (`latlong_rows` module docs).
+pub struct TexturedDome<'a> {
+    pub rows: Rows<'a>,
+    pub inv: DMat3,
+}
+
+/// `Σ multiplier · E(portal clipped at n·ω ≥ 0)` over the portals whose −Z side x is on,
+/// and `(−1)^{|S|+1} multiplier(S's first member) · E(∩S clipped)` over the `overlaps` S
 /// (`Prepared::portal_overlaps`) whose every member x is on the −Z side of (unit-radiance dome,
-/// before `base` and `diffuse`).
-pub fn portals_lambert(
+/// before `base` and `diffuse`). E is Lambert's formula for a uniform dome (`dome` None) and
+/// the texture's exact integral over the polygon for a textured one ([`polygon_texture`]).
+pub fn portals_irradiance(
     portals: &[PreparedPortal],
     overlaps: &[Vec<u32>],
     x: DVec3,
     n: DVec3,
+    dome: Option<&TexturedDome>,
 ) -> DVec3 {
     let seen = |q: &PreparedPortal| q.normal.dot(x - q.origin) < 0.0;
     let mut sum = DVec3::ZERO;
@@ -53,36 +68,58 @@ pub fn portals_lambert(
         if v.iter().all(|v| !(n.dot(*v) > 0.0)) {
             continue;
         }
-        sum += q.multiplier * polygon_irradiance(&v, n);
+        sum += q.multiplier * portal_value(&v, n, dome);
     }
     for set in overlaps {
         if !set.iter().all(|&k| seen(&portals[k as usize])) {
             continue;
         }
         let sign = if set.len() % 2 == 0 { -1.0 } else { 1.0 };
-        sum += sign * portals[set[0] as usize].multiplier * overlap_lambert(portals, set, x, n);
+        sum += sign
+            * portals[set[0] as usize].multiplier
+            * overlap_value(portals, set, x, n, dome);
     }
     sum
 }
 
-/// Lambert's formula (clipped at n·ω ≥ 0) on what x sees through every portal of `set`: the
-/// first one's parallelogram (vectors from x) clipped to the cones from x over the others
-/// ([`clip_to_cone`]), as a fan of triangles from its first vertex (the device's form; the
-/// fan's inner edges cancel).
-pub fn overlap_lambert(portals: &[PreparedPortal], set: &[u32], x: DVec3, n: DVec3) -> f64 {
+/// E on one portal's parallelogram (corners `v`, vectors from x): Lambert's formula on its
+/// corners, or the texture's integral.
+pub fn portal_value(v: &[DVec3; 4], n: DVec3, dome: Option<&TexturedDome>) -> DVec3 {
+    match dome {
+        Some(d) => polygon_texture(v, n, d),
+        None => DVec3::splat(polygon_irradiance(v, n)),
+    }
+}
+
+/// E on what x sees through every portal of `set`: the first one's parallelogram (vectors from
+/// x) clipped to the cones from x over the others ([`clip_to_cone`]), as a fan of Lambert's
+/// triangles from its first vertex (the device's form; the fan's inner edges cancel) or
+/// through the texture's integral.
+pub fn overlap_value(
+    portals: &[PreparedPortal],
+    set: &[u32],
+    x: DVec3,
+    n: DVec3,
+    dome: Option<&TexturedDome>,
+) -> DVec3 {
     let mut poly: Vec<DVec3> = portals[set[0] as usize].corners.map(|c| c - x).to_vec();
     for &k in &set[1..] {
         poly = clip_to_cone(&poly, &portals[k as usize].corners.map(|c| c - x));
         if poly.len() < 3 {
-            return 0.0;
+            return DVec3::ZERO;
         }
     }
     if poly.iter().all(|v| !(n.dot(*v) > 0.0)) {
-        return 0.0;
+        return DVec3::ZERO;
     }
-    (1..poly.len() - 1)
-        .map(|i| polygon_irradiance(&[poly[0], poly[i], poly[i + 1]], n))
-        .sum()
+    if let Some(d) = dome {
+        return polygon_texture(&poly, n, d);
+    }
+    DVec3::splat(
+        (1..poly.len() - 1)
+            .map(|i| polygon_irradiance(&[poly[0], poly[i], poly[i + 1]], n))
+            .sum(),
+    )
 }
 
 /// The part of the convex polygon `poly` (vectors from x) inside the cone from x over the
@@ -95,6 +132,21 @@ pub fn clip_to_cone(poly: &[DVec3], cone: &[DVec3; 4]) -> Vec<DVec3> {
         let k = a.cross(b);
         clip_above(&cur, if k.dot(c) < 0.0 { -k } else { k })
     })
+}
+
+/// The texture's integral over the convex polygon `poly` (vectors from x) clipped at the
+/// horizon `n·ω ≥ 0` and mapped to dome space ([`latlong_polygon`]; the frame is conformal,
+/// so the dome-space polygon is the image of the world one and the normal `A_eff⁻¹ n`
+/// normalised, as `latlong_rows` maps it).
+pub fn polygon_texture(poly: &[DVec3], n: DVec3, dome: &TexturedDome) -> DVec3 {
+    let clipped: Vec<DVec3> = clip_above(poly, n)
+        .into_iter()
+        .map(|v| dome.inv * v)
+        .collect();
+    if clipped.len() < 3 {
+        return DVec3::ZERO;
+    }
+    latlong_polygon(&dome.rows, &clipped, (dome.inv * n).normalize())
 }
 
 #[cfg(test)]
