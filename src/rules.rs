@@ -234,6 +234,19 @@ pub const IRR_GL_POLYGON: usize = 8;
 /// Irradiance kernel: the longest θ interval of that integral (coarse textures' intervals are
 /// cut in equal parts no longer than this).
 pub const IRR_ROWS_MAX_SPAN: f64 = 0.2;
+/// Most whole pieces `cpu::irradiance::latlong_polygon::span_moments` sums one by one; a longer span takes the difference of
+/// the prefix sums. On the device the prefix sums are f32 (`shaders/irradiance/latlong_rows.wgsl` divergence 1):
+/// their difference is within ~1e-7 of the row's total, not of the span's part of it, which
+/// for a portal seen small (a sliver, a far window: a few pieces of the row) is far more than
+/// 1e-4 of it; summed piece by piece from the texel values it is within ~1e-7 of the span's.
+/// A span of more than this many pieces holds at least `SHORT_SPAN / W` of the row.
+pub const LATLONG_SHORT_SPAN: f64 = 16.0;
+/// The least span of α over which `cpu::irradiance::latlong_polygon::end_integral` (and its
+/// kernel) integrates an arc end in α rather than in σ: along an edge near a meridian α barely
+/// moves from π/2, and f32 cannot place nodes a few ulps apart (lavapipe: 2.4e-3 off on a
+/// triple overlap whose polygon had such an edge); over 0.1 the nodes are within ~1e-6 of it.
+pub const LATLONG_MIN_ALPHA_SPAN: f64 = 0.1;
+
 /// Irradiance kernel: samples per elliptic arc when bracketing cone crossings.
 pub const IRR_ARC_SAMPLES: u32 = 24;
 /// Irradiance kernel: an unshaped rect uses Lambert's formula only where its edge terms cannot
@@ -278,6 +291,8 @@ pub fn wgsl_f32_constants() -> Vec<(&'static str, f64)> {
         ("IRR_TAN_MAP_RHO", TAN_MAP_RHO),
         ("IRR_MAX_U_SPAN", MAX_U_SPAN),
         ("IRR_ROWS_MAX_SPAN", IRR_ROWS_MAX_SPAN),
+        ("LATLONG_SHORT_SPAN", LATLONG_SHORT_SPAN),
+        ("LATLONG_MIN_ALPHA_SPAN", LATLONG_MIN_ALPHA_SPAN),
     ]
 }
 

@@ -18,19 +18,12 @@ use glam::{DMat4, DVec3};
 use luxeval::testkit::Rng;
 use luxeval::testkit::dome::{near_discontinuity, prepare_with_filter};
 use luxeval::{
-    Accumulate, Asset, Evaluator, Light, PoleAxis, Texture, TextureFilter, TextureFormat, UpAxis,
+    Accumulate, Evaluator, Light, PoleAxis, Texture, TextureFilter, TextureFormat, UpAxis,
 };
 
 const TOL: f64 = 1e-4;
 
-fn png(w: u32, h: u32, rng: &mut Rng) -> Asset {
-    let img = image::RgbImage::from_fn(w, h, |_, _| {
-        image::Rgb([0, 1, 2].map(|_| 128 + rng.below(128) as u8))
-    });
-    let mut bytes = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-    Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
-}
+use luxeval::testkit::dome::random_png as png;
 
 fn unit(rng: &mut Rng) -> [f32; 3] {
     let z: f64 = 2.0 * rng.f64() - 1.0;

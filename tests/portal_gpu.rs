@@ -9,7 +9,9 @@
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use luxeval::testkit::Rng;
-use luxeval::{Accumulate, Asset, Evaluator, Light, Portal, PortalMode, Texture, TextureFormat};
+use luxeval::{
+    Accumulate, Asset, Evaluator, Light, Portal, PortalMode, Texture, TextureFilter, TextureFormat,
+};
 
 /// Half-width of the excluded band, as `conformance::BAND`.
 const BAND: f64 = 1e-4;
@@ -151,9 +153,8 @@ fn rays(ps: &[(Portal, DMat4, f64, f64)], n: usize, seed: u64) -> (Vec<[f32; 3]>
 }
 
 /// GPU radiance of masked domes, untextured and textured, within 1e-4 of the reference away
-/// from the portals' edges and planes; emission is the dome's own on both; intensity, and the
-/// textured dome's irradiance, are the reference's exactly (the untextured one's irradiance is
-/// the device's, within 1e-4 away from the check's bands).
+/// from the portals' edges and planes; emission is the dome's own on both; intensity is the
+/// reference's exactly; irradiance is the device's, within 1e-4 away from the check's bands.
 #[test]
 fn masked_dome_radiance_runs_on_the_device_within_tolerance() {
     let Some(gpu) = crate::common::gpu() else {
@@ -227,10 +228,10 @@ fn masked_dome_radiance_runs_on_the_device_within_tolerance() {
             g.irradiance(&pts[..64], &dirs[..64], Accumulate::PerLight)
                 .unwrap(),
         );
-        if dome.texture.is_some() {
-            assert_eq!(ic, ig);
-        } else {
-            // Untextured: these portals overlap in one order each, so the device sums it.
+        {
+            // These portals overlap in one order each, so the device sums it (the textured
+            // dome's texture is large for lavapipe's loop budget: most receivers are cut
+            // short and recomputed by the host, see masked_textured_dome_irradiance_…).
             use luxeval::testkit::check;
             let reference = luxeval::Reference::with_portal_mode(
                 dome,
@@ -417,6 +418,76 @@ fn masked_dome_irradiance_runs_on_the_device_where_portals_overlap() {
         return;
     };
     let gpu = gpu.with_portal_mode(PortalMode::Mask);
+    let dome = glazed(
+        Light::dome()
+            .with_path("/Sky")
+            .with_intensity(2.0)
+            .with_color(DVec3::new(0.9, 0.7, 1.0)),
+    );
+    let n = 3000;
+    let (excluded, lit, worst) = irradiance_matches_the_reference(&gpu, &dome, 0x0E_1A9);
+    eprintln!(
+        "masked dome irradiance through overlapping portals: {n} receivers, {excluded} \
+         excluded, {lit} lit, worst relative error {worst:e}"
+    );
+    assert!(lit > n / 3, "{lit} lit of {n}");
+    // Eight portals' f32 bands (measured: 66 receivers, 2.2 %).
+    assert!(excluded < n / 30, "{excluded} excluded");
+}
+
+/// The same glazing over textured latlong domes (random 32 × 16 texels; the default bilinear
+/// filter and nearest; the identity frame and a turned, scaled one): the device integrates the
+/// texture over each portal and overlap by rows (shaders/irradiance/latlong_polygon.wgsl),
+/// within 1e-4 of the reference's exact texel integral over the visible pieces, away from the
+/// check's bands; `luxeval check` passes, nothing host-only. (tests/resident.rs shows the
+/// kernel finishes these on lavapipe rather than leaving them to the host.)
+#[test]
+fn masked_textured_dome_irradiance_runs_on_the_device() {
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let gpu = gpu.with_portal_mode(PortalMode::Mask);
+    let mut rng = Rng::new(0x7E_47);
+    let turned = DMat4::from_scale_rotation_translation(
+        DVec3::splat(3.0),
+        DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7),
+        DVec3::new(1.0, -2.0, 0.5),
+    );
+    for (i, (filter, frame)) in [
+        (TextureFilter::Nearest, DMat4::IDENTITY),
+        (TextureFilter::Bilinear, turned),
+        (TextureFilter::Bilinear, DMat4::IDENTITY),
+        (TextureFilter::Nearest, turned),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let texture = Texture::new(luxeval::testkit::dome::random_png(32, 16, &mut rng))
+            .with_format(TextureFormat::LatLong)
+            .with_filter(filter);
+        let dome = glazed(
+            Light::dome()
+                .with_path("/Map")
+                .with_intensity(1.5)
+                .with_transform(frame)
+                .with_texture(texture),
+        );
+        let n = 3000;
+        let (excluded, lit, worst) =
+            irradiance_matches_the_reference(&gpu, &dome, 0x7E_0E + i as u64);
+        eprintln!(
+            "textured masked dome irradiance ({filter:?}): {n} receivers, {excluded} excluded, \
+             {lit} lit, worst relative error {worst:e}"
+        );
+        assert!(lit > n / 3, "{lit} lit of {n}");
+        assert!(excluded < n / 30, "{excluded} excluded");
+    }
+}
+
+/// Eight portals on `dome`, each of its own intensity and colour: a skylight under two tilted,
+/// turned panes, two overlapping windows in one wall, a window with a pane outside it, a
+/// window apart.
+fn glazed(dome: Light) -> Light {
     // (facing, centre, turn about the facing, width, height)
     let tilt = |x: f64, y: f64| DVec3::new(x, y, 1.0).normalize();
     let specs = [
@@ -429,12 +500,10 @@ fn masked_dome_irradiance_runs_on_the_device_where_portals_overlap() {
         (tilt(0.0, -3.0), DVec3::new(-0.8, -3.7, 0.3), 0.3, 2.0, 1.6),
         (-DVec3::X, DVec3::new(-3.0, 0.0, 0.5), 0.6, 1.2, 2.0),
     ];
-    let dome = specs.iter().enumerate().fold(
-        Light::dome()
-            .with_path("/Sky")
-            .with_intensity(2.0)
-            .with_color(DVec3::new(0.9, 0.7, 1.0)),
-        |l, (i, &(facing, c, turn, w, h))| {
+    specs
+        .iter()
+        .enumerate()
+        .fold(dome, |l, (i, &(facing, c, turn, w, h))| {
             let rot = DQuat::from_rotation_arc(DVec3::Z, facing) * DQuat::from_rotation_z(turn);
             l.with_portal(
                 Portal::new(w, h)
@@ -447,17 +516,7 @@ fn masked_dome_irradiance_runs_on_the_device_where_portals_overlap() {
                         0.4 + 0.05 * i as f64,
                     )),
             )
-        },
-    );
-    let n = 3000;
-    let (excluded, lit, worst) = irradiance_matches_the_reference(&gpu, &dome, 0x0E_1A9);
-    eprintln!(
-        "masked dome irradiance through overlapping portals: {n} receivers, {excluded} \
-         excluded, {lit} lit, worst relative error {worst:e}"
-    );
-    assert!(lit > n / 3, "{lit} lit of {n}");
-    // Eight portals' f32 bands (measured: 66 receivers, 2.2 %).
-    assert!(excluded < n / 30, "{excluded} excluded");
+        })
 }
 
 /// Compares the masked `dome`'s irradiance on `gpu` with the reference's at 3,000 receivers

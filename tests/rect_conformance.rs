@@ -14,18 +14,11 @@ use crate::common;
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use luxeval::testkit::Rng;
 use luxeval::testkit::rect::{near_rect_discontinuity, prepare_rects_with_filter};
-use luxeval::{Accumulate, Asset, Evaluator, Light, LightType, Shaping, Texture};
+use luxeval::{Accumulate, Evaluator, Light, LightType, Shaping, Texture};
 
 const TOL: f64 = 1e-4;
 
-fn png(w: u32, h: u32, rng: &mut Rng) -> Asset {
-    let img = image::RgbImage::from_fn(w, h, |_, _| {
-        image::Rgb([0, 1, 2].map(|_| 128 + rng.below(128) as u8))
-    });
-    let mut bytes = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-    Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
-}
+use luxeval::testkit::dome::random_png as png;
 
 fn unit(rng: &mut Rng) -> DVec3 {
     let z: f64 = 2.0 * rng.f64() - 1.0;

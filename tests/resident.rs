@@ -1119,3 +1119,109 @@ fn a_masked_dome_with_the_most_overlaps_the_budget_admits_finishes_on_the_device
         }
     }
 }
+
+/// A latlong-textured dome masked by a window, a pane of another intensity above it (one ray
+/// crosses both: their overlap counts by inclusion–exclusion) and a second window in a wall:
+/// its irradiance is the device's (the texture's row integral over each portal and overlap,
+/// shaders/irradiance/latlong_polygon.wgsl), so `encode_irradiance` accepts it, and on lavapipe
+/// the kernel finishes every receiver of a 32 × 16 map (a row cut short would read NaN) within
+/// 1e-4 of the host path and of the CPU reference.
+#[test]
+fn a_masked_textured_dome_is_resident() {
+    let Some(r) = renderer() else { return };
+    let mut rng = luxeval::testkit::Rng::new(0x7E_5D);
+    let portal = |path: &str, w: f64, h: f64, k: f64, world: glam::DMat4| {
+        luxeval::Portal::new(w, h)
+            .with_path(path)
+            .with_intensity(k)
+            .with_transform(world)
+    };
+    let dome = Light::dome()
+        .with_path("/World/Sky")
+        .with_texture(
+            Texture::new(luxeval::testkit::dome::random_png(32, 16, &mut rng))
+                .with_format(TextureFormat::LatLong),
+        )
+        .with_portal(portal(
+            "/World/Window",
+            2.0,
+            1.0,
+            3.0,
+            glam::DMat4::from_translation(glam::DVec3::new(0.0, 0.0, 3.0)),
+        ))
+        .with_portal(portal(
+            "/World/Pane",
+            2.4,
+            1.6,
+            1.5,
+            glam::DMat4::from_rotation_translation(
+                glam::DQuat::from_rotation_x(0.2),
+                glam::DVec3::new(0.2, 0.1, 3.6),
+            ),
+        ))
+        .with_portal(portal(
+            "/World/Side",
+            1.5,
+            1.2,
+            2.0,
+            glam::DMat4::from_rotation_translation(
+                glam::DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2),
+                glam::DVec3::new(3.0, 0.5, 1.0),
+            ),
+        ));
+    let n = 64;
+    let points: Vec<[f32; 3]> = (0..n)
+        .map(|i| {
+            [
+                -2.0 + 0.5 * (i % 8) as f32,
+                -2.0 + 0.5 * (i / 8) as f32,
+                (i % 3) as f32 * 0.4,
+            ]
+        })
+        .collect();
+    let normals: Vec<[f32; 3]> = (0..n)
+        .map(|i| {
+            let t = i as f32 * 0.61;
+            let v = [0.5 * t.sin(), 0.5 * t.cos(), 1.0];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+            v.map(|c| c / l)
+        })
+        .collect();
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone())
+        .unwrap()
+        .with_portal_mode(luxeval::PortalMode::Mask);
+    let scene = eval.prepare(std::slice::from_ref(&dome)).unwrap();
+    let pts = r.buffer(&points, wgpu::BufferUsages::STORAGE);
+    let nrm = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    scene
+        .encode_irradiance(&mut enc, &pts, &nrm, &out, n as u32, Accumulate::Sum)
+        .unwrap();
+    let got = r.finish(enc, &out, n);
+    let host = scene
+        .irradiance(&points, &normals, Accumulate::Sum)
+        .unwrap();
+    let reference = Evaluator::cpu()
+        .with_portal_mode(luxeval::PortalMode::Mask)
+        .prepare(std::slice::from_ref(&dome))
+        .unwrap()
+        .irradiance(&points, &normals, Accumulate::Sum)
+        .unwrap();
+    for i in 0..n {
+        let (g, h, c) = (got[i], host[i], reference[i]);
+        let scale = c.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0, "{i}: dark");
+        for k in 0..3 {
+            assert!(g[k].is_finite(), "{i}: cut short: {g:?}");
+            assert!(
+                (g[k] - h[k]).abs() <= 1e-4 * scale,
+                "{i}: {g:?} vs host path {h:?}"
+            );
+            assert!(
+                (g[k] - c[k]).abs() <= 1e-4 * scale,
+                "{i}: {g:?} vs reference {c:?}"
+            );
+        }
+    }
+}

@@ -373,14 +373,7 @@ fn gpu_samples_match_cpu_on_ies_shaped_and_textured_lights() {
     );
 }
 
-fn png(w: u32, h: u32, rng: &mut Rng) -> Asset {
-    let img = image::RgbImage::from_fn(w, h, |_, _| {
-        image::Rgb([0, 1, 2].map(|_| 128 + rng.below(128) as u8))
-    });
-    let mut bytes = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-    Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
-}
+use luxeval::testkit::dome::random_png as png;
 
 /// Textured domes on the device (DESIGN.md §9 S3): every format (latlong, cross, angular,
 /// mirroredBall) and both filters, under the identity, a rotation, a uniform and a non-uniform

@@ -23,7 +23,12 @@
 //   horizon for a textured dome), and a rounded one that would gain more keeps the first ones
 //   (the CPU's Vec has no bound).
 // GPU-only PortalDome: the twin's Option<&TexturedDome>.
-// GPU-only clip_polygon: the twin's closed::clip_above, on the device's fixed-size polygon.
+// GPU-only clip_polygon, parallelogram: the twin's closed::clip_above and corner list, on the
+//   device's fixed-size polygon, which also carries each edge's plane.
+// f32: a textured dome's polygon carries each edge's plane through x from the portal's edges
+//   and the clip planes, where the CPU takes it from the cross product of the edge's ends: a
+//   clip through (nearly) a vertex leaves an edge of ~1e-5 rad, whose ends' f32 cross product
+//   has no direction (lavapipe: 3.9e-4 off on a triple overlap with such an edge).
 // GPU-only portal_at, portal_multiplier, portal_seen, portal_corners: they read a portal's
 //   words in the mesh atlas (the CPU reads PreparedPortal's fields).
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: for a uniform dome
@@ -39,9 +44,11 @@
 // #import irradiance/latlong_rows.wgsl
 // #import irradiance/latlong_polygon.wgsl
 
-// A convex polygon (vectors from x) of `count` vertices.
+// A convex polygon (vectors from x) of `count` vertices, and the inward normal of the plane
+// through x and each edge p[i] → p[i + 1] (carried through the clips: see the header).
 struct OverlapPolygon {
     p: array<vec3<f32>, PORTAL_OVERLAP_VERTICES>,
+    k: array<vec3<f32>, PORTAL_OVERLAP_VERTICES>,
     count: u32,
 }
 
@@ -84,13 +91,17 @@ fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> 
         let o = sets_at + 1u + s * PORTAL_OVERLAP_WORDS;
         var size = 0u;
         var all_seen = true;
-        for (var j = 0u; j < PORTAL_OVERLAP_WORDS; j++) {
+        var j = 0u;
+        for (; j < PORTAL_OVERLAP_WORDS; j++) {
             let member = bitcast<u32>(mesh_atlas[o + j]);
             if member == 0xffffffffu {
                 break;
             }
             size += 1u;
             all_seen = all_seen && portal_seen(portal_at(at, member), x);
+        }
+        if j < PORTAL_OVERLAP_WORDS && bitcast<u32>(mesh_atlas[o + j]) != 0xffffffffu {
+            irr_cut = true;
         }
         if all_seen {
             let m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
@@ -108,12 +119,7 @@ fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> 
 // formula, or the texture's integral.
 fn portal_value(c: array<vec3<f32>, 4>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     if dome.textured {
-        var poly: OverlapPolygon;
-        poly.count = 4u;
-        for (var i = 0u; i < 4u; i++) {
-            poly.p[i] = c[i];
-        }
-        return polygon_texture(poly, n, dome);
+        return polygon_texture(parallelogram(c), n, dome);
     }
     return vec3<f32>(triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n));
 }
@@ -123,12 +129,9 @@ fn portal_value(c: array<vec3<f32>, 4>, n: vec3<f32>, dome: PortalDome) -> vec3<
 // through the texture's integral.
 fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     let first = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o])), x);
-    var poly: OverlapPolygon;
-    poly.count = 4u;
-    for (var i = 0u; i < 4u; i++) {
-        poly.p[i] = first[i];
-    }
-    for (var j = 1u; j < size; j++) {
+    var poly = parallelogram(first);
+    var j = 1u;
+    for (; j < size; j++) {
         let cone = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o + j])), x);
         poly = clip_to_cone(poly, cone);
         if poly.count < 3u {
@@ -136,8 +139,13 @@ fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: P
         }
     }
     var above = false;
-    for (var i = 0u; i < poly.count; i++) {
-        above = above || dot(n, poly.p[i]) > 0.0;
+    var v = 0u;
+    for (; v < poly.count; v++) {
+        above = above || dot(n, poly.p[v]) > 0.0;
+    }
+    if j < size || v < poly.count {
+        // Cut short by the device's loop budget (see irr_cut).
+        irr_cut = true;
     }
     if !above {
         return vec3<f32>(0.0);
@@ -160,12 +168,16 @@ fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: P
 // x): clipped to k·v ≥ 0 for each edge's plane through x, k toward the other corners.
 fn clip_to_cone(poly: OverlapPolygon, cone: array<vec3<f32>, 4>) -> OverlapPolygon {
     var cur = poly;
-    for (var e = 0u; e < 4u; e++) {
+    var e = 0u;
+    for (; e < 4u; e++) {
         var k = cross(cone[e], cone[(e + 1u) % 4u]);
         if dot(k, cone[(e + 2u) % 4u]) < 0.0 {
             k = -k;
         }
         cur = clip_polygon(cur, k);
+    }
+    if e < 4u {
+        irr_cut = true;
     }
     return cur;
 }
@@ -177,8 +189,13 @@ fn polygon_texture(poly: OverlapPolygon, n: vec3<f32>, dome: PortalDome) -> vec3
     var e = vec3<f32>(0.0);
     // #if TEXTURE
     var d = clip_polygon(poly, n);
-    for (var i = 0u; i < d.count; i++) {
+    var i = 0u;
+    for (; i < d.count; i++) {
         d.p[i] = dome.inv * d.p[i];
+        d.k[i] = dome.inv * d.k[i];
+    }
+    if i < d.count {
+        irr_cut = true;
     }
     if d.count >= 3u {
         e = latlong_polygon(rows_info(dome.rows), d, normalize(dome.inv * n));
@@ -187,7 +204,9 @@ fn polygon_texture(poly: OverlapPolygon, n: vec3<f32>, dome: PortalDome) -> vec3
     return e;
 }
 
-// `poly` clipped to k·v ≥ 0 (Sutherland–Hodgman; the twin's closed::clip_above).
+// `poly` clipped to k·v ≥ 0 (Sutherland–Hodgman; the twin's closed::clip_above), each edge
+// keeping its plane: a kept vertex and a point where the boundary comes back in start edges
+// along their input edge's plane, a point where it leaves starts one along k.
 fn clip_polygon(poly: OverlapPolygon, k: vec3<f32>) -> OverlapPolygon {
     var out: OverlapPolygon;
     out.count = 0u;
@@ -199,10 +218,12 @@ fn clip_polygon(poly: OverlapPolygon, k: vec3<f32>) -> OverlapPolygon {
         let d1 = dot(k, p1);
         if d0 >= 0.0 && out.count < PORTAL_OVERLAP_VERTICES {
             out.p[out.count] = p0;
+            out.k[out.count] = poly.k[i];
             out.count += 1u;
         }
         if (d0 >= 0.0) != (d1 >= 0.0) && out.count < PORTAL_OVERLAP_VERTICES {
             out.p[out.count] = p0 + (p1 - p0) * (d0 / (d0 - d1));
+            out.k[out.count] = select(poly.k[i], k, d0 >= 0.0);
             out.count += 1u;
         }
     }
@@ -211,6 +232,25 @@ fn clip_polygon(poly: OverlapPolygon, k: vec3<f32>) -> OverlapPolygon {
         irr_cut = true;
     }
     return out;
+}
+
+// The parallelogram with corners c (vectors from x) and its edges' inward planes through x.
+fn parallelogram(c: array<vec3<f32>, 4>) -> OverlapPolygon {
+    var poly: OverlapPolygon;
+    poly.count = 4u;
+    var e = 0u;
+    for (; e < 4u; e++) {
+        var k = cross(c[e], c[(e + 1u) % 4u]);
+        if dot(k, c[(e + 2u) % 4u]) < 0.0 {
+            k = -k;
+        }
+        poly.p[e] = c[e];
+        poly.k[e] = k;
+    }
+    if e < 4u {
+        irr_cut = true;
+    }
+    return poly;
 }
 
 // Where the words of portal k of the block at `at` start.

@@ -33,9 +33,9 @@ pub mod dome;
 // The device's method in f64, checked against the reference by its tests (which are its only
 // callers: the reference integrates by pieces, dome.rs).
 #[cfg_attr(not(test), allow(dead_code))]
-pub mod latlong_rows;
-#[cfg_attr(not(test), allow(dead_code))]
 pub mod latlong_polygon;
+#[cfg_attr(not(test), allow(dead_code))]
+pub mod latlong_rows;
 pub mod line;
 pub mod outer;
 pub mod pieces;

@@ -1,9 +1,10 @@
 //! A dome masked by its portals (DESIGN.md §8 P2, mask mode) on the CPU (f64). Twin of
-//! `shaders/portal.wgsl` (`crossing`); the irradiance kernel sums Lambert's formula over the
-//! portals of an untextured dome and, by inclusion–exclusion, their overlaps
-//! (`irradiance/portals.rs`, checked against [`irradiance`]; `prepare::portal::overlaps` says
-//! where); every other masked dome's
-//! irradiance is this module's on the GPU path too (`GpuPath::HostIrradiance`).
+//! `shaders/portal.wgsl` (`crossing`); the irradiance kernel sums Lambert's formula (an
+//! untextured dome) or a latlong texture's row integral over the portals and, by
+//! inclusion–exclusion, their overlaps (`irradiance/portals.rs`, checked against
+//! [`irradiance`]; `prepare::portal::overlaps` and `prepare::gpu_path::masked` say where);
+//! every other masked dome's irradiance is this module's on the GPU path too
+//! (`GpuPath::HostIrradiance`).
 //!
 //! - `radiance(x, ω)`: the dome's radiance along ω ⊙ the multiplier of the nearest portal the
 //!   ray `x + tω`, t > 0, passes through moving toward the portal's +Z (against the light it

@@ -31,15 +31,16 @@ pub enum GpuPath {
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
-    /// - Textured domes masked by portals, and untextured ones whose portals may hide one
-    ///   another in either order with different multipliers, or in more ways than the kernel sums
-    ///   (`portal::overlaps`; §8 P2 mask mode): emission is the dome's own and radiance tests
-    ///   the portal crossings on the device (shaders/portal.wgsl, the portals in the mesh
-    ///   atlas); irradiance needs the portals' visible pieces (cpu::portal::irradiance), which
-    ///   have no kernel. Other untextured masked domes are [`Device`]
-    ///   (`Prepared::apply_portal_mode`: Lambert's formula summed over the portals and, by
-    ///   inclusion–exclusion, their overlaps, shaders/irradiance/portals.wgsl). A dome's
-    ///   intensity is 0 on both paths.
+    /// - Masked domes whose portals may hide one another in either order with different
+    ///   multipliers, or in more ways than the kernel sums (`portal::overlaps`; §8 P2 mask
+    ///   mode), and masked textured domes the row integral does not take (the formats and
+    ///   frames above): emission is the dome's own and radiance tests the portal crossings on
+    ///   the device (shaders/portal.wgsl, the portals in the mesh atlas); irradiance needs the
+    ///   portals' visible pieces (cpu::portal::irradiance), which have no kernel. Other masked
+    ///   domes are [`Device`] (`Prepared::apply_portal_mode`: Lambert's formula, or a latlong
+    ///   texture's row integral over each polygon, summed over the portals and, by
+    ///   inclusion–exclusion, their overlaps, shaders/irradiance/portals.wgsl and
+    ///   latlong_polygon.wgsl). A dome's intensity is 0 on both paths.
     ///
     ///   [`Device`]: GpuPath::Device
     HostIrradiance(&'static str),

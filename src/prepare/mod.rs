@@ -274,8 +274,7 @@ impl Prepared {
     ) -> Result<()> {
         self.portals = portal::prepare_portals(&self.light, mode, temperature)?;
         if let Some(portals) = &self.portals {
-            (self.gpu_path, self.portal_overlaps) =
-                gpu_path::masked(portals, self.dome_texture());
+            (self.gpu_path, self.portal_overlaps) = gpu_path::masked(portals, self.dome_texture());
         }
         Ok(())
     }

@@ -175,8 +175,8 @@ impl PreparedScene {
     ///
     /// Refused with [`LuxError::NotOnDevice`] naming the first such light when the scene holds
     /// a light whose irradiance the host path computes on the CPU (textured rects, textured
-    /// domes but latlong ones the kernel integrates, textured masked domes and untextured ones
-    /// with portals of different multipliers crossed in either order, IES profiles of type B
+    /// domes, masked or not, but latlong ones under a conformal frame, masked domes with
+    /// portals of different multipliers crossed in either order, IES profiles of type B
     /// under angleScale:
     /// `prepare::latlong_rows::gpu_path` and `prepare::gpu_path::GpuPath`): the kernel gives 0
     /// for them, which this path would return as if it were the answer. Prepare those lights in a scene

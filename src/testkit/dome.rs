@@ -75,3 +75,14 @@ pub fn irradiance_with_filter(
         .map(|&n| crate::cpu::irradiance::irradiance(&p, DVec3::ZERO, n))
         .collect())
 }
+
+/// A PNG of `w` × `h` random texels in [128, 255] per channel, in memory (the tests' textures).
+pub fn random_png(w: u32, h: u32, rng: &mut crate::synthetic::Rng) -> crate::Asset {
+    let img = image::RgbImage::from_fn(w, h, |_, _| {
+        image::Rgb([0, 1, 2].map(|_| 128 + rng.below(128) as u8))
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut bytes, image::ImageFormat::Png)
+        .expect("an in-memory PNG encodes");
+    crate::Asset::from_bytes(format!("gen-{w}x{h}.png"), bytes.into_inner())
+}

@@ -42,8 +42,13 @@
 use glam::DVec3;
 use std::f64::consts::PI;
 
-use super::latlong_rows::{Moments, Rows, about_tangent, cumulative, row_entry, row_pair};
-use crate::rules::{IRR_GL_POLYGON, IRR_GL_ROWS, IRR_ROWS_MAX_SPAN, gauss_legendre};
+use super::latlong_rows::{
+    Moments, Rows, about_tangent, cumulative, piece_partial, row_entry, row_pair,
+};
+use crate::rules::{
+    IRR_GL_POLYGON, IRR_GL_ROWS, IRR_ROWS_MAX_SPAN, LATLONG_MIN_ALPHA_SPAN, LATLONG_SHORT_SPAN,
+    gauss_legendre,
+};
 
 /// A monotone piece of an edge, oriented toward growing θ, as the sweep reads it: its edge
 /// plane `k`, its θ at both ends, and the piece boundaries it crosses: `count` meridians
@@ -273,8 +278,8 @@ pub fn polygon_interval(
         let ue = edge_roots(edges[s.enter], mid).0;
         let ul = edge_roots(edges[s.leave], mid).1;
         let shift = ((ue + s.width - ul) / (2.0 * PI)).round() * 2.0 * PI;
-        sum += end_integral(t, r, edges[s.leave], true, shift, lo, hi, n)
-            - end_integral(t, r, edges[s.enter], false, 0.0, lo, hi, n);
+        sum += end_integral(t, r, edges[s.leave], true, shift, ue, lo, hi, n)
+            - end_integral(t, r, edges[s.enter], false, 0.0, ue, lo, hi, n);
     }
     sum
 }
@@ -289,7 +294,9 @@ pub fn polygon_interval(
 /// `θ = atan2(|k_y|, −sgn(k_y) ρ_k cos α)` is smooth but for the complex poles
 /// `α = π/2 ± i asinh(|k_y|/ρ_k)` (a great circle passing near a pole: θ races through it).
 /// The rule is Gauss–Legendre in whichever variable puts the remaining singularity farther from
-/// the interval, relative to its half-length (the Bernstein ellipse through it is larger).
+/// the interval, relative to its half-length (the Bernstein ellipse through it is larger), but
+/// never in α over less than [`LATLONG_MIN_ALPHA_SPAN`]: along an edge near a meridian α barely moves
+/// (`α ≈ π/2`), and f32 cannot place nodes a few ulps apart.
 #[allow(clippy::too_many_arguments)]
 pub fn end_integral(
     t: &Rows,
@@ -297,6 +304,7 @@ pub fn end_integral(
     k: DVec3,
     leave: bool,
     shift: f64,
+    u_ref: f64,
     lo: f64,
     hi: f64,
     n: DVec3,
@@ -318,10 +326,25 @@ pub fn end_integral(
     let (a_lo, a_hi) = (alpha(lo), alpha(hi));
     let ratio_alpha = (0.5 * (a_lo + a_hi) - 0.5 * PI).hypot((k.y.abs() / rho).asinh())
         / (0.5 * (a_hi - a_lo).abs());
+    // The end's piece is the same at every node (its crossings of piece boundaries are
+    // breakpoints), so the moments from u_ref to the piece's start are the interval's
+    // ([`span_base`]) and each node adds its partial piece.
+    let step = 2.0 * PI / t.width as f64;
+    let u0 = if t.bilinear { 0.5 * step } else { 0.0 };
+    let (ue, ul, _) = edge_roots(k, mid);
+    let piece = ((if leave { ul + shift } else { ue } - u0) / step).floor();
+    let (j0, j1, _) = row_pair(t, r, mid);
+    let bases = [
+        span_base(t, j0, u_ref, piece),
+        span_base(t, j1, u_ref, piece),
+    ];
     let (x, w) = gauss_legendre(IRR_GL_POLYGON);
-    if ratio_sigma >= ratio_alpha || !ratio_alpha.is_finite() {
+    if ratio_sigma >= ratio_alpha
+        || !ratio_alpha.is_finite()
+        || (a_hi - a_lo).abs() < LATLONG_MIN_ALPHA_SPAN
+    {
         about_tangent(lo, hi, near, (&x, &w), |theta| {
-            end_node(t, r, k, leave, shift, theta, alpha(theta), n)
+            end_node(t, r, k, leave, shift, piece, &bases, theta, alpha(theta), n)
         })
     } else {
         // θ(α) and dθ/dα = −k_y ρ sin α / (k_y² + ρ² cos² α), signed: α runs either way.
@@ -332,7 +355,8 @@ pub fn end_integral(
             let (sin_a, cos_a) = al.sin_cos();
             let theta = k.y.abs().atan2(-sg * rho * cos_a);
             let dtheta = -k.y * rho * sin_a / (k.y * k.y + rho * rho * cos_a * cos_a);
-            sum += end_node(t, r, k, leave, shift, theta, al, n) * (wt * (a_hi - a_lo) * dtheta);
+            sum += end_node(t, r, k, leave, shift, piece, &bases, theta, al, n)
+                * (wt * (a_hi - a_lo) * dtheta);
         }
         sum
     }
@@ -395,8 +419,11 @@ pub fn spans_at(edges: &[DVec3], ends: &[(DVec3, DVec3)], theta: f64) -> (Vec<Sp
 }
 
 /// One arc end's term of the integrand at θ in piece row `r`:
-/// `sin θ [(1 − f_y) I_{j₀} + f_y I_{j₁}]` with `I_j = a C⁰_j(u) + sin θ (p Cˢ_j(u) + q Cᶜ_j(u))`
-/// at edge `k`'s leaving root `ψ + α` plus `shift`, or at its entering root `ψ − α`.
+/// `sin θ [(1 − f_y) I_{j₀} + f_y I_{j₁}]` with `I_j = a D⁰_j(u) + sin θ (p Dˢ_j(u) + q Dᶜ_j(u))`,
+/// `D_j(u) = C_j(u) − C_j(u_ref)`: the interval's `bases` (to the start of the end's piece
+/// `g`, rows j₀ and j₁) plus the partial piece to u (the arc's two ends share `u_ref`, so
+/// their difference is the arc's), at edge `k`'s leaving root `ψ + α` plus `shift`, or at its
+/// entering root `ψ − α`.
 #[allow(clippy::too_many_arguments)]
 pub fn end_node(
     t: &Rows,
@@ -404,21 +431,33 @@ pub fn end_node(
     k: DVec3,
     leave: bool,
     shift: f64,
+    g: f64,
+    bases: &[Moments; 2],
     theta: f64,
     alpha: f64,
     n: DVec3,
 ) -> DVec3 {
     let (sin_t, cos_t) = theta.sin_cos();
     let psi = k.x.atan2(-k.z);
-    let u = if leave { psi + alpha + shift } else { psi - alpha };
+    let u = if leave {
+        psi + alpha + shift
+    } else {
+        psi - alpha
+    };
+    let w = t.width as f64;
+    let step = 2.0 * PI / w;
+    let u0 = if t.bilinear { 0.5 * step } else { 0.0 };
+    let piece = (g - (g / w).floor() * w) as usize;
+    let tau = ((u - u0) / step - g) * step;
     let (j0, j1, fy) = row_pair(t, r, theta);
-    let row = |j: usize| -> DVec3 {
-        let c = cumulative(t, j, u);
+    let row = |j: usize, base: &Moments| -> DVec3 {
+        let part = piece_partial(t, j, piece, tau);
+        let c: Moments = std::array::from_fn(|i| base[i] + part[i]);
         n.y * cos_t * c[0] + sin_t * (n.x * c[1] - n.z * c[2])
     };
-    let mut v = row(j0);
+    let mut v = row(j0, &bases[0]);
     if j1 != j0 {
-        v += (row(j1) - v) * fy;
+        v += (row(j1, &bases[1]) - v) * fy;
     }
     sin_t * v
 }
@@ -437,6 +476,35 @@ pub fn full_node(t: &Rows, r: usize, theta: f64, n: DVec3) -> DVec3 {
         v += (row(j1) - v) * fy;
     }
     sin_t * v
+}
+
+/// `∫_{u_ref}^{u₀ + g·h} R_j {1, sin u, cos u} du`: to the start of piece `g` (a global index,
+/// turns · W + k): the partial piece at u_ref in closed form and the whole pieces between
+/// summed one by one from the texel values where there are at most [`LATLONG_SHORT_SPAN`],
+/// else the prefix sums' difference.
+pub fn span_base(t: &Rows, j: usize, u_ref: f64, g: f64) -> Moments {
+    let w = t.width as f64;
+    let step = 2.0 * PI / w;
+    let u0 = if t.bilinear { 0.5 * step } else { 0.0 };
+    let xa = (u_ref - u0) / step;
+    let ga = xa.floor();
+    if (g - ga).abs() > LATLONG_SHORT_SPAN {
+        let (c1, c0) = (cumulative(t, j, u0 + g * step), cumulative(t, j, u_ref));
+        return std::array::from_fn(|i| c1[i] - c0[i]);
+    }
+    let piece = |g: f64| (g - (g / w).floor() * w) as usize;
+    let pa = piece_partial(t, j, piece(ga), (xa - ga) * step);
+    let mut out: Moments = std::array::from_fn(|i| -pa[i]);
+    let (lo, hi, sign) = if g >= ga { (ga, g, 1.0) } else { (g, ga, -1.0) };
+    let mut p = lo;
+    while p < hi {
+        let whole = piece_partial(t, j, piece(p), step);
+        for i in 0..3 {
+            out[i] += sign * whole[i];
+        }
+        p += 1.0;
+    }
+    out
 }
 
 #[cfg(test)]

@@ -74,7 +74,7 @@ pub(crate) fn row_entry(t: &Rows, j: usize, k: usize) -> (Moments, DVec3) {
 }
 
 /// The partial piece: `∫` over the first `tau` of row `j`'s piece `k`.
-fn piece_partial(t: &Rows, j: usize, k: usize, tau: f64) -> Moments {
+pub(crate) fn piece_partial(t: &Rows, j: usize, k: usize, tau: f64) -> Moments {
     let step = 2.0 * PI / t.width as f64;
     let (_, v0) = row_entry(t, j, k);
     let v1 = if t.bilinear {

@@ -75,9 +75,7 @@ pub fn portals_irradiance(
             continue;
         }
         let sign = if set.len() % 2 == 0 { -1.0 } else { 1.0 };
-        sum += sign
-            * portals[set[0] as usize].multiplier
-            * overlap_value(portals, set, x, n, dome);
+        sum += sign * portals[set[0] as usize].multiplier * overlap_value(portals, set, x, n, dome);
     }
     sum
 }

@@ -704,7 +704,10 @@ fn textured_sum_is_the_visible_pieces() {
                         lit += 1;
                     }
                     let e = (got - want).abs().max_element() / scale;
-                    assert!(e < 1e-8, "{filter:?} x={x} n={n}: {got} vs {want} ({e:.2e})");
+                    assert!(
+                        e < 1e-8,
+                        "{filter:?} x={x} n={n}: {got} vs {want} ({e:.2e})"
+                    );
                     worst = worst.max(e);
                 }
             }
