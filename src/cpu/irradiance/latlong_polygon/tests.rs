@@ -68,7 +68,9 @@ fn normals(rng: &mut Lcg) -> Vec<DVec3> {
 }
 
 /// The polygon method against the CPU reference's exact clipped sum over texel pieces: two
-/// independent integrations of the same filtered texture.
+/// independent integrations of the same filtered texture, within 5e-11 relative (measured:
+/// 1.3e-11; integrating every arc end in σ, never in α, gives 1.5e-10; both ends of an arc in
+/// one rule 3.1e-8).
 #[test]
 fn polygons_match_the_reference() {
     let mut rng = Lcg(7);
@@ -109,7 +111,7 @@ fn polygons_match_the_reference() {
                 worst = worst.max(err);
                 compared += 1;
                 assert!(
-                    err < 1e-8,
+                    err < 5e-11,
                     "{w}x{h} {filter:?} q={q:?} n={n}: {got} vs {want} ({err:.2e})"
                 );
             }
