@@ -705,7 +705,7 @@ fn textured_sum_is_the_visible_pieces() {
                     }
                     let e = (got - want).abs().max_element() / scale;
                     assert!(
-                        e < 1e-8,
+                        e < 1e-10,
                         "{filter:?} x={x} n={n}: {got} vs {want} ({e:.2e})"
                     );
                     worst = worst.max(e);
