@@ -1081,43 +1081,7 @@ fn a_masked_dome_with_the_most_overlaps_the_budget_admits_finishes_on_the_device
             v.map(|c| c / l)
         })
         .collect();
-    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone())
-        .unwrap()
-        .with_portal_mode(luxeval::PortalMode::Mask);
-    let scene = eval.prepare(std::slice::from_ref(&dome)).unwrap();
-    let pts = r.buffer(&points, wgpu::BufferUsages::STORAGE);
-    let nrm = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
-    let out = r.output(n);
-    let mut enc = r.encoder();
-    scene
-        .encode_irradiance(&mut enc, &pts, &nrm, &out, n as u32, Accumulate::Sum)
-        .unwrap();
-    let got = r.finish(enc, &out, n);
-    let want = scene
-        .irradiance(&points, &normals, Accumulate::Sum)
-        .unwrap();
-    let reference = Evaluator::cpu()
-        .with_portal_mode(luxeval::PortalMode::Mask)
-        .prepare(std::slice::from_ref(&dome))
-        .unwrap()
-        .irradiance(&points, &normals, Accumulate::Sum)
-        .unwrap();
-    for i in 0..n {
-        let (g, w, c) = (got[i], want[i], reference[i]);
-        let scale = c.iter().fold(0.0f32, |m, v| m.max(v.abs()));
-        assert!(scale > 0.0, "{i}: dark");
-        for k in 0..3 {
-            assert!(g[k].is_finite(), "{i}: cut short: {g:?}");
-            assert!(
-                (g[k] - w[k]).abs() <= 1e-4 * scale,
-                "{i}: {g:?} vs host path {w:?}"
-            );
-            assert!(
-                (g[k] - c[k]).abs() <= 1e-4 * scale,
-                "{i}: {g:?} vs reference {c:?}"
-            );
-        }
-    }
+    resident_masked_irradiance_finishes(&r, &dome, &points, &normals);
 }
 
 /// A latlong-textured dome masked by a window, a pane of another intensity above it (one ray
@@ -1187,26 +1151,37 @@ fn a_masked_textured_dome_is_resident() {
             v.map(|c| c / l)
         })
         .collect();
+    resident_masked_irradiance_finishes(&r, &dome, &points, &normals);
+}
+
+/// `dome` in mask mode through `encode_irradiance` at (`points`, `normals`): every row lit,
+/// finished (the kernel writes NaN where lavapipe's loop budget cut it short, and this path
+/// has no host step) and within 1e-4 of the host path and of the CPU reference.
+fn resident_masked_irradiance_finishes(
+    r: &Renderer,
+    dome: &Light,
+    points: &[[f32; 3]],
+    normals: &[[f32; 3]],
+) {
+    let n = points.len();
     let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone())
         .unwrap()
         .with_portal_mode(luxeval::PortalMode::Mask);
-    let scene = eval.prepare(std::slice::from_ref(&dome)).unwrap();
-    let pts = r.buffer(&points, wgpu::BufferUsages::STORAGE);
-    let nrm = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    let scene = eval.prepare(std::slice::from_ref(dome)).unwrap();
+    let pts = r.buffer(points, wgpu::BufferUsages::STORAGE);
+    let nrm = r.buffer(normals, wgpu::BufferUsages::STORAGE);
     let out = r.output(n);
     let mut enc = r.encoder();
     scene
         .encode_irradiance(&mut enc, &pts, &nrm, &out, n as u32, Accumulate::Sum)
         .unwrap();
     let got = r.finish(enc, &out, n);
-    let host = scene
-        .irradiance(&points, &normals, Accumulate::Sum)
-        .unwrap();
+    let host = scene.irradiance(points, normals, Accumulate::Sum).unwrap();
     let reference = Evaluator::cpu()
         .with_portal_mode(luxeval::PortalMode::Mask)
-        .prepare(std::slice::from_ref(&dome))
+        .prepare(std::slice::from_ref(dome))
         .unwrap()
-        .irradiance(&points, &normals, Accumulate::Sum)
+        .irradiance(points, normals, Accumulate::Sum)
         .unwrap();
     for i in 0..n {
         let (g, h, c) = (got[i], host[i], reference[i]);

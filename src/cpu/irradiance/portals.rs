@@ -27,7 +27,7 @@
 //! the exact row integral over the polygon ([`latlong_polygon`]). `crate::cpu::portal::irradiance`,
 //! which cuts the portals into their visible pieces nearest first for any set, is this sum's
 //! independent check (`tests::the_inclusion_exclusion_sum_is_the_visible_pieces_where_portals_overlap`,
-//! and for textured domes `tests::textured_sum_is_the_visible_pieces`).
+//! and for textured domes `tests::textured::textured_sum_is_the_visible_pieces`).
 //!
 //! [`crossing_orders`]: crate::prepare::portal::crossing_orders
 //! [`overlaps`]: crate::prepare::portal::overlaps
