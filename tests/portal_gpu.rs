@@ -1,8 +1,7 @@
 //! A dome masked by portals (DESIGN.md §8 P2 mask mode) on a GPU evaluator: emission and
-//! radiance on the device (shaders/portal.wgsl); irradiance on the device for an untextured
-//! dome whose portals cannot hide one another, or whose portals of different multipliers rays
-//! cross in one order only (shaders/irradiance/portals.wgsl, the last two tests), else, with
-//! intensity, from the CPU reference (`GpuPath::HostIrradiance`). Radiance is compared with
+//! radiance on the device (shaders/portal.wgsl); irradiance on the device for untextured and
+//! latlong domes whose portals cannot hide one another or overlap, in one order or in either
+//! (shaders/irradiance/portals.wgsl, the last four tests); intensity from the CPU reference. Radiance is compared with
 //! the reference within 1e-4 relative away from the portals' edges and planes (a band of 1e-4 of the portal's size, the
 //! one `luxeval check` excludes, computed here from the portals' transforms); the excluded count
 //! is printed. Hint mode is bitwise the dome without portals.
@@ -482,6 +481,91 @@ fn masked_textured_dome_irradiance_runs_on_the_device() {
         assert!(lit > n / 3, "{lit} lit of {n}");
         assert!(excluded < n / 30, "{excluded} excluded");
     }
+}
+
+/// Portals of different multipliers that rays cross in either order (panes through a skylight
+/// and through a window at steep angles, three through one another over the skylight): the
+/// device splits each such overlap where its members are crossed at once and gives each piece
+/// its farthest portal's multiplier (`prepare::portal::Overlap::split`), within 1e-4 of the
+/// reference (the visible pieces, nearest first) away from the check's bands, for a uniform
+/// dome and a textured latlong one; `luxeval check` passes, nothing host-only.
+#[test]
+fn masked_dome_irradiance_runs_on_the_device_where_portals_cross() {
+    let Some(gpu) = crate::common::gpu() else {
+        return;
+    };
+    let gpu = gpu.with_portal_mode(PortalMode::Mask);
+    let mut rng = Rng::new(0xC2_055);
+    let texture = Texture::new(luxeval::testkit::dome::random_png(32, 16, &mut rng))
+        .with_format(TextureFormat::LatLong);
+    for (i, dome) in [
+        Light::dome().with_path("/Sky").with_intensity(2.0),
+        Light::dome().with_path("/Map").with_texture(texture),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let dome = crossed(dome);
+        let n = 3000;
+        let (excluded, lit, worst) =
+            irradiance_matches_the_reference(&gpu, &dome, 0xC2_0E + i as u64);
+        eprintln!(
+            "masked dome irradiance through crossed portals ({}): {n} receivers, {excluded} \
+             excluded, {lit} lit, worst relative error {worst:e}",
+            dome.path
+        );
+        assert!(lit > n / 4, "{lit} lit of {n}");
+        assert!(excluded < n / 30, "{excluded} excluded");
+    }
+}
+
+/// Five portals on `dome`, each of its own intensity and colour: a skylight with two panes
+/// through it at steep angles (crossing it and each other), a window with a pane through it.
+fn crossed(dome: Light) -> Light {
+    // (rotation, centre, width, height)
+    let specs = [
+        (DQuat::IDENTITY, DVec3::new(0.0, 0.0, 3.0), 2.0, 2.4),
+        (
+            DQuat::from_rotation_x(1.0),
+            DVec3::new(0.2, 0.1, 3.1),
+            1.8,
+            1.6,
+        ),
+        (
+            DQuat::from_rotation_y(-0.8),
+            DVec3::new(-0.3, 0.2, 3.2),
+            1.6,
+            1.6,
+        ),
+        (
+            DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2),
+            DVec3::new(3.0, 0.5, 0.0),
+            2.0,
+            1.4,
+        ),
+        (
+            DQuat::from_rotation_y(std::f64::consts::FRAC_PI_2) * DQuat::from_rotation_x(0.9),
+            DVec3::new(3.1, 0.4, 0.2),
+            1.6,
+            1.2,
+        ),
+    ];
+    specs
+        .iter()
+        .enumerate()
+        .fold(dome, |l, (i, &(rot, c, w, h))| {
+            l.with_portal(
+                Portal::new(w, h)
+                    .with_path(format!("/C{i}"))
+                    .with_transform(DMat4::from_rotation_translation(rot, c))
+                    .with_intensity(0.6 + 0.7 * i as f64)
+                    .with_color(DVec3::new(
+                        1.0,
+                        0.9 - 0.15 * i as f64,
+                        0.3 + 0.15 * i as f64,
+                    )),
+            )
+        })
 }
 
 /// Eight portals on `dome`, each of its own intensity and colour: a skylight under two tilted,

@@ -167,8 +167,23 @@ fn check_compares_a_masked_domes_radiance_and_irradiance() {
 /// (prepare::portal::overlaps), and `check` compares it.
 #[test]
 fn check_compares_a_domes_irradiance_through_glazing() {
-    check_compares_the_glazed_dome("");
+    check_compares_the_glazed_dome("", GLAZING_ABOVE);
 }
+
+/// The same with the glazing tilted 30° through the skylight: rays cross the two in either
+/// order, so the device splits their overlap where they are crossed at once
+/// (prepare::portal::Overlap::split), and `check` compares it, nothing host-only.
+#[test]
+fn check_compares_a_domes_irradiance_through_crossed_glazing() {
+    check_compares_the_glazed_dome(
+        "",
+        "double3 xformOp:translate = (0.2, 3.05, 0.1)\n        float xformOp:rotateX = -120",
+    );
+}
+
+/// The glazing's place: 0.4 above the skylight, tilted 5° (rays cross the skylight first).
+const GLAZING_ABOVE: &str =
+    "double3 xformOp:translate = (0.2, 3.4, 0.1)\n        float xformOp:rotateX = -95";
 
 /// The same glazing over a latlong-textured dome (testImage.png): its irradiance is the
 /// device's too (the texture's row integral over each portal and overlap,
@@ -176,15 +191,19 @@ fn check_compares_a_domes_irradiance_through_glazing() {
 /// of a 1024 × 512 map to the host), and `check` compares it, listing nothing as host-only.
 #[test]
 fn check_compares_a_textured_domes_irradiance_through_glazing() {
-    check_compares_the_glazed_dome(concat!(
-        "asset inputs:texture:file = @",
-        env!("CARGO_MANIFEST_DIR"),
-        "/../tests/data/textures/testImage.png@\n        token inputs:texture:format = \"latlong\""
-    ));
+    check_compares_the_glazed_dome(
+        concat!(
+            "asset inputs:texture:file = @",
+            env!("CARGO_MANIFEST_DIR"),
+            "/../tests/data/textures/testImage.png@\n        token inputs:texture:format = \"latlong\""
+        ),
+        GLAZING_ABOVE,
+    );
 }
 
-/// Writes the glazed stage, `sky` added to the dome's attributes, and checks its dome.
-fn check_compares_the_glazed_dome(sky: &str) {
+/// Writes the glazed stage, `sky` added to the dome's attributes and `glazing` placing the
+/// glazing (its translate and rotateX), and checks its dome.
+fn check_compares_the_glazed_dome(sky: &str, glazing: &str) {
     let dir = tempfile::tempdir().unwrap();
     let stage = dir.path().join("glazed.usda");
     std::fs::write(
@@ -217,8 +236,7 @@ def Xform "World"
         float inputs:height = 2.2
         float inputs:intensity = 0.8
         color3f inputs:color = (0.9, 0.95, 1)
-        double3 xformOp:translate = (0.2, 3.4, 0.1)
-        float xformOp:rotateX = -95
+        GLAZING
         float xformOp:rotateZ = 25
         uniform token[] xformOpOrder = ["xformOp:translate", "xformOp:rotateX", "xformOp:rotateZ"]
     }
@@ -232,7 +250,8 @@ def Xform "World"
     }
 }
 "#
-        .replace("SKY", sky),
+        .replace("SKY", sky)
+        .replace("GLAZING", glazing),
     )
     .unwrap();
     check_compares_the_masked_dome(stage.to_str().unwrap());

@@ -3,12 +3,13 @@
 // the −Z side of of the portal's multiplier times E on its parallelogram clipped at the
 // horizon, and by inclusion–exclusion over the overlaps the mesh atlas lists after the
 // portals, ± the multiplier of the one each names first times E on the first portal's
-// parallelogram clipped to the cones from x over the others. E is Lambert's formula for a
-// uniform dome and the texture's exact integral over the polygon for a textured latlong one
+// parallelogram clipped to the cones from x over the others; a split overlap (portals of
+// different multipliers crossed in either order) sums each member's multiplier times E on
+// the piece where it is the farthest (farther_plane). E is Lambert's formula for a uniform
+// dome and the texture's exact integral over the polygon for a textured latlong one
 // (irradiance/latlong_polygon.wgsl). Twin of src/cpu/irradiance/portals.rs, which carries the
-// proof; portals of different multipliers that rays cross in either order, and textured
-// domes of other formats or non-conformal frames, keep their irradiance on the host
-// (GpuPath::HostIrradiance).
+// proof; textured domes of other formats or non-conformal frames keep their irradiance on the
+// host (GpuPath::HostIrradiance).
 //
 // f32: the parallelogram is two triangles through mesh/lambert.wgsl's triangle_lambert (with
 //   its sliver form for portals low over the horizon); the CPU takes Lambert's formula on the
@@ -19,9 +20,12 @@
 //   differently from the reference, where the portal is seen edge-on (the conformance check
 //   excludes that band, conformance::band::irradiance_margin).
 // f32: clip_polygon writes at most PORTAL_OVERLAP_VERTICES vertices (gpu::mesh_atlas): a
-//   convex polygon gains at most one a clip (4 + 4·3 for four portals, and one more at the
-//   horizon for a textured dome), and a rounded one that would gain more keeps the first ones
-//   (the CPU's Vec has no bound).
+//   convex polygon gains at most one a clip (4 + 4·3 for four portals, 3 more for a split
+//   overlap's piece and one at the horizon for a textured dome), and a rounded one that would
+//   gain more keeps the first ones (the CPU's Vec has no bound).
+// f32: farther_plane is formed from the portal's f32 origin and normal; the plane is exact
+//   (a member's piece ends where two portals are crossed at once), so a rounded one moves
+//   that boundary by ~1e-7 relative, where either member's multiplier is right to that order.
 // GPU-only PortalDome: the twin's Option<&TexturedDome>.
 // GPU-only clip_polygon, parallelogram: the twin's closed::clip_above and corner list, on the
 //   device's fixed-size polygon, which also carries each edge's plane.
@@ -31,9 +35,10 @@
 //   has no direction (lavapipe: 3.9e-4 off on a triple overlap with such an edge).
 // GPU-only portal_at, portal_multiplier, portal_seen, portal_corners: they read a portal's
 //   words in the mesh atlas (the CPU reads PreparedPortal's fields).
+// GPU-only portal_origin, portal_normal: the same, for farther_plane.
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: for a uniform dome
 //   a portal costs at most ~25 (two triangles), an overlap of two, three or four at most 120,
-//   237 or 386, and prepare::portal::overlaps keeps a dome's overlaps within 48,000
+//   237 or 386 (330, 807, 1,526 split: prepare::portal::overlap_iterations), and prepare::portal::overlaps keeps a dome's overlaps within 48,000
 //   (OVERLAP_ITERATIONS), so up to ~2,600 portals without overlaps stay inside it; a textured
 //   dome's polygons cost far more (latlong_polygon.wgsl). The portal and overlap loops, each
 //   clip's vertex loop and the fan's check their own condition after they end and set irr_cut
@@ -62,8 +67,9 @@ struct PortalDome {
 
 // Σ multiplier · E(portal clipped at n·ω ≥ 0) over the portals at `at` in the mesh atlas
 // (layout: src/gpu/mesh_atlas.rs) whose −Z side x is on, and ± multiplier · E(overlap) over
-// the overlaps after them whose every portal x is on the −Z side of; E is Lambert's formula
-// for a uniform dome, the texture's integral (latlong_polygon.wgsl) for a textured one.
+// the overlaps after them whose every portal x is on the −Z side of (overlap_value); E is
+// Lambert's formula for a uniform dome, the texture's integral (latlong_polygon.wgsl) for a
+// textured one.
 fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     let count = bitcast<u32>(mesh_atlas[at]);
     var sum = vec3<f32>(0.0);
@@ -92,7 +98,7 @@ fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> 
         var size = 0u;
         var all_seen = true;
         var j = 0u;
-        for (; j < PORTAL_OVERLAP_WORDS; j++) {
+        for (; j < PORTAL_OVERLAP_MEMBERS; j++) {
             let member = bitcast<u32>(mesh_atlas[o + j]);
             if member == 0xffffffffu {
                 break;
@@ -100,13 +106,12 @@ fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> 
             size += 1u;
             all_seen = all_seen && portal_seen(portal_at(at, member), x);
         }
-        if j < PORTAL_OVERLAP_WORDS && bitcast<u32>(mesh_atlas[o + j]) != 0xffffffffu {
+        if j < PORTAL_OVERLAP_MEMBERS && bitcast<u32>(mesh_atlas[o + j]) != 0xffffffffu {
             irr_cut = true;
         }
         if all_seen {
-            let m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
             let sign = select(1.0, -1.0, size % 2u == 0u);
-            sum += sign * m * overlap_value(at, o, size, x, n, dome);
+            sum += sign * overlap_value(at, o, size, x, n, dome);
         }
     }
     if s < sets {
@@ -124,9 +129,11 @@ fn portal_value(c: array<vec3<f32>, 4>, n: vec3<f32>, dome: PortalDome) -> vec3<
     return vec3<f32>(triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n));
 }
 
-// E on what x sees through each of the `size` portals listed at `o`: the first one's
-// parallelogram clipped to the cones over the others, as a fan of Lambert's triangles or
-// through the texture's integral.
+// The multiplier times E on what x sees through each of the `size` portals listed at `o`:
+// the first one's parallelogram clipped to the cones over the others, with the first one's
+// multiplier; for a split overlap the sum over its members of each one's multiplier times E
+// on the piece where it is the farthest (farther_plane; bit 4i + j of the split word: member
+// i lies before member j on every ray through both).
 fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     let first = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o])), x);
     var poly = parallelogram(first);
@@ -138,12 +145,64 @@ fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: P
             return vec3<f32>(0.0);
         }
     }
+    if j < size {
+        // Cut short by the device's loop budget (see irr_cut).
+        irr_cut = true;
+    }
+    let split = bitcast<u32>(mesh_atlas[o + PORTAL_OVERLAP_MEMBERS]);
+    if (split & PORTAL_OVERLAP_SPLIT) == 0u {
+        let m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
+        return m * polygon_value(poly, n, dome);
+    }
+    var sum = vec3<f32>(0.0);
+    var l = 0u;
+    for (; l < size; l++) {
+        let ql = portal_at(at, bitcast<u32>(mesh_atlas[o + l]));
+        var piece = poly;
+        var empty = false;
+        var z = 0u;
+        for (; z < size; z++) {
+            if z == l || ((split >> (4u * z + l)) & 1u) == 1u {
+                continue;
+            }
+            if ((split >> (4u * l + z)) & 1u) == 1u {
+                empty = true;
+                break;
+            }
+            let qz = portal_at(at, bitcast<u32>(mesh_atlas[o + z]));
+            piece = clip_polygon(piece, farther_plane(ql, qz, x));
+        }
+        if !empty && z < size {
+            irr_cut = true;
+        }
+        if !empty && piece.count >= 3u {
+            sum += portal_multiplier(ql) * polygon_value(piece, n, dome);
+        }
+    }
+    if l < size {
+        irr_cut = true;
+    }
+    return sum;
+}
+
+// The normal of the plane through x on whose positive side a ray crosses the portal at qz
+// before the one at ql (both toward +Z, x on both −Z sides): d_l N_z − d_z N_l with
+// d = N·(O − x).
+fn farther_plane(ql: u32, qz: u32, x: vec3<f32>) -> vec3<f32> {
+    let nl = portal_normal(ql);
+    let nz = portal_normal(qz);
+    return dot(nl, portal_origin(ql) - x) * nz - dot(nz, portal_origin(qz) - x) * nl;
+}
+
+// E on the convex polygon `poly` (vectors from x): 0 where no vertex is above the horizon,
+// else a fan of Lambert's triangles from its first vertex or the texture's integral.
+fn polygon_value(poly: OverlapPolygon, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     var above = false;
     var v = 0u;
     for (; v < poly.count; v++) {
         above = above || dot(n, poly.p[v]) > 0.0;
     }
-    if j < size || v < poly.count {
+    if v < poly.count {
         // Cut short by the device's loop budget (see irr_cut).
         irr_cut = true;
     }
@@ -263,11 +322,18 @@ fn portal_multiplier(q: u32) -> vec3<f32> {
     return vec3<f32>(mesh_atlas[q + 17u], mesh_atlas[q + 18u], mesh_atlas[q + 19u]);
 }
 
+// The origin and the unit normal of the portal whose words start at q.
+fn portal_origin(q: u32) -> vec3<f32> {
+    return vec3<f32>(mesh_atlas[q], mesh_atlas[q + 1u], mesh_atlas[q + 2u]);
+}
+
+fn portal_normal(q: u32) -> vec3<f32> {
+    return vec3<f32>(mesh_atlas[q + 3u], mesh_atlas[q + 4u], mesh_atlas[q + 5u]);
+}
+
 // Whether x is on the −Z side of the portal whose words start at q.
 fn portal_seen(q: u32, x: vec3<f32>) -> bool {
-    let origin = vec3<f32>(mesh_atlas[q], mesh_atlas[q + 1u], mesh_atlas[q + 2u]);
-    let normal = vec3<f32>(mesh_atlas[q + 3u], mesh_atlas[q + 4u], mesh_atlas[q + 5u]);
-    return dot(normal, x - origin) < 0.0;
+    return dot(portal_normal(q), x - portal_origin(q)) < 0.0;
 }
 
 // The corners of the portal whose words start at q, as vectors from x: c0, c0 + e1,

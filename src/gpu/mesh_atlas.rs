@@ -22,8 +22,8 @@
 //! then its parallelogram as corner `c0` (local −,−) and edges `c1 − c0`, `c3 − c0` (xyz each,
 //! subtracted in f64, then rounded); then the overlaps whose irradiance terms the device sums
 //! (`Prepared::portal_overlaps`, read by shaders/irradiance/portals.wgsl): their count as u32
-//! bits, then [`OVERLAP_WORDS`] words each, the portals' indices ascending as u32 bits,
-//! `u32::MAX` past the last. The record's `tex.w` holds the block's offset and `FLAG_PORTALS`
+//! bits, then [`OVERLAP_WORDS`] words each: the portals' indices in `Overlap::members`' order
+//! as u32 bits, `u32::MAX` past the last, then the split word ([`SPLIT`]). The record's `tex.w` holds the block's offset and `FLAG_PORTALS`
 //! says it is there (a textured dome keeps `tex.xyz`).
 
 use crate::prepare::{KindData, Prepared};
@@ -32,21 +32,32 @@ use crate::prepare::{KindData, Prepared};
 pub const NODE_WORDS: u32 = 8;
 pub const TRIANGLE_WORDS: u32 = 10;
 pub const PORTAL_WORDS: u32 = 29;
-/// Words per overlap: the most portals one ray may cross that the kernel clips.
-pub const OVERLAP_WORDS: u32 = crate::prepare::portal::MOST_PORTALS_ONE_RAY_CROSSES as u32;
+/// Member words per overlap: the most portals one ray may cross that the kernel clips.
+pub const OVERLAP_MEMBERS: u32 = crate::prepare::portal::MOST_PORTALS_ONE_RAY_CROSSES as u32;
+/// Words per overlap: its members, then [`SPLIT`] with the `before` bits where it is split
+/// (`prepare::portal::Overlap::split`), 0 where not.
+pub const OVERLAP_WORDS: u32 = OVERLAP_MEMBERS + 1;
+/// The bit of an overlap's last word that says it is split.
+pub const SPLIT: u32 = 1 << 31;
 
 /// The constants shaders/mesh/ray.wgsl, shaders/portal.wgsl and shaders/irradiance/portals.wgsl
 /// read from the WGSL prelude.
-pub fn wgsl_constants() -> [(&'static str, u32); 6] {
+pub fn wgsl_constants() -> [(&'static str, u32); 8] {
     [
         ("MESH_NODE_WORDS", NODE_WORDS),
         ("MESH_TRIANGLE_WORDS", TRIANGLE_WORDS),
         ("MESH_STACK", crate::prepare::MESH_STACK as u32),
         ("PORTAL_WORDS", PORTAL_WORDS),
         ("PORTAL_OVERLAP_WORDS", OVERLAP_WORDS),
+        ("PORTAL_OVERLAP_MEMBERS", OVERLAP_MEMBERS),
+        ("PORTAL_OVERLAP_SPLIT", SPLIT),
         // A convex polygon gains at most one vertex a clip: the first portal's four, then one
-        // for each edge of the others (shaders/irradiance/portals.wgsl).
-        ("PORTAL_OVERLAP_VERTICES", 4 * OVERLAP_WORDS),
+        // for each edge of the others, for each plane of a split overlap's piece and for the
+        // horizon of a textured dome (shaders/irradiance/portals.wgsl).
+        (
+            "PORTAL_OVERLAP_VERTICES",
+            4 * OVERLAP_MEMBERS + OVERLAP_MEMBERS,
+        ),
     ]
 }
 
@@ -55,72 +66,74 @@ pub fn wgsl_constants() -> [(&'static str, u32); 6] {
 /// dome's `[0, 0, 0, portals' offset]`.
 pub fn scene_atlas(lights: &[Prepared]) -> (Vec<f32>, Vec<Option<[u32; 4]>>) {
     let mut data: Vec<f32> = Vec::new();
-    let offsets = lights
-        .iter()
-        .map(|p| {
-            if let Some(portals) = &p.portals {
+    let offsets =
+        lights
+            .iter()
+            .map(|p| {
+                if let Some(portals) = &p.portals {
+                    if p.radiance_on_host() {
+                        return None;
+                    }
+                    let at = data.len() as u32;
+                    data.push(f32::from_bits(portals.len() as u32));
+                    for q in portals {
+                        data.extend(q.origin.to_array().map(|c| c as f32));
+                        data.extend(q.normal.to_array().map(|c| c as f32));
+                        for i in 0..3 {
+                            data.extend(q.to_local.row(i).to_array().map(|c| c as f32));
+                        }
+                        data.extend(q.half.to_array().map(|c| c as f32));
+                        data.extend(q.multiplier.to_array().map(|c| c as f32));
+                        let c = q.corners;
+                        for v in [c[0], c[1] - c[0], c[3] - c[0]] {
+                            data.extend(v.to_array().map(|x| x as f32));
+                        }
+                    }
+                    data.push(f32::from_bits(p.portal_overlaps.len() as u32));
+                    for set in &p.portal_overlaps {
+                        data.extend((0..OVERLAP_MEMBERS as usize).map(|k| {
+                            f32::from_bits(set.members.get(k).copied().unwrap_or(u32::MAX))
+                        }));
+                        let split = set.split.map_or(0, |before| SPLIT | u32::from(before));
+                        data.push(f32::from_bits(split));
+                    }
+                    return Some([0, 0, 0, at]);
+                }
+                let KindData::Mesh { bvh, fronts, .. } = &p.kind else {
+                    return None;
+                };
                 if p.radiance_on_host() {
                     return None;
                 }
-                let at = data.len() as u32;
-                data.push(f32::from_bits(portals.len() as u32));
-                for q in portals {
-                    data.extend(q.origin.to_array().map(|c| c as f32));
-                    data.extend(q.normal.to_array().map(|c| c as f32));
-                    for i in 0..3 {
-                        data.extend(q.to_local.row(i).to_array().map(|c| c as f32));
+                let nodes = data.len() as u32;
+                for n in &bvh.nodes {
+                    for v in n.bounds.min.to_array() {
+                        data.push(down(v));
                     }
-                    data.extend(q.half.to_array().map(|c| c as f32));
-                    data.extend(q.multiplier.to_array().map(|c| c as f32));
-                    let c = q.corners;
-                    for v in [c[0], c[1] - c[0], c[3] - c[0]] {
-                        data.extend(v.to_array().map(|x| x as f32));
+                    for v in n.bounds.max.to_array() {
+                        data.push(up(v));
+                    }
+                    data.push(f32::from_bits(n.first));
+                    data.push(f32::from_bits(n.count));
+                }
+                let triangles = data.len() as u32;
+                for (&i, e) in bvh.order.iter().zip(&bvh.edges) {
+                    for v in e {
+                        data.extend(v.to_array().map(|c| c as f32));
+                    }
+                    data.push(f32::from_bits(i));
+                }
+                let mut front_words = 0;
+                if !p.emission_on_host() {
+                    front_words = data.len() as u32;
+                    data.push(f32::from_bits(fronts.len() as u32));
+                    for n in fronts.iter() {
+                        data.extend(n.to_array().map(|c| c as f32));
                     }
                 }
-                data.push(f32::from_bits(p.portal_overlaps.len() as u32));
-                for set in &p.portal_overlaps {
-                    data.extend(
-                        (0..OVERLAP_WORDS as usize)
-                            .map(|k| f32::from_bits(set.get(k).copied().unwrap_or(u32::MAX))),
-                    );
-                }
-                return Some([0, 0, 0, at]);
-            }
-            let KindData::Mesh { bvh, fronts, .. } = &p.kind else {
-                return None;
-            };
-            if p.radiance_on_host() {
-                return None;
-            }
-            let nodes = data.len() as u32;
-            for n in &bvh.nodes {
-                for v in n.bounds.min.to_array() {
-                    data.push(down(v));
-                }
-                for v in n.bounds.max.to_array() {
-                    data.push(up(v));
-                }
-                data.push(f32::from_bits(n.first));
-                data.push(f32::from_bits(n.count));
-            }
-            let triangles = data.len() as u32;
-            for (&i, e) in bvh.order.iter().zip(&bvh.edges) {
-                for v in e {
-                    data.extend(v.to_array().map(|c| c as f32));
-                }
-                data.push(f32::from_bits(i));
-            }
-            let mut front_words = 0;
-            if !p.emission_on_host() {
-                front_words = data.len() as u32;
-                data.push(f32::from_bits(fronts.len() as u32));
-                for n in fronts.iter() {
-                    data.extend(n.to_array().map(|c| c as f32));
-                }
-            }
-            Some([nodes, bvh.nodes.len() as u32, triangles, front_words])
-        })
-        .collect();
+                Some([nodes, bvh.nodes.len() as u32, triangles, front_words])
+            })
+            .collect();
     (data, offsets)
 }
 
@@ -232,7 +245,10 @@ mod tests {
         // The second portal's plane z = 0 lies below the first (z = 3): a ray up through both,
         // the second first; their multipliers differ, so the first's counts for the overlap.
         assert_eq!(p.gpu_path, GpuPath::Device);
-        assert_eq!(p.portal_overlaps, [vec![0, 1]]);
+        assert_eq!(
+            p.portal_overlaps,
+            [crate::prepare::portal::Overlap::whole(&[0, 1])]
+        );
         let (data, words) = scene_atlas(&[prep(&fan(3)), p]);
         let at = words[1].unwrap()[3] as usize;
         assert!(at > 0);
@@ -255,7 +271,7 @@ mod tests {
             .iter()
             .map(|v| v.to_bits())
             .collect();
-        assert_eq!(bits, [1, 0, 1, u32::MAX, u32::MAX]);
+        assert_eq!(bits, [1, 0, 1, u32::MAX, u32::MAX, 0]);
         // World → local of a uniform scale 2: rows of 0.5·I; half extents in local units.
         assert_eq!(
             &second[6..17],
@@ -264,7 +280,8 @@ mod tests {
     }
 
     /// Three stacked panes of one multiplier and a window apart: the overlaps after the
-    /// portals, count then OVERLAP_WORDS each (indices ascending, u32::MAX past the last).
+    /// portals, count then OVERLAP_WORDS each (indices ascending, u32::MAX past the last, then
+    /// the split word: 0, one multiplier).
     #[test]
     fn overlaps_are_packed_after_the_portals() {
         let pane = |z: f64| {
@@ -288,7 +305,7 @@ mod tests {
         assert_eq!(
             bits,
             [
-                4, 0, 2, none, none, 0, 2, 3, none, 0, 3, none, none, 2, 3, none, none
+                4, 0, 2, none, none, 0, 0, 2, 3, none, 0, 0, 3, none, none, 0, 2, 3, none, none, 0
             ]
         );
     }

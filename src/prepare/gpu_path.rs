@@ -6,6 +6,7 @@ use glam::DMat3;
 
 use super::texture::PreparedTexture;
 use super::{KindData, PreparedIes, PreparedPortal, latlong_rows, portal};
+use portal::Overlap;
 
 /// Where the GPU path takes a light's values from: the one decision, made per light when it is
 /// prepared, that the record (`FLAG_HOST_IRRADIANCE`, `FLAG_MESH_FRONTS`, or a record that emits
@@ -31,15 +32,15 @@ pub enum GpuPath {
     /// - Textured rects: the exact integral of the filtered texture over the surface, split at
     ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
     ///   (src/cpu/irradiance/rect_texture.rs).
-    /// - Masked domes whose portals may hide one another in either order with different
-    ///   multipliers, or in more ways than the kernel sums (`portal::overlaps`; §8 P2 mask
-    ///   mode), and masked textured domes the row integral does not take (the formats and
+    /// - Masked domes whose portals may hide one another in more ways than the kernel sums
+    ///   (`portal::overlaps`; §8 P2 mask mode), and masked textured domes the row integral does not take (the formats and
     ///   frames above): emission is the dome's own and radiance tests the portal crossings on
     ///   the device (shaders/portal.wgsl, the portals in the mesh atlas); irradiance needs the
     ///   portals' visible pieces (cpu::portal::irradiance), which have no kernel. Other masked
     ///   domes are [`Device`] (`Prepared::apply_portal_mode`: Lambert's formula, or a latlong
     ///   texture's row integral over each polygon, summed over the portals and, by
-    ///   inclusion–exclusion, their overlaps, shaders/irradiance/portals.wgsl and
+    ///   inclusion–exclusion, their overlaps, split where portals of different multipliers
+    ///   are crossed in either order, shaders/irradiance/portals.wgsl and
     ///   latlong_polygon.wgsl). A dome's intensity is 0 on both paths.
     ///
     ///   [`Device`]: GpuPath::Device
@@ -117,14 +118,13 @@ pub(super) fn decide(
 /// A dome's [`GpuPath`] once it is masked by `portals` (`Prepared::apply_portal_mode`, DESIGN.md
 /// §8 P2), and the overlaps the device sums: emission and radiance on the device (up to
 /// [`PORTALS_ON_DEVICE`] portals), and irradiance too where the dome is uniform or latlong
-/// under a conformal frame ([`latlong_rows::gpu_path`]) and its portals cannot hide one another
-/// or the portals of different multipliers are crossed in one order ([`portal::overlaps`]:
-/// Lambert's formula or the texture's row integral summed over them by inclusion–exclusion,
-/// shaders/irradiance/portals.wgsl).
+/// under a conformal frame ([`latlong_rows::gpu_path`]) and the overlaps of its portals fit the
+/// kernel ([`portal::overlaps`]: Lambert's formula or the texture's row integral summed over
+/// them by inclusion–exclusion, shaders/irradiance/portals.wgsl).
 pub(super) fn masked(
     portals: &[PreparedPortal],
     textured: Option<&PreparedTexture>,
-) -> (GpuPath, Vec<Vec<u32>>) {
+) -> (GpuPath, Vec<Overlap>) {
     if portals.len() > PORTALS_ON_DEVICE {
         (
             GpuPath::Host("it is masked by more portals than the radiance kernel tests"),

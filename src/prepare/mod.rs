@@ -122,7 +122,7 @@ pub struct Prepared {
     /// Where a masked dome's irradiance is the device's: the sets of its portals one ray may
     /// cross together ([`portal::overlaps`]), the inclusion–exclusion terms the kernel sums
     /// beyond the portals' own (shaders/irradiance/portals.wgsl). Empty otherwise.
-    pub portal_overlaps: Vec<Vec<u32>>,
+    pub portal_overlaps: Vec<portal::Overlap>,
 }
 
 /// What one kind of light carries beyond the shared frame, base radiance and shaping of
@@ -263,10 +263,11 @@ impl Prepared {
     /// Reads the dome's portals as `mode` says (DESIGN.md §8 P2): in mask mode a dome naming
     /// portals is masked; on a GPU evaluator its emission and radiance are the device's (the
     /// radiance kernel tests the portal crossings), and so is its irradiance where the dome is
-    /// untextured and its portals of different multipliers are crossed by rays in one order
-    /// only ([`portal::overlaps`]: an inclusion–exclusion sum of Lambert's formula over
-    /// the portals and their overlaps, shaders/irradiance/portals.wgsl); else its irradiance is the CPU reference's
-    /// ([`GpuPath::HostIrradiance`]). Hint mode changes nothing.
+    /// untextured or latlong under a conformal frame and its overlaps fit the kernel
+    /// ([`portal::overlaps`]: an inclusion–exclusion sum of Lambert's formula or the texture's
+    /// integral over the portals and their overlaps, shaders/irradiance/portals.wgsl); else its
+    /// irradiance is the CPU reference's ([`GpuPath::HostIrradiance`]). Hint mode changes
+    /// nothing.
     pub fn apply_portal_mode(
         &mut self,
         mode: PortalMode,

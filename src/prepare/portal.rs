@@ -173,93 +173,145 @@ pub const OVERLAP_ITERATIONS: usize = 48_000;
 /// the end of the list), the first parallelogram's 4 corners, `4(k − 1)` clips of up to `4k`
 /// vertices, the above-horizon test of up to `4k` vertices, and a fan of up to `4k − 2`
 /// triangles of at most 12 each (mesh/lambert.wgsl's count): 120 for two, 237 for three, 386
-/// for four.
-pub const fn overlap_iterations(k: usize) -> usize {
-    1 + (k + 1) + 4 + 4 * (k - 1) * 4 * k + 4 * k + (4 * k - 2) * 12
+/// for four. A split overlap ([`Overlap::split`]) adds, for each of its `k` pieces, the piece
+/// loop's own, the loop over the members with up to `k − 1` clips of up to `5k − 1` vertices
+/// (a clip adds one at most), and the piece's above-horizon test and fan: 330 for two, 807 for
+/// three, 1,526 for four.
+pub const fn overlap_iterations(k: usize, split: bool) -> usize {
+    let whole = 1 + (k + 1) + 4 + 4 * (k - 1) * 4 * k + 4 * k + (4 * k - 2) * 12;
+    if split {
+        let v = 5 * k - 1;
+        whole + k * (1 + k + (k - 1) * v + v + (v - 2) * 12)
+    } else {
+        whole
+    }
 }
 
 /// [`overlaps`]' reason past [`OVERLAP_ITERATIONS`].
 const TOO_MANY_OVERLAPS: &str =
     "it is masked by portals that overlap in more ways than the irradiance kernel sums";
 
+/// One inclusion–exclusion term beyond the portals' own (`cpu::irradiance::portals`, which
+/// carries the proof): a set of two or more portals that one ray may cross together, and whose
+/// multiplier the term takes on each ray (that of the set's farthest member along it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Overlap {
+    /// Indices into the dome's portals. Unsplit: first the member whose multiplier the term
+    /// takes on every ray, then the others ascending. Split: ascending.
+    pub members: Vec<u32>,
+    /// `None` where one member's multiplier is the farthest's on every ray through the set.
+    /// Otherwise (portals of different multipliers that rays cross in either order) the term is
+    /// summed over pieces, one per member, each the directions along which that member is the
+    /// farthest, clipped from the set's polygon by the plane through x where it and another
+    /// member are crossed at once ([`farther_plane`](crate::cpu::irradiance::portals)); bit
+    /// `4i + j` says `members[i]` lies before `members[j]` on every ray through both (no plane
+    /// between them: `members[i]`'s piece is empty, and `members[j]`'s needs no clip for `i`).
+    pub split: Option<u16>,
+}
+
+impl Overlap {
+    /// An unsplit set, its first member's multiplier the term's (tests).
+    #[cfg(test)]
+    pub fn whole(members: &[u32]) -> Self {
+        Self {
+            members: members.to_vec(),
+            split: None,
+        }
+    }
+}
+
 /// The sets of two or more of `portals` that one ray may cross together (every pair of the set
 /// crossable in some order, [`crossing_orders`]: the cliques of that graph), in lexicographic
-/// order of their members, each as indices into `portals`: first the member whose multiplier the set's term
-/// takes (the farthest along the rays through all of them), then the others ascending. They
-/// are the terms beyond the portals' own of the inclusion–exclusion sum the device takes a
-/// masked untextured dome's irradiance by (`cpu::irradiance::portals`, which carries the
-/// proof). Empty exactly when no pair is crossable.
+/// order of their members, as [`Overlap`]s. They are the terms beyond the portals' own of the
+/// inclusion–exclusion sum the device takes a masked dome's irradiance by
+/// (`cpu::irradiance::portals`, which carries the proof). Empty exactly when no pair is
+/// crossable.
 ///
-/// A pair with different multipliers must be crossed in one order only (P2 gives each ray the
-/// nearer one's); a set's first member is one that every member of another multiplier lies
-/// before on every ray (the farthest on any ray through them all: a set no ray passes through
-/// has none, and its term is 0 whichever is named). `Err` with the reason the device cannot
-/// sum them: two portals of different multipliers that rays cross in either order, more than
-/// [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise crossable portals, or sets costing the kernel more
-/// than [`OVERLAP_ITERATIONS`] ([`overlap_iterations`]).
-pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>, &'static str> {
-    // Neighbours above each portal in the graph "one ray may cross both", and the pairs of
-    // different multipliers crossed in one order: `after[i]` holds the j that rays cross
-    // after i (never before).
-    let mut above: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
-    let mut after: Vec<Vec<usize>> = vec![Vec::new(); portals.len()];
+/// P2 gives each ray the nearest portal's multiplier, and a set's term the farthest member's.
+/// Where every member of another multiplier lies before one member `l` on every ray through
+/// them (the farthest on any ray through them all: a set no ray passes through has none, and
+/// its term is 0 whichever is named), the set names `l` first and is whole; otherwise (a pair
+/// of different multipliers crossed in either order, e.g. a pane through a window at an
+/// angle) it is split by the planes where its members are crossed at once. `Err` with the
+/// reason the device cannot sum them: more than [`MOST_PORTALS_ONE_RAY_CROSSES`] pairwise
+/// crossable portals, or sets costing the kernel more than [`OVERLAP_ITERATIONS`]
+/// ([`overlap_iterations`]).
+pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Overlap>, &'static str> {
+    // Neighbours above each portal in the graph "one ray may cross both", each with the
+    // orders rays cross the pair in (`crossing_orders`).
+    let mut above: Vec<Vec<(usize, (bool, bool))>> = vec![Vec::new(); portals.len()];
     let mut cost = 0;
     for (i, a) in portals.iter().enumerate() {
         for (j, b) in portals.iter().enumerate().skip(i + 1) {
-            let (a_first, b_first) = crossing_orders(a, b);
-            if !(a_first || b_first) {
+            let orders = crossing_orders(a, b);
+            if !(orders.0 || orders.1) {
                 continue;
             }
-            above[i].push(j);
+            above[i].push((j, orders));
             // Every crossable pair is a set: past the budget already (and no quadratic list).
-            cost += overlap_iterations(2);
+            cost += overlap_iterations(2, false);
             if cost > OVERLAP_ITERATIONS {
                 return Err(TOO_MANY_OVERLAPS);
             }
-            if a.multiplier != b.multiplier {
-                match (a_first, b_first) {
-                    (true, false) => after[i].push(j),
-                    (false, true) => after[j].push(i),
-                    _ => {
-                        return Err("it is masked by portals of different intensity or colour \
-                             that rays cross in either order");
-                    }
-                }
-            }
         }
     }
-    let is_after = |j: usize, i: usize| after[i].contains(&j);
+    // Whether rays through both cross `i` before `j` and never after (i, j crossable).
+    let only_before = |i: usize, j: usize| {
+        let (lo, hi) = (i.min(j), i.max(j));
+        let (_, (lo_first, hi_first)) = above[lo][above[lo].partition_point(|e| e.0 < hi)];
+        if i == lo {
+            lo_first && !hi_first
+        } else {
+            hi_first && !lo_first
+        }
+    };
+    let neighbours = |i: usize| -> Vec<usize> { above[i].iter().map(|e| e.0).collect() };
     // Every clique, grown from its lowest member by common neighbours above its highest.
     let mut sets = Vec::new();
     let mut stack: Vec<(Vec<usize>, Vec<usize>)> = (0..portals.len())
         .rev()
-        .map(|i| (vec![i], above[i].clone()))
+        .map(|i| (vec![i], neighbours(i)))
         .collect();
     while let Some((set, common)) = stack.pop() {
         if set.len() > 1 {
-            // The pairs are counted already.
-            if set.len() > 2 {
-                cost += overlap_iterations(set.len());
-                if cost > OVERLAP_ITERATIONS {
-                    return Err(TOO_MANY_OVERLAPS);
-                }
-            }
-            let last = set
-                .iter()
-                .copied()
-                .find(|&l| {
-                    set.iter().all(|&z| {
-                        z == l || portals[z].multiplier == portals[l].multiplier || is_after(l, z)
-                    })
+            let last = set.iter().copied().find(|&l| {
+                set.iter().all(|&z| {
+                    z == l || portals[z].multiplier == portals[l].multiplier || only_before(z, l)
                 })
-                .unwrap_or(set[0]);
-            let rest = set.iter().copied().filter(|&k| k != last);
-            sets.push(
-                std::iter::once(last)
-                    .chain(rest)
-                    .map(|k| k as u32)
-                    .collect(),
-            );
+            });
+            // The pairs' whole cost is counted already.
+            cost += overlap_iterations(set.len(), last.is_none())
+                - if set.len() == 2 {
+                    overlap_iterations(2, false)
+                } else {
+                    0
+                };
+            if cost > OVERLAP_ITERATIONS {
+                return Err(TOO_MANY_OVERLAPS);
+            }
+            sets.push(match last {
+                Some(last) => Overlap {
+                    members: std::iter::once(last)
+                        .chain(set.iter().copied().filter(|&k| k != last))
+                        .map(|k| k as u32)
+                        .collect(),
+                    split: None,
+                },
+                None => {
+                    let mut before = 0u16;
+                    for (a, &i) in set.iter().enumerate() {
+                        for (b, &j) in set.iter().enumerate() {
+                            if i != j && only_before(i, j) {
+                                before |= 1 << (4 * a + b);
+                            }
+                        }
+                    }
+                    Overlap {
+                        members: set.iter().map(|&k| k as u32).collect(),
+                        split: Some(before),
+                    }
+                }
+            });
         }
         if set.len() == MOST_PORTALS_ONE_RAY_CROSSES && !common.is_empty() {
             return Err(
@@ -271,7 +323,7 @@ pub fn overlaps(portals: &[PreparedPortal]) -> std::result::Result<Vec<Vec<u32>>
             let next: Vec<usize> = common
                 .iter()
                 .copied()
-                .filter(|c| *c > k && above[k].binary_search(c).is_ok())
+                .filter(|c| *c > k && above[k].binary_search_by_key(c, |e| e.0).is_ok())
                 .collect();
             let mut grown = set.clone();
             grown.push(k);

@@ -175,9 +175,9 @@ impl PreparedScene {
     ///
     /// Refused with [`LuxError::NotOnDevice`] naming the first such light when the scene holds
     /// a light whose irradiance the host path computes on the CPU (textured rects, textured
-    /// domes, masked or not, but latlong ones under a conformal frame, masked domes with
-    /// portals of different multipliers crossed in either order, IES profiles of type B
-    /// under angleScale:
+    /// domes, masked or not, but latlong ones under a conformal frame, masked domes whose
+    /// portals overlap in more ways than the kernel sums, IES profiles of type B under
+    /// angleScale:
     /// `prepare::latlong_rows::gpu_path` and `prepare::gpu_path::GpuPath`): the kernel gives 0
     /// for them, which this path would return as if it were the answer. Prepare those lights in a scene
     /// of their own and use [`PreparedScene::irradiance`] for them.

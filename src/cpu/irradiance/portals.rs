@@ -17,9 +17,17 @@
 //! for R ⊆ {t₁, …, t_{j−1}}, and `Σ_R (−1)^{|R|}` is 1 for j = 1 and 0 otherwise. So
 //! `E = Σ_S c(S) ∫_{∩S} L(ω) n·ω dω` over the nonempty sets S of portals seen from x. A set with two
 //! members no ray crosses together meets in measure zero, so the sum runs over the portals and
-//! the cliques of the "crossable" graph that [`overlaps`] lists, each with the multiplier of
-//! the member it names first; that member's multiplier is the same on every ray through the
-//! set because [`overlaps`] refuses pairs of different multipliers crossed in either order.
+//! the cliques of the "crossable" graph that [`overlaps`] lists. Where one member is the
+//! farthest among those of other multipliers on every ray through the set, the set names it
+//! first and its multiplier is the term's. Otherwise (portals of different multipliers crossed
+//! in either order) the set is split: the directions through all of S are partitioned by which
+//! member `l` is the farthest, and the term is `Σ_l m_l ∫` over l's piece. Along ω the ray
+//! meets portal z's plane at `t_z = d_z / (N_z·ω)`, `d_z = N_z·(O_z − x) > 0` (x on its −Z
+//! side) and `N_z·ω > 0` (crossed toward +Z), so z comes before l exactly where
+//! `(d_l N_z − d_z N_l)·ω > 0` ([`farther_plane`]): l's piece is the set's polygon clipped by
+//! that plane through x for each other member z, a convex polygon again. A pair crossed in one
+//! order only needs no plane (coplanar portals, whose plane is 0, are such pairs): l's piece is
+//! empty if some member always lies after it, and z's clip is dropped if it always lies before.
 //! Each intersection, seen from x, is the first portal's parallelogram clipped by the planes
 //! through x and the other portals' edges (a convex polygon: convex sets' intersection), and
 //! the irradiance of a uniform convex polygon clipped at the receiver's horizon is Lambert's
@@ -38,6 +46,7 @@ use super::closed::{clip_above, polygon_irradiance};
 use super::latlong_polygon::latlong_polygon;
 use super::latlong_rows::Rows;
 use crate::prepare::PreparedPortal;
+use crate::prepare::portal::Overlap;
 
 /// A textured latlong dome under a conformal frame, as the device integrates it through its
 /// portals: its row tables and its world → dome map `A_eff⁻¹` (`latlong_rows` module docs).
@@ -47,13 +56,14 @@ pub struct TexturedDome<'a> {
 }
 
 /// `Σ multiplier · E(portal clipped at n·ω ≥ 0)` over the portals whose −Z side x is on,
-/// and `(−1)^{|S|+1} multiplier(S's first member) · E(∩S clipped)` over the `overlaps` S
-/// (`Prepared::portal_overlaps`) whose every member x is on the −Z side of (unit-radiance dome,
-/// before `base` and `diffuse`). E is Lambert's formula for a uniform dome (`dome` None) and
-/// the texture's exact integral over the polygon for a textured one ([`polygon_texture`]).
+/// and `(−1)^{|S|+1} Σ multiplier · E(piece of ∩S clipped)` over the `overlaps` S
+/// (`Prepared::portal_overlaps`) whose every member x is on the −Z side of ([`overlap_value`];
+/// unit-radiance dome, before `base` and `diffuse`). E is Lambert's formula for a uniform dome
+/// (`dome` None) and the texture's exact integral over the polygon for a textured one
+/// ([`polygon_texture`]).
 pub fn portals_irradiance(
     portals: &[PreparedPortal],
-    overlaps: &[Vec<u32>],
+    overlaps: &[Overlap],
     x: DVec3,
     n: DVec3,
     dome: Option<&TexturedDome>,
@@ -71,11 +81,15 @@ pub fn portals_irradiance(
         sum += q.multiplier * portal_value(&v, n, dome);
     }
     for set in overlaps {
-        if !set.iter().all(|&k| seen(&portals[k as usize])) {
+        if !set.members.iter().all(|&k| seen(&portals[k as usize])) {
             continue;
         }
-        let sign = if set.len() % 2 == 0 { -1.0 } else { 1.0 };
-        sum += sign * portals[set[0] as usize].multiplier * overlap_value(portals, set, x, n, dome);
+        let sign = if set.members.len() % 2 == 0 {
+            -1.0
+        } else {
+            1.0
+        };
+        sum += sign * overlap_value(portals, set, x, n, dome);
     }
     sum
 }
@@ -89,29 +103,65 @@ pub fn portal_value(v: &[DVec3; 4], n: DVec3, dome: Option<&TexturedDome>) -> DV
     }
 }
 
-/// E on what x sees through every portal of `set`: the first one's parallelogram (vectors from
-/// x) clipped to the cones from x over the others ([`clip_to_cone`]), as a fan of Lambert's
-/// triangles from its first vertex (the device's form; the fan's inner edges cancel) or
-/// through the texture's integral.
+/// The multiplier times E on what x sees through every portal of `set`: the first one's
+/// parallelogram (vectors from x) clipped to the cones from x over the others
+/// ([`clip_to_cone`]), with the first member's multiplier; for a split set the sum over its
+/// members of each one's multiplier times E on the piece where it is the farthest (module
+/// docs, [`farther_plane`]).
 pub fn overlap_value(
     portals: &[PreparedPortal],
-    set: &[u32],
+    set: &Overlap,
     x: DVec3,
     n: DVec3,
     dome: Option<&TexturedDome>,
 ) -> DVec3 {
-    let mut poly: Vec<DVec3> = portals[set[0] as usize].corners.map(|c| c - x).to_vec();
-    for &k in &set[1..] {
+    let members = &set.members;
+    let mut poly: Vec<DVec3> = portals[members[0] as usize].corners.map(|c| c - x).to_vec();
+    for &k in &members[1..] {
         poly = clip_to_cone(&poly, &portals[k as usize].corners.map(|c| c - x));
         if poly.len() < 3 {
             return DVec3::ZERO;
         }
     }
+    let Some(before) = set.split else {
+        return portals[members[0] as usize].multiplier * polygon_value(&poly, n, dome);
+    };
+    let mut sum = DVec3::ZERO;
+    'pieces: for (l, &ml) in members.iter().enumerate() {
+        let mut piece = poly.clone();
+        for (z, &mz) in members.iter().enumerate() {
+            if z == l || before >> (4 * z + l) & 1 == 1 {
+                continue;
+            }
+            if before >> (4 * l + z) & 1 == 1 {
+                continue 'pieces;
+            }
+            let k = farther_plane(&portals[ml as usize], &portals[mz as usize], x);
+            piece = clip_above(&piece, k);
+        }
+        if piece.len() >= 3 {
+            sum += portals[ml as usize].multiplier * polygon_value(&piece, n, dome);
+        }
+    }
+    sum
+}
+
+/// The normal of the plane through x on whose positive side a ray crosses `z` before `l`
+/// (both toward +Z, x on both −Z sides): `d_l N_z − d_z N_l` with `d = N·(O − x)` (module docs).
+pub fn farther_plane(l: &PreparedPortal, z: &PreparedPortal, x: DVec3) -> DVec3 {
+    let d = |q: &PreparedPortal| q.normal.dot(q.origin - x);
+    d(l) * z.normal - d(z) * l.normal
+}
+
+/// E on the convex polygon `poly` (vectors from x): 0 where no vertex is above the horizon,
+/// else a fan of Lambert's triangles from its first vertex (the device's form; the fan's inner
+/// edges cancel) or the texture's integral.
+pub fn polygon_value(poly: &[DVec3], n: DVec3, dome: Option<&TexturedDome>) -> DVec3 {
     if poly.iter().all(|v| !(n.dot(*v) > 0.0)) {
         return DVec3::ZERO;
     }
     if let Some(d) = dome {
-        return polygon_texture(&poly, n, d);
+        return polygon_texture(poly, n, d);
     }
     DVec3::splat(
         (1..poly.len() - 1)

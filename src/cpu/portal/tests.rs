@@ -458,7 +458,7 @@ fn bad_portals_refused_in_mask_mode_only() {
 
 /// On a GPU evaluator a masked dome's emission and radiance are the device's (within f32
 /// rounding of the reference: these rays pass far from the portals' edges), and so is its
-/// irradiance (this room's portals of different multipliers are crossed in one order each:
+/// irradiance (inclusion–exclusion over this room's overlapping portals:
 /// `prepare::portal::overlaps`); its intensity is the reference's.
 #[test]
 fn gpu_takes_masked_domes_from_the_reference() {

@@ -38,7 +38,8 @@ fn masked_textured(
 /// A textured latlong dome's sum (the texture's row integral over each portal and overlap,
 /// `polygon_texture`) is the visible pieces' irradiance (`cpu::portal::irradiance`: the exact
 /// texel integral clipped at each piece's edge planes, nearest portal first) within 1e-10
-/// relative (measured 2.5e-12), for window rooms and stacks of overlapping panes, both filters, under the
+/// relative (measured 2.5e-12), for window rooms and stacks of overlapping panes (of one
+/// multiplier, or each its own and crossed in either order: split overlaps), both filters, under the
 /// identity and a turned, scaled frame (conformal), receivers of every orientation.
 #[test]
 fn textured_sum_is_the_visible_pieces() {
@@ -47,23 +48,33 @@ fn textured_sum_is_the_visible_pieces() {
     use crate::prepare::latlong_rows::tables;
     use crate::prepare::texture::Filter;
     let mut rng = Rng::new(0x7E47);
+    let mut crossed = Rng::new(0xC2055);
     let img = image(16, 8, 99, false);
     let turned = glam::DMat3::from_quat(DQuat::from_axis_angle(
         DVec3::new(1.0, 2.0, 3.0).normalize(),
         0.7,
     )) * 2.0;
     let mut worst: f64 = 0.0;
-    let (mut lit, mut sets, mut overlapping) = (0, 0, 0);
+    let (mut lit, mut sets, mut overlapping, mut split) = (0, 0, 0, 0);
     for filter in [Filter::Bilinear, Filter::Nearest] {
         let mut data = Vec::new();
         tables(&img, filter, |v| v, &mut data);
         for frame in [glam::DMat3::IDENTITY, turned] {
-            for case in 0..16 {
-                let ps = if case % 2 == 0 {
-                    window_room(&mut rng, 4, 2.0)
+            for case in 0..24 {
+                // The crossed cases draw apart, so that the others keep their draw.
+                let rng = if case < 16 { &mut rng } else { &mut crossed };
+                let ps = if case >= 16 {
+                    // Each its own multiplier, tilted so that pairs cross in either order.
+                    (0..3)
+                        .map(|_| {
+                            random_pane(rng, 0.8, 1.6, 1.0, 0.0).with_intensity(rng.range(0.5, 3.0))
+                        })
+                        .collect()
+                } else if case % 2 == 0 {
+                    window_room(rng, 4, 2.0)
                 } else {
                     (0..2 + rng.below(2))
-                        .map(|_| random_pane(&mut rng, 0.5, 3.0, 0.5, 0.15))
+                        .map(|_| random_pane(rng, 0.5, 3.0, 0.5, 0.15))
                         .collect()
                 };
                 let p = masked_textured(ps, &img, filter, frame);
@@ -72,6 +83,7 @@ fn textured_sum_is_the_visible_pieces() {
                 }
                 sets += 1;
                 overlapping += usize::from(!p.portal_overlaps.is_empty());
+                split += usize::from(p.portal_overlaps.iter().any(|s| s.split.is_some()));
                 let portals = p.portals.as_ref().unwrap();
                 let dome = TexturedDome {
                     rows: Rows {
@@ -83,8 +95,8 @@ fn textured_sum_is_the_visible_pieces() {
                     inv: p.dome_texture().unwrap().frame.inv,
                 };
                 for _ in 0..12 {
-                    let x = if case % 2 == 0 {
-                        in_cube(&mut rng, 2.5)
+                    let x = if case % 2 == 0 && case < 16 {
+                        in_cube(rng, 2.5)
                     } else {
                         DVec3::new(
                             rng.range(-3.0, 3.0),
@@ -111,11 +123,11 @@ fn textured_sum_is_the_visible_pieces() {
         }
     }
     eprintln!(
-        "{sets} sets ({overlapping} with overlaps), {lit} lit receivers, worst relative \
-         difference {worst:e}"
+        "{sets} sets ({overlapping} with overlaps, {split} split), {lit} lit receivers, \
+         worst relative difference {worst:e}"
     );
     assert!(
-        sets >= 50 && overlapping >= 15 && lit > 200,
-        "{sets} sets, {overlapping} overlapping, {lit} lit"
+        sets >= 50 && overlapping >= 15 && split >= 10 && lit > 200,
+        "{sets} sets, {overlapping} overlapping, {split} split, {lit} lit"
     );
 }
