@@ -11,10 +11,9 @@
 // proof; textured domes of other formats or non-conformal frames keep their irradiance on the
 // host (GpuPath::HostIrradiance).
 //
-// f32: the parallelogram is two triangles through mesh/lambert.wgsl's triangle_lambert (with
-//   its sliver form for portals low over the horizon); the CPU takes Lambert's formula on the
-//   four corners (the shared diagonal's terms cancel in exact arithmetic). An overlap's
-//   polygon is a fan of triangles on both.
+// f32: every polygon, a portal's parallelogram included, is a fan of triangles through
+//   mesh/lambert.wgsl's triangle_lambert (with its sliver form for polygons low over the
+//   horizon), as on the CPU (where each triangle is Lambert's formula on its corners).
 // f32: the side test is the f32 sign of normal·(x − origin), as the radiance kernel's
 //   (portal.wgsl); a receiver within ~1e-6 (relative) of a portal's plane may count it or not
 //   differently from the reference, where the portal is seen edge-on (the conformance check
@@ -37,12 +36,13 @@
 //   words in the mesh atlas (the CPU reads PreparedPortal's fields).
 // GPU-only portal_origin, portal_normal: the same, for farther_plane.
 // f32: lavapipe stops an invocation's loops after 65,535 iterations in all: for a uniform dome
-//   a portal costs at most ~25 (two triangles), an overlap of two, three or four at most 120,
-//   237 or 386 (330, 807, 1,526 split: prepare::portal::overlap_iterations), and prepare::portal::overlaps keeps a dome's overlaps within 48,000
-//   (OVERLAP_ITERATIONS), so up to ~2,600 portals without overlaps stay inside it; a textured
-//   dome's polygons cost far more (latlong_polygon.wgsl). The portal and overlap loops, each
-//   clip's vertex loop and the fan's check their own condition after they end and set irr_cut
-//   if they stopped short, and the host recomputes that receiver (shared/record.wgsl).
+//   a portal costs at most ~34 (a parallelogram, two triangles), an overlap of two, three or
+//   four at most 121, 238 or 387 (250, 675, 1,342 split: prepare::portal::overlap_iterations),
+//   and prepare::portal::overlaps keeps a dome's overlaps within 49,000 (OVERLAP_ITERATIONS),
+//   so up to ~1,900 portals without overlaps stay inside it; a textured dome's polygons cost
+//   far more (latlong_polygon.wgsl). The term and piece loops, each clip's vertex loop and the
+//   fan's check their own condition after they end and set irr_cut if they stopped short, and
+//   the host recomputes that receiver (shared/record.wgsl).
 
 // #import shared/record.wgsl
 // #import mesh/lambert.wgsl
@@ -67,74 +67,89 @@ struct PortalDome {
 
 // Σ multiplier · E(portal clipped at n·ω ≥ 0) over the portals at `at` in the mesh atlas
 // (layout: src/gpu/mesh_atlas.rs) whose −Z side x is on, and ± multiplier · E(overlap) over
-// the overlaps after them whose every portal x is on the −Z side of (overlap_value); E is
-// Lambert's formula for a uniform dome, the texture's integral (latlong_polygon.wgsl) for a
-// textured one.
+// the overlaps after them whose every portal x is on the −Z side of, a split one's pieces
+// each with its own (split_piece); E is Lambert's formula for a uniform dome, the texture's
+// integral (latlong_polygon.wgsl) for a textured one. Every term's polygons go through the
+// one call of polygon_value, so that the texture's integral is inlined once (each call site
+// of a function is a copy of it after inlining: with three, lavapipe took 108 s and 1.2 GB to
+// compile the textured kernel, against 44 s and 0.7 GB with two).
 fn portals_irradiance(at: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
     let count = bitcast<u32>(mesh_atlas[at]);
-    var sum = vec3<f32>(0.0);
-    var k = 0u;
-    for (; k < count; k++) {
-        let q = portal_at(at, k);
-        if !portal_seen(q, x) {
-            continue;
-        }
-        let c = portal_corners(q, x);
-        let above = max(max(dot(n, c[0]), dot(n, c[1])), max(dot(n, c[2]), dot(n, c[3]))) > 0.0;
-        if above {
-            sum += portal_multiplier(q) * portal_value(c, n, dome);
-        }
-    }
-    if k < count {
-        // Cut short by the device's loop budget (see irr_cut).
-        irr_cut = true;
-    }
     // The overlaps follow the last portal.
     let sets_at = portal_at(at, count);
     let sets = bitcast<u32>(mesh_atlas[sets_at]);
-    var s = 0u;
-    for (; s < sets; s++) {
-        let o = sets_at + 1u + s * PORTAL_OVERLAP_WORDS;
+    var sum = vec3<f32>(0.0);
+    var t = 0u;
+    for (; t < count + sets; t++) {
+        // The term's polygon, sign and multiplier, and for a split overlap its pieces.
+        var poly: OverlapPolygon;
+        var sign = 1.0;
+        var m: vec3<f32>;
+        var pieces = 1u;
+        var o = 0u;
         var size = 0u;
-        var all_seen = true;
-        var j = 0u;
-        for (; j < PORTAL_OVERLAP_MEMBERS; j++) {
-            let member = bitcast<u32>(mesh_atlas[o + j]);
-            if member == 0xffffffffu {
-                break;
+        var split = 0u;
+        if t < count {
+            let q = portal_at(at, t);
+            if !portal_seen(q, x) {
+                continue;
             }
-            size += 1u;
-            all_seen = all_seen && portal_seen(portal_at(at, member), x);
+            poly = parallelogram(portal_corners(q, x));
+            m = portal_multiplier(q);
+        } else {
+            o = sets_at + 1u + (t - count) * PORTAL_OVERLAP_WORDS;
+            var all_seen = true;
+            var j = 0u;
+            for (; j < PORTAL_OVERLAP_MEMBERS; j++) {
+                let member = bitcast<u32>(mesh_atlas[o + j]);
+                if member == 0xffffffffu {
+                    break;
+                }
+                size += 1u;
+                all_seen = all_seen && portal_seen(portal_at(at, member), x);
+            }
+            if j < PORTAL_OVERLAP_MEMBERS && bitcast<u32>(mesh_atlas[o + j]) != 0xffffffffu {
+                irr_cut = true;
+            }
+            if !all_seen {
+                continue;
+            }
+            poly = overlap_polygon(at, o, size, x);
+            if poly.count < 3u {
+                continue;
+            }
+            sign = select(1.0, -1.0, size % 2u == 0u);
+            m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
+            split = bitcast<u32>(mesh_atlas[o + PORTAL_OVERLAP_MEMBERS]);
+            if (split & PORTAL_OVERLAP_SPLIT) != 0u {
+                pieces = size;
+            }
         }
-        if j < PORTAL_OVERLAP_MEMBERS && bitcast<u32>(mesh_atlas[o + j]) != 0xffffffffu {
+        var l = 0u;
+        for (; l < pieces; l++) {
+            var piece = poly;
+            if pieces > 1u {
+                piece = split_piece(at, o, size, split, poly, l, x);
+                m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o + l])));
+            }
+            if piece.count >= 3u {
+                sum += sign * m * polygon_value(piece, n, dome);
+            }
+        }
+        if l < pieces {
             irr_cut = true;
         }
-        if all_seen {
-            let sign = select(1.0, -1.0, size % 2u == 0u);
-            sum += sign * overlap_value(at, o, size, x, n, dome);
-        }
     }
-    if s < sets {
+    if t < count + sets {
+        // Cut short by the device's loop budget (see irr_cut).
         irr_cut = true;
     }
     return sum;
 }
 
-// E on one portal's parallelogram (corners c, vectors from x): two triangles through Lambert's
-// formula, or the texture's integral.
-fn portal_value(c: array<vec3<f32>, 4>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
-    if dome.textured {
-        return polygon_texture(parallelogram(c), n, dome);
-    }
-    return vec3<f32>(triangle_lambert(c[0], c[1], c[2], n) + triangle_lambert(c[0], c[2], c[3], n));
-}
-
-// The multiplier times E on what x sees through each of the `size` portals listed at `o`:
-// the first one's parallelogram clipped to the cones over the others, with the first one's
-// multiplier; for a split overlap the sum over its members of each one's multiplier times E
-// on the piece where it is the farthest (farther_plane; bit 4i + j of the split word: member
-// i lies before member j on every ray through both).
-fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: PortalDome) -> vec3<f32> {
+// What x sees through each of the `size` portals listed at `o`: the first one's
+// parallelogram clipped to the cones over the others (count < 3 where nothing).
+fn overlap_polygon(at: u32, o: u32, size: u32, x: vec3<f32>) -> OverlapPolygon {
     let first = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o])), x);
     var poly = parallelogram(first);
     var j = 1u;
@@ -142,47 +157,39 @@ fn overlap_value(at: u32, o: u32, size: u32, x: vec3<f32>, n: vec3<f32>, dome: P
         let cone = portal_corners(portal_at(at, bitcast<u32>(mesh_atlas[o + j])), x);
         poly = clip_to_cone(poly, cone);
         if poly.count < 3u {
-            return vec3<f32>(0.0);
+            return poly;
         }
     }
     if j < size {
         // Cut short by the device's loop budget (see irr_cut).
         irr_cut = true;
     }
-    let split = bitcast<u32>(mesh_atlas[o + PORTAL_OVERLAP_MEMBERS]);
-    if (split & PORTAL_OVERLAP_SPLIT) == 0u {
-        let m = portal_multiplier(portal_at(at, bitcast<u32>(mesh_atlas[o])));
-        return m * polygon_value(poly, n, dome);
+    return poly;
+}
+
+// The piece of a split overlap's polygon `poly` where its member l is the farthest: clipped
+// by farther_plane against each other member that rays cross in either order with it (bit
+// 4i + j of `split`: member i lies before member j on every ray through both; count 0 where
+// some member always lies after l).
+fn split_piece(at: u32, o: u32, size: u32, split: u32, poly: OverlapPolygon, l: u32, x: vec3<f32>) -> OverlapPolygon {
+    var piece = poly;
+    let ql = portal_at(at, bitcast<u32>(mesh_atlas[o + l]));
+    var z = 0u;
+    for (; z < size; z++) {
+        if z == l || ((split >> (4u * z + l)) & 1u) == 1u {
+            continue;
+        }
+        if ((split >> (4u * l + z)) & 1u) == 1u {
+            piece.count = 0u;
+            return piece;
+        }
+        let qz = portal_at(at, bitcast<u32>(mesh_atlas[o + z]));
+        piece = clip_polygon(piece, farther_plane(ql, qz, x));
     }
-    var sum = vec3<f32>(0.0);
-    var l = 0u;
-    for (; l < size; l++) {
-        let ql = portal_at(at, bitcast<u32>(mesh_atlas[o + l]));
-        var piece = poly;
-        var empty = false;
-        var z = 0u;
-        for (; z < size; z++) {
-            if z == l || ((split >> (4u * z + l)) & 1u) == 1u {
-                continue;
-            }
-            if ((split >> (4u * l + z)) & 1u) == 1u {
-                empty = true;
-                break;
-            }
-            let qz = portal_at(at, bitcast<u32>(mesh_atlas[o + z]));
-            piece = clip_polygon(piece, farther_plane(ql, qz, x));
-        }
-        if !empty && z < size {
-            irr_cut = true;
-        }
-        if !empty && piece.count >= 3u {
-            sum += portal_multiplier(ql) * polygon_value(piece, n, dome);
-        }
-    }
-    if l < size {
+    if z < size {
         irr_cut = true;
     }
-    return sum;
+    return piece;
 }
 
 // The normal of the plane through x on whose positive side a ray crosses the portal at qz

@@ -162,29 +162,35 @@ pub(crate) fn crossing_orders(a: &PreparedPortal, b: &PreparedPortal) -> (bool, 
 pub const MOST_PORTALS_ONE_RAY_CROSSES: usize = 4;
 
 /// The most loop iterations the kernel may spend on one dome's overlaps ([`overlaps`]) for a
-/// receiver that sees every portal: three quarters of lavapipe's 65,535 an invocation, the rest
-/// left to the portals themselves (~25 each) and the scene's other lights. Past it a receiver
+/// receiver that sees every portal: about three quarters of lavapipe's 65,535 an invocation,
+/// the rest left to the portals themselves (~34 each) and the scene's other lights. Past it a receiver
 /// would be cut short and recomputed on the host (shaders/irradiance/portals.wgsl), so the dome
 /// keeps the host's irradiance instead.
-pub const OVERLAP_ITERATIONS: usize = 48_000;
+pub const OVERLAP_ITERATIONS: usize = 49_000;
 
 /// The kernel's loop iterations for one overlap of `k` portals at most
-/// (shaders/irradiance/portals.wgsl): the overlap loop's own, the members' side tests (and
-/// the end of the list), the first parallelogram's 4 corners, `4(k − 1)` clips of up to `4k`
-/// vertices, the above-horizon test of up to `4k` vertices, and a fan of up to `4k − 2`
-/// triangles of at most 12 each (mesh/lambert.wgsl's count): 120 for two, 237 for three, 386
-/// for four. A split overlap ([`Overlap::split`]) adds, for each of its `k` pieces, the piece
-/// loop's own, the loop over the members with up to `k − 1` clips of up to `5k − 1` vertices
-/// (a clip adds one at most), and the piece's above-horizon test and fan: 330 for two, 807 for
-/// three, 1,526 for four.
+/// (shaders/irradiance/portals.wgsl): the term loop's own, the members' side tests (and the
+/// end of the list), the first parallelogram's 4 corners, `4(k − 1)` clips of up to `4k`
+/// vertices, then per piece the piece loop's own, the above-horizon test of up to `v`
+/// vertices and a fan of up to `v − 2` triangles of at most 12 each (mesh/lambert.wgsl's
+/// count). One piece of `v = 4k` vertices: 121 for two, 238 for three, 387 for four. A split
+/// overlap ([`Overlap::split`]) has `k` pieces, each also looping over the members with up to
+/// `k − 1` clips, so of up to `v = 5k − 1` vertices (a clip adds one at most): 250 for two,
+/// 675 for three, 1,342 for four.
 pub const fn overlap_iterations(k: usize, split: bool) -> usize {
-    let whole = 1 + (k + 1) + 4 + 4 * (k - 1) * 4 * k + 4 * k + (4 * k - 2) * 12;
+    let polygon = 1 + (k + 1) + 4 + 4 * (k - 1) * 4 * k;
     if split {
         let v = 5 * k - 1;
-        whole + k * (1 + k + (k - 1) * v + v + (v - 2) * 12)
+        polygon + k * (piece_iterations(v) + k + (k - 1) * v)
     } else {
-        whole
+        polygon + piece_iterations(4 * k)
     }
+}
+
+/// A piece's loop iterations in [`overlap_iterations`]: the piece loop's own, the above-horizon
+/// test of `v` vertices and a fan of `v − 2` triangles of at most 12 each.
+const fn piece_iterations(v: usize) -> usize {
+    1 + v + (v - 2) * 12
 }
 
 /// [`overlaps`]' reason past [`OVERLAP_ITERATIONS`].

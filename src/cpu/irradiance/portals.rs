@@ -56,11 +56,13 @@ pub struct TexturedDome<'a> {
 }
 
 /// `Σ multiplier · E(portal clipped at n·ω ≥ 0)` over the portals whose −Z side x is on,
-/// and `(−1)^{|S|+1} Σ multiplier · E(piece of ∩S clipped)` over the `overlaps` S
-/// (`Prepared::portal_overlaps`) whose every member x is on the −Z side of ([`overlap_value`];
-/// unit-radiance dome, before `base` and `diffuse`). E is Lambert's formula for a uniform dome
-/// (`dome` None) and the texture's exact integral over the polygon for a textured one
-/// ([`polygon_texture`]).
+/// and `(−1)^{|S|+1} multiplier · E(∩S clipped)` over the `overlaps` S
+/// (`Prepared::portal_overlaps`) whose every member x is on the −Z side of, a split one's
+/// pieces each with its member's multiplier ([`split_piece`]); unit-radiance dome, before
+/// `base` and `diffuse`. E is Lambert's formula for a uniform dome (`dome` None) and the
+/// texture's exact integral over the polygon for a textured one ([`polygon_value`]). Every
+/// term's polygons go through one call of [`polygon_value`], as on the device (where each
+/// call site is a copy of the texture's integral after inlining).
 pub fn portals_irradiance(
     portals: &[PreparedPortal],
     overlaps: &[Overlap],
@@ -70,80 +72,91 @@ pub fn portals_irradiance(
 ) -> DVec3 {
     let seen = |q: &PreparedPortal| q.normal.dot(x - q.origin) < 0.0;
     let mut sum = DVec3::ZERO;
-    for q in portals {
-        if !seen(q) {
-            continue;
-        }
-        let v = q.corners.map(|c| c - x);
-        if v.iter().all(|v| !(n.dot(*v) > 0.0)) {
-            continue;
-        }
-        sum += q.multiplier * portal_value(&v, n, dome);
-    }
-    for set in overlaps {
-        if !set.members.iter().all(|&k| seen(&portals[k as usize])) {
-            continue;
-        }
-        let sign = if set.members.len() % 2 == 0 {
-            -1.0
-        } else {
-            1.0
+    for t in 0..portals.len() + overlaps.len() {
+        // The term's polygon, sign and multiplier, and for a split overlap its pieces.
+        let (poly, sign, m, set) = match portals.get(t) {
+            Some(q) => {
+                if !seen(q) {
+                    continue;
+                }
+                (q.corners.map(|c| c - x).to_vec(), 1.0, q.multiplier, None)
+            }
+            None => {
+                let set = &overlaps[t - portals.len()];
+                if !set.members.iter().all(|&k| seen(&portals[k as usize])) {
+                    continue;
+                }
+                let poly = overlap_polygon(portals, &set.members, x);
+                if poly.len() < 3 {
+                    continue;
+                }
+                let sign = if set.members.len() % 2 == 0 {
+                    -1.0
+                } else {
+                    1.0
+                };
+                let m = portals[set.members[0] as usize].multiplier;
+                (poly, sign, m, Some(set))
+            }
         };
-        sum += sign * overlap_value(portals, set, x, n, dome);
+        let pieces = match set {
+            Some(s @ Overlap { split: Some(_), .. }) => s.members.len(),
+            _ => 1,
+        };
+        for l in 0..pieces {
+            let (piece, m) = match set {
+                Some(s) if pieces > 1 => (
+                    split_piece(portals, s, &poly, l, x),
+                    portals[s.members[l] as usize].multiplier,
+                ),
+                _ => (poly.clone(), m),
+            };
+            if piece.len() >= 3 {
+                sum += sign * m * polygon_value(&piece, n, dome);
+            }
+        }
     }
     sum
 }
 
-/// E on one portal's parallelogram (corners `v`, vectors from x): Lambert's formula on its
-/// corners, or the texture's integral.
-pub fn portal_value(v: &[DVec3; 4], n: DVec3, dome: Option<&TexturedDome>) -> DVec3 {
-    match dome {
-        Some(d) => polygon_texture(v, n, d),
-        None => DVec3::splat(polygon_irradiance(v, n)),
-    }
-}
-
-/// The multiplier times E on what x sees through every portal of `set`: the first one's
-/// parallelogram (vectors from x) clipped to the cones from x over the others
-/// ([`clip_to_cone`]), with the first member's multiplier; for a split set the sum over its
-/// members of each one's multiplier times E on the piece where it is the farthest (module
-/// docs, [`farther_plane`]).
-pub fn overlap_value(
-    portals: &[PreparedPortal],
-    set: &Overlap,
-    x: DVec3,
-    n: DVec3,
-    dome: Option<&TexturedDome>,
-) -> DVec3 {
-    let members = &set.members;
+/// What x sees through every portal of `members`: the first one's parallelogram (vectors
+/// from x) clipped to the cones from x over the others ([`clip_to_cone`]; fewer than 3
+/// vertices where nothing).
+pub fn overlap_polygon(portals: &[PreparedPortal], members: &[u32], x: DVec3) -> Vec<DVec3> {
     let mut poly: Vec<DVec3> = portals[members[0] as usize].corners.map(|c| c - x).to_vec();
     for &k in &members[1..] {
         poly = clip_to_cone(&poly, &portals[k as usize].corners.map(|c| c - x));
         if poly.len() < 3 {
-            return DVec3::ZERO;
+            return poly;
         }
     }
-    let Some(before) = set.split else {
-        return portals[members[0] as usize].multiplier * polygon_value(&poly, n, dome);
-    };
-    let mut sum = DVec3::ZERO;
-    'pieces: for (l, &ml) in members.iter().enumerate() {
-        let mut piece = poly.clone();
-        for (z, &mz) in members.iter().enumerate() {
-            if z == l || before >> (4 * z + l) & 1 == 1 {
-                continue;
-            }
-            if before >> (4 * l + z) & 1 == 1 {
-                continue 'pieces;
-            }
-            let k = farther_plane(&portals[ml as usize], &portals[mz as usize], x);
-            piece = clip_above(&piece, k);
+    poly
+}
+
+/// The piece of the split overlap `set`'s polygon `poly` where its member `l` (a position in
+/// `members`) is the farthest: clipped by [`farther_plane`] against each other member that
+/// rays cross in either order with it; empty where some member always lies after it
+/// ([`Overlap::split`]'s bits).
+pub fn split_piece(
+    portals: &[PreparedPortal],
+    set: &Overlap,
+    poly: &[DVec3],
+    l: usize,
+    x: DVec3,
+) -> Vec<DVec3> {
+    let before = set.split.unwrap_or(0);
+    let ql = &portals[set.members[l] as usize];
+    let mut piece = poly.to_vec();
+    for (z, &mz) in set.members.iter().enumerate() {
+        if z == l || before >> (4 * z + l) & 1 == 1 {
+            continue;
         }
-        if piece.len() >= 3 {
-            sum += portals[ml as usize].multiplier * polygon_value(&piece, n, dome);
+        if before >> (4 * l + z) & 1 == 1 {
+            return Vec::new();
         }
+        piece = clip_above(&piece, farther_plane(ql, &portals[mz as usize], x));
     }
-    sum
+    piece
 }
 
 /// The normal of the plane through x on whose positive side a ray crosses `z` before `l`
@@ -155,7 +168,7 @@ pub fn farther_plane(l: &PreparedPortal, z: &PreparedPortal, x: DVec3) -> DVec3 
 
 /// E on the convex polygon `poly` (vectors from x): 0 where no vertex is above the horizon,
 /// else a fan of Lambert's triangles from its first vertex (the device's form; the fan's inner
-/// edges cancel) or the texture's integral.
+/// edges cancel) or the texture's integral ([`polygon_texture`]).
 pub fn polygon_value(poly: &[DVec3], n: DVec3, dome: Option<&TexturedDome>) -> DVec3 {
     if poly.iter().all(|v| !(n.dot(*v) > 0.0)) {
         return DVec3::ZERO;

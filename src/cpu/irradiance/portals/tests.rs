@@ -536,8 +536,8 @@ fn overlaps_are_the_cliques_of_the_crossable_pairs() {
     assert_eq!(four.portal_overlaps.len(), 11);
     // k windows in a row and a pane 1 above each: every window and every pane are
     // crossable (a ray slanting up from under one window through another's pane), no two
-    // windows nor two panes are: k² sets of two, up to OVERLAP_ITERATIONS (20² · 120 =
-    // 48,000; 21² · 120 = 52,920), each naming its pane
+    // windows nor two panes are: k² sets of two, up to OVERLAP_ITERATIONS (20² · 121 =
+    // 48,400; 21² · 121 = 53,361), each naming its pane
     // first (of another multiplier, always crossed after the window).
     let facade = |k: usize| {
         let at = |i: usize, z: f64| {
