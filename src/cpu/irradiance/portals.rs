@@ -90,7 +90,7 @@ pub fn portals_irradiance(
                 if poly.len() < 3 {
                     continue;
                 }
-                let sign = if set.members.len() % 2 == 0 {
+                let sign = if set.members.len().is_multiple_of(2) {
                     -1.0
                 } else {
                     1.0
