@@ -56,7 +56,7 @@ pub fn wgsl_constants() -> [(&'static str, u32); 8] {
         // horizon of a textured dome (shaders/irradiance/portals.wgsl).
         (
             "PORTAL_OVERLAP_VERTICES",
-            4 * OVERLAP_MEMBERS + OVERLAP_MEMBERS,
+            4 * OVERLAP_MEMBERS + (OVERLAP_MEMBERS - 1) + 1,
         ),
     ]
 }
