@@ -484,7 +484,8 @@ fn masked_textured_dome_irradiance_runs_on_the_device() {
 }
 
 /// Portals of different multipliers that rays cross in either order (panes through a skylight
-/// and through a window at steep angles, three through one another over the skylight): the
+/// and through a window at steep angles, three through one another over the skylight, a
+/// second skylight overlapping the first in its plane): the
 /// device splits each such overlap where its members are crossed at once and gives each piece
 /// its farthest portal's multiplier (`prepare::portal::Overlap::split`), within 1e-4 of the
 /// reference (the visible pieces, nearest first) away from the check's bands, for a uniform
@@ -519,12 +520,15 @@ fn masked_dome_irradiance_runs_on_the_device_where_portals_cross() {
     }
 }
 
-/// Five portals on `dome`, each of its own intensity and colour: a skylight with two panes
-/// through it at steep angles (crossing it and each other), a window with a pane through it.
+/// Six portals on `dome`, each of its own intensity and colour: a skylight with two panes
+/// through it at steep angles (crossing it and each other), a window with a pane through it,
+/// and a second skylight in the first one's plane overlapping it (a coplanar pair, crossed
+/// in one order: the panes' split sets that hold both rely on the set's `before` bits).
 fn crossed(dome: Light) -> Light {
     // (rotation, centre, width, height)
     let specs = [
         (DQuat::IDENTITY, DVec3::new(0.0, 0.0, 3.0), 2.0, 2.4),
+        (DQuat::IDENTITY, DVec3::new(0.8, 0.5, 3.0), 1.4, 1.2),
         (
             DQuat::from_rotation_x(1.0),
             DVec3::new(0.2, 0.1, 3.1),
