@@ -554,20 +554,33 @@ fn crossed(dome: Light) -> Light {
             1.2,
         ),
     ];
-    specs
-        .iter()
+    with_tinted_portals(dome, "/C", specs, |i| {
+        (
+            0.6 + 0.7 * i,
+            DVec3::new(1.0, 0.9 - 0.15 * i, 0.3 + 0.15 * i),
+        )
+    })
+}
+
+/// `dome` with a portal per `(rotation, centre, width, height)`, named `prefix` and its
+/// index i, of intensity and colour `tint(i)`.
+fn with_tinted_portals(
+    dome: Light,
+    prefix: &str,
+    placed: impl IntoIterator<Item = (DQuat, DVec3, f64, f64)>,
+    tint: impl Fn(f64) -> (f64, DVec3),
+) -> Light {
+    placed
+        .into_iter()
         .enumerate()
-        .fold(dome, |l, (i, &(rot, c, w, h))| {
+        .fold(dome, |l, (i, (rot, c, w, h))| {
+            let (intensity, color) = tint(i as f64);
             l.with_portal(
                 Portal::new(w, h)
-                    .with_path(format!("/C{i}"))
+                    .with_path(format!("{prefix}{i}"))
                     .with_transform(DMat4::from_rotation_translation(rot, c))
-                    .with_intensity(0.6 + 0.7 * i as f64)
-                    .with_color(DVec3::new(
-                        1.0,
-                        0.9 - 0.15 * i as f64,
-                        0.3 + 0.15 * i as f64,
-                    )),
+                    .with_intensity(intensity)
+                    .with_color(color),
             )
         })
 }
@@ -588,23 +601,16 @@ fn glazed(dome: Light) -> Light {
         (tilt(0.0, -3.0), DVec3::new(-0.8, -3.7, 0.3), 0.3, 2.0, 1.6),
         (-DVec3::X, DVec3::new(-3.0, 0.0, 0.5), 0.6, 1.2, 2.0),
     ];
-    specs
-        .iter()
-        .enumerate()
-        .fold(dome, |l, (i, &(facing, c, turn, w, h))| {
-            let rot = DQuat::from_rotation_arc(DVec3::Z, facing) * DQuat::from_rotation_z(turn);
-            l.with_portal(
-                Portal::new(w, h)
-                    .with_path(format!("/P{i}"))
-                    .with_transform(DMat4::from_rotation_translation(rot, c))
-                    .with_intensity(0.8 + 0.3 * i as f64)
-                    .with_color(DVec3::new(
-                        1.0,
-                        0.9 - 0.08 * i as f64,
-                        0.4 + 0.05 * i as f64,
-                    )),
-            )
-        })
+    let placed = specs.map(|(facing, c, turn, w, h)| {
+        let rot = DQuat::from_rotation_arc(DVec3::Z, facing) * DQuat::from_rotation_z(turn);
+        (rot, c, w, h)
+    });
+    with_tinted_portals(dome, "/P", placed, |i| {
+        (
+            0.8 + 0.3 * i,
+            DVec3::new(1.0, 0.9 - 0.08 * i, 0.4 + 0.05 * i),
+        )
+    })
 }
 
 /// Compares the masked `dome`'s irradiance on `gpu` with the reference's at 3,000 receivers
