@@ -321,7 +321,7 @@ impl UsdStage {
                 .collect();
             // Filters, link collections, shaping inputs without ShapingAPI (those are said on
             // their own, not as stray inputs).
-            let extras = unapplied::light_extras(&prim, &applied_schemas).map_err(e)?;
+            let extras = unapplied::light_extras(&prim, &applied_schemas, &authored).map_err(e)?;
             let stray_inputs = extras.not_shaping(stray_inputs);
             // The prims from the light up to the first one known, each with whether it has
             // such an op itself; its ops are checked for splines on the way.
