@@ -310,3 +310,49 @@ fn a_query_warns_once_about_what_it_does_not_apply() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!stderr(&o).contains("not applied"), "{}", stderr(&o));
 }
+
+/// A light prim can author a light list itself (no ListAPI / LightListAPI): `lightList` with
+/// targets, or `lightList:cacheBehavior` alone, is listed; `rel lightList` declared without
+/// targets is not (no authored targets). The light's authored property names decide which of
+/// these are asked about (`unapplied::list_site`), so this pins that a light's own list is not
+/// lost on the way.
+#[test]
+fn a_light_list_authored_on_a_light_is_listed() {
+    let dir = tempfile::tempdir().unwrap();
+    let stage = dir.path().join("lists_on_lights.usda");
+    std::fs::write(
+        &stage,
+        r#"#usda 1.0
+def Xform "World"
+{
+    def SphereLight "Self"
+    {
+        rel lightList = </World/Self>
+        token lightList:cacheBehavior = "consumeAndHalt"
+    }
+    def SphereLight "Declared"
+    {
+        rel lightList
+    }
+    def SphereLight "Behaviour"
+    {
+        token lightList:cacheBehavior = "ignore"
+    }
+}
+"#,
+    )
+    .unwrap();
+    let o = luxeval(&["lights", stage.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        v["light_lists"],
+        serde_json::json!([
+            {"path": "/World/Self", "api": null, "targets": ["/World/Self"],
+             "cache_behavior": "consumeAndHalt"},
+            {"path": "/World/Behaviour", "api": null, "targets": [],
+             "cache_behavior": "ignore"},
+        ])
+    );
+    assert_eq!(v["lights"].as_array().unwrap().len(), 3);
+}

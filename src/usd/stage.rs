@@ -124,6 +124,9 @@ struct LightSite {
     mesh_light: bool,
     /// See [`LightPrim::portals`]; relationships do not vary with time.
     portals: Vec<String>,
+    /// Whether the prim's authored property names hold `visibility` (when they do not, its
+    /// own visibility is not asked about: see [`visible_at`]).
+    authors_visibility: bool,
     /// The prim or an ancestor has an xformOp that openusd 0.8 evaluates differently from
     /// usd-core between samples (see [`super::xform::needs_own_xform`]); its world matrix is
     /// composed here.
@@ -272,29 +275,37 @@ impl UsdStage {
                 .iter()
                 .map(|t| t.as_str().to_string())
                 .collect();
-            if let Some(site) = unapplied::list_site(&prim, &applied_schemas).map_err(e)? {
-                light_lists.push(site);
-            }
             let light_api = if LIGHT_TYPES.contains(&usd_type.as_str()) {
-                None
+                Some(None)
             } else {
-                match applied_schemas
+                applied_schemas
                     .iter()
                     .find(|s| LIGHT_APIS.contains(&s.as_str()))
                     // LightAPI on a prim of another type (an Xform, a renderer's own light
                     // type): listed with a warning, never dropped silently.
                     .or_else(|| applied_schemas.iter().find(|s| *s == "LightAPI"))
-                {
-                    Some(api) => Some(api.clone()),
-                    None => continue,
-                }
+                    .map(|api| Some(api.clone()))
+            };
+            // A light's authored property names, listed once: they decide which of its
+            // properties are asked about below (a property no layer authors has no spec, so
+            // neither a value, targets nor a spline).
+            let authored = match light_api {
+                Some(_) => Some(prim.authored_property_names().map_err(e)?),
+                None => None,
+            };
+            if let Some(site) =
+                unapplied::list_site(&prim, &applied_schemas, authored.as_deref()).map_err(e)?
+            {
+                light_lists.push(site);
+            }
+            let (Some(light_api), Some(authored)) = (light_api, authored) else {
+                continue;
             };
             let applied: Vec<&str> = applied_schemas.iter().map(String::as_str).collect();
             let attrs = attrs_of
                 .entry((usd_type.clone(), applied_schemas.clone()))
                 .or_insert_with(|| schema::attrs_for(&usd_type, &applied).into())
                 .clone();
-            let authored = prim.authored_property_names().map_err(e)?;
             // Only an attribute some layer authors can hold a value or a spline (openusd finds
             // neither without a spec): the others are not asked about, which spares a typical
             // light most of its per-attribute queries and the indexes openusd caches for them.
@@ -363,6 +374,7 @@ impl UsdStage {
                 _ => Vec::new(),
             };
             lights.push(LightSite {
+                authors_visibility: authored.iter().any(|n| n.as_str() == "visibility"),
                 mesh_light,
                 portals,
                 path: p.to_string(),
@@ -435,7 +447,8 @@ impl UsdStage {
         let mut visible_of = HashMap::new();
         let mut out = Vec::with_capacity(self.lights.len());
         for site in &self.lights {
-            let visible = visible_at(&site.prim, tc, &mut visible_of).map_err(e)?;
+            let visible =
+                visible_at(&site.prim, site.authors_visibility, tc, &mut visible_of).map_err(e)?;
             let world = match site.own_xform_chain {
                 false => cache.local_to_world(&site.prim),
                 true => world_as_usd_core(&cache, &site.prim, tc),

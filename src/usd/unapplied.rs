@@ -220,20 +220,25 @@ pub(crate) fn light_extras(
 }
 
 /// The light list `prim` authors: where ListAPI or LightListAPI is applied, or `lightList` or
-/// `lightList:cacheBehavior` is authored without either.
+/// `lightList:cacheBehavior` is authored without either. `authored_names`, the prim's
+/// `authored_property_names()` where the caller has them (a light's), spares the queries of
+/// properties no layer authors (see [`light_extras`]).
 pub(crate) fn list_site(
     prim: &ousd::Prim,
     applied: &[String],
+    authored_names: Option<&[Token]>,
 ) -> openusd::Result<Option<ListSite>> {
     let api = applied
         .iter()
         .find(|s| LIST_APIS.contains(&s.as_str()))
         .cloned();
+    let may = |name: &str| authored_names.is_none_or(|ns| ns.iter().any(|n| n.as_str() == name));
     let authored = api.is_some()
-        || prim.relationship("lightList").has_authored_targets()?
-        || prim
-            .attribute("lightList:cacheBehavior")
-            .has_authored_value()?;
+        || (may("lightList") && prim.relationship("lightList").has_authored_targets()?)
+        || (may("lightList:cacheBehavior")
+            && prim
+                .attribute("lightList:cacheBehavior")
+                .has_authored_value()?);
     Ok(authored.then(|| ListSite {
         prim: prim.clone(),
         api,

@@ -87,14 +87,20 @@ pub(super) fn held_before_block(samples: &sdf::TimeSampleMap, tc: TimeCode) -> O
 /// root). Every prim walked is answered: a prim is visible when it is and the prim the walk
 /// stopped at is. The prims are asked in the same order, bottom-up, as without `known`, and
 /// a prim answered visible was asked without error, so errors and answers are the same.
+///
+/// `prim_authors_it` is false where the caller knows that no layer authors `visibility` on
+/// `prim` itself (its authored property names lack it: no spec, so no value), which spares the
+/// query; its ancestors are asked as before.
 pub(super) fn visible_at(
     prim: &ousd::Prim,
+    prim_authors_it: bool,
     tc: TimeCode,
     known: &mut HashMap<sdf::Path, bool>,
 ) -> openusd::Result<bool> {
     let mut walked: Vec<sdf::Path> = Vec::new();
     let mut visible = true;
     let mut cur = Some(prim.clone());
+    let mut may_author = prim_authors_it;
     while let Some(p) = cur.filter(|p| !p.path().is_abs_root()) {
         if let Some(&v) = known.get(p.path()) {
             visible = v;
@@ -102,7 +108,8 @@ pub(super) fn visible_at(
         }
         walked.push(p.path().clone());
         // An opinion on a prim that is not imageable (an untyped prim) is ignored, as in C++.
-        if Imageable::from_prim(p.clone())?.is_some()
+        if std::mem::replace(&mut may_author, true)
+            && Imageable::from_prim(p.clone())?.is_some()
             && let Some(v) = value_at(&p.attribute("visibility"), tc)?
             && v.as_str() == Some("invisible")
         {
