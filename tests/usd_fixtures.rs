@@ -646,7 +646,9 @@ fn a_broken_transform_is_a_warning_not_a_failed_load() {
 }
 
 /// usd-core evaluates splines; openusd 0.8 reads them as unauthored, so they are refused with
-/// the light and attribute named rather than silently replaced by the fallback.
+/// the light and attribute named rather than silently replaced by the fallback. The refusal
+/// asks about splines only where a layer read may hold one (`may_hold_splines`): a text root
+/// without one whose light takes its spline through a reference is refused all the same.
 #[test]
 fn splines_are_refused_naming_the_attribute() {
     let errs = data().join("usd/errors");
@@ -654,6 +656,7 @@ fn splines_are_refused_naming_the_attribute() {
         ("spline_input.usda", "inputs:intensity"),
         ("spline_input.usdc", "inputs:intensity"),
         ("spline_xform.usda", "xformOp:rotateX"),
+        ("spline_referenced.usda", "inputs:intensity"),
     ] {
         match Stage::load(&errs.join(file), None) {
             Err(LuxError::InvalidAttribute {
@@ -664,10 +667,10 @@ fn splines_are_refused_naming_the_attribute() {
             }) => {
                 assert_eq!(
                     light,
-                    if file.contains("xform") {
-                        "/Rig/L"
-                    } else {
-                        "/L"
+                    match file {
+                        "spline_xform.usda" => "/Rig/L",
+                        "spline_referenced.usda" => "/World/L",
+                        _ => "/L",
                     }
                 );
                 assert_eq!(a, attr, "{file}");

@@ -766,6 +766,12 @@ ERRORS = {
         "    uniform token[] xformOpOrder = [\"xformOp:rotateX\"]\n\n"
         "    def SphereLight \"L\"\n    {\n    }\n}\n"
     ),
+    # A text layer without a spline whose light takes one through a reference (the reader
+    # asks about splines only where a layer read may hold one).
+    "spline_referenced.usda": (
+        "#usda 1.0\n\ndef Xform \"World\"\n{\n    def \"L\" (\n"
+        "        prepend references = @spline_input.usda@</L>\n    )\n    {\n    }\n}\n"
+    ),
     # One light whose transform cannot be computed (the inverse of a singular matrix) beside a
     # healthy one: the first is listed with a warning, the second still evaluates.
     "singular_invert.usda": (

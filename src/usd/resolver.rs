@@ -29,6 +29,10 @@ pub(super) struct LimitedResolver {
     /// layer and line.
     notes: Rc<RefCell<Vec<String>>>,
     noted: Rc<RefCell<std::collections::HashSet<String>>>,
+    /// Whether a layer read so far may hold a spline: a text layer where a property authors
+    /// one, and every asset that is not text (a crate file, a package), whose fields luxeval
+    /// does not read itself.
+    may_hold_splines: Rc<std::cell::Cell<bool>>,
 }
 
 /// Text luxeval's reader cannot read: rendered as openusd renders its parse errors
@@ -63,7 +67,15 @@ impl LimitedResolver {
             opened: Rc::default(),
             notes: Rc::default(),
             noted: Rc::default(),
+            may_hold_splines: Rc::default(),
         }
+    }
+
+    /// Whether a layer opened so far may hold a spline (see `values::reject_spline`): false
+    /// only when every one was text without a `.spline` property, so that no attribute of the
+    /// stage has a spline field to ask about.
+    pub(super) fn may_hold_splines(&self) -> bool {
+        self.may_hold_splines.get()
     }
 
     /// What the text reader read differently from how it was written, in the order found.
@@ -167,7 +179,12 @@ impl ar::Resolver for LimitedResolver {
                     notes.push(n);
                 }
             }
+            if read.has_spline {
+                self.may_hold_splines.set(true);
+            }
             bytes = read.text.into_bytes();
+        } else {
+            self.may_hold_splines.set(true);
         }
         Ok(Box::new(io::Cursor::new(ar::AssetBuffer::Owned(bytes))))
     }

@@ -34,6 +34,9 @@ pub(super) struct Canonical {
     pub text: String,
     /// One line per value usd-core keeps but no typed read sees (see the module table).
     pub notes: Vec<String>,
+    /// Whether some property authors a spline (`name.spline = {...}`): the only way a text
+    /// layer holds one, which `values::reject_spline` refuses.
+    pub has_spline: bool,
 }
 
 /// Text this reader cannot read, at a 1-based line.
@@ -54,8 +57,12 @@ type R<T> = std::result::Result<T, SyntaxError>;
 /// Reads `text` (a whole `.usda` layer) and writes it back canonically. Prims, dictionaries,
 /// lists and tuples nested deeper than `max_nesting` are refused (the reader recurses per level).
 pub(super) fn canonical(text: &str, max_nesting: usize) -> R<Canonical> {
-    let (text, notes) = read::Reader::new(text, lex::lex(text)?, max_nesting).read()?;
-    Ok(Canonical { text, notes })
+    let (text, notes, has_spline) = read::Reader::new(text, lex::lex(text)?, max_nesting).read()?;
+    Ok(Canonical {
+        text,
+        notes,
+        has_spline,
+    })
 }
 
 fn err<T>(line: usize, reason: impl Into<String>) -> R<T> {
@@ -102,6 +109,20 @@ mod tests {
         ] {
             assert!(out.contains(want), "{want:?} not in\n{out}");
         }
+    }
+
+    /// `has_spline` is what lets the stage skip asking every attribute about splines: true
+    /// for a `.spline` property anywhere (a prim's, a nested prim's), false for a layer whose
+    /// other suffixes (`.timeSamples`, `.connect`) or names merely mention splines.
+    #[test]
+    fn a_spline_property_is_noticed() {
+        let spline = "#usda 1.0\ndef Xform \"A\"\n{\n    def Xform \"B\"\n    {\n        \
+                      float f.spline = {\n            bezier,\n            1: 0,\n        }\n    }\n}\n";
+        assert!(canonical(spline, 64).unwrap().has_spline);
+        let none = "#usda 1.0\ndef Xform \"A\" (\n    doc = \"f.spline = {}\"\n)\n{\n    \
+                    float spline.timeSamples = { 1: 0.5 }\n    float g.connect = </A.spline>\n}\n";
+        let c = canonical(none, 64).unwrap();
+        assert!(!c.has_spline, "{}", c.text);
     }
 
     #[test]

@@ -40,6 +40,8 @@ pub(super) struct Reader<'a> {
     /// The line the output is on: tokens are written on their own source line.
     out_line: usize,
     notes: Vec<String>,
+    /// Whether a property authors a spline (`.spline =`).
+    has_spline: bool,
     /// How deep the construct being read nests, and the most allowed.
     depth: usize,
     max_nesting: usize,
@@ -54,16 +56,18 @@ impl<'a> Reader<'a> {
             out: String::with_capacity(src.len() + 64),
             out_line: 1,
             notes: Vec::new(),
+            has_spline: false,
             depth: 0,
             max_nesting,
         }
     }
 
-    /// The whole layer written canonically, and the notes of what was read differently.
-    pub(super) fn read(mut self) -> R<(String, Vec<String>)> {
+    /// The whole layer written canonically, the notes of what was read differently, and
+    /// whether a property authors a spline.
+    pub(super) fn read(mut self) -> R<(String, Vec<String>, bool)> {
         self.layer()?;
         self.out.push('\n');
-        Ok((self.out, self.notes))
+        Ok((self.out, self.notes, self.has_spline))
     }
 
     fn peek(&self) -> Option<&Tok<'a>> {
@@ -432,6 +436,7 @@ impl<'a> Reader<'a> {
             self.pass()?;
             self.pass()?;
         }
+        self.has_spline |= suffix == "spline";
         if self.at_punct('=') {
             self.pass()?;
             match (is_rel, suffix) {
