@@ -13,7 +13,7 @@ use super::diagnostics::{check_composition, open_error, stage_error};
 use super::mesh::{MeshArrays, read_arrays};
 use super::resolver::LimitedResolver;
 use super::unapplied::{self, LightExtras, LightList, ListSite};
-use super::values::{convert, reject_spline, value_at, visible_at};
+use super::values::{authors, convert, reject_spline, value_at, visible_at};
 use super::xform::{WorldCache, ops_need_own_xform, world_as_usd_core, xform_error};
 use crate::error::{LuxError, Result};
 use crate::limits::{ENV_MAX_FILE_BYTES, Limits, raise_hint};
@@ -289,10 +289,11 @@ impl UsdStage {
             // A light's authored property names, listed once: they decide which of its
             // properties are asked about below (a property no layer authors has no spec, so
             // neither a value, targets nor a spline).
-            let authored = match light_api {
-                Some(_) => Some(prim.authored_property_names().map_err(e)?),
-                None => None,
-            };
+            let authored = light_api
+                .as_ref()
+                .map(|_| prim.authored_property_names())
+                .transpose()
+                .map_err(e)?;
             if let Some(site) =
                 unapplied::list_site(&prim, &applied_schemas, authored.as_deref()).map_err(e)?
             {
@@ -309,10 +310,7 @@ impl UsdStage {
             // Only an attribute some layer authors can hold a value or a spline (openusd finds
             // neither without a spec): the others are not asked about, which spares a typical
             // light most of its per-attribute queries and the indexes openusd caches for them.
-            let has_spec: Vec<bool> = attrs
-                .iter()
-                .map(|a| authored.iter().any(|n| n.as_str() == a.name))
-                .collect();
+            let has_spec: Vec<bool> = attrs.iter().map(|a| authors(&authored, a.name)).collect();
             // Every layer this prim's properties come from has been read by now (listing its
             // authored names composed them); where none may hold a spline, no attribute has a
             // spline field to ask about (3.5 % of `luxeval lights` on 30,000 plain lights).
@@ -378,7 +376,7 @@ impl UsdStage {
                 _ => Vec::new(),
             };
             lights.push(LightSite {
-                authors_visibility: authored.iter().any(|n| n.as_str() == "visibility"),
+                authors_visibility: authors(&authored, "visibility"),
                 mesh_light,
                 portals,
                 path: p.to_string(),

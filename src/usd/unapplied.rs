@@ -12,7 +12,7 @@ use openusd::tf::Token;
 use openusd::usd::{self as ousd, TimeCode};
 use serde::Serialize;
 
-use super::values::{is_blocked, value_at};
+use super::values::{authors, is_blocked, value_at};
 
 /// `light:filters` (spec/001 "light:filters": "Use filters to modulate the effects of the light.
 /// Light filters use shaders to create custom light effects").
@@ -152,8 +152,7 @@ pub(crate) fn light_extras(
     applied: &[String],
     authored_names: &[Token],
 ) -> openusd::Result<LightExtras> {
-    let has = |name: &str| authored_names.iter().any(|n| n.as_str() == name);
-    let filters = match has(FILTERS) {
+    let filters = match authors(authored_names, FILTERS) {
         true => targets(&prim.relationship(FILTERS))?,
         false => Vec::new(),
     };
@@ -232,7 +231,7 @@ pub(crate) fn list_site(
         .iter()
         .find(|s| LIST_APIS.contains(&s.as_str()))
         .cloned();
-    let may = |name: &str| authored_names.is_none_or(|ns| ns.iter().any(|n| n.as_str() == name));
+    let may = |name: &str| authored_names.is_none_or(|ns| authors(ns, name));
     let authored = api.is_some()
         || (may("lightList") && prim.relationship("lightList").has_authored_targets()?)
         || (may("lightList:cacheBehavior")

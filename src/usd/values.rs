@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 
 use openusd::sdf;
+use openusd::tf::Token;
 use openusd::usd::{self as ousd, TimeCode};
 use openusd_schemas::geom::Imageable;
 
@@ -60,6 +61,13 @@ pub(super) fn value_at(
     Ok(held_before_block(&samples, tc).map(|i| samples[i].1.clone()))
 }
 
+/// Whether `name` is among a prim's authored property names (`authored_property_names()`). A
+/// property none of them names has no spec in any layer, so it has neither a value, targets,
+/// nor a spline: the reader asks openusd about a light's properties only where this holds.
+pub(super) fn authors(authored_names: &[Token], name: &str) -> bool {
+    authored_names.iter().any(|n| n.as_str() == name)
+}
+
 pub(super) fn is_blocked(v: &sdf::Value) -> bool {
     matches!(v, sdf::Value::ValueBlock | sdf::Value::None)
 }
@@ -100,15 +108,16 @@ pub(super) fn visible_at(
     let mut walked: Vec<sdf::Path> = Vec::new();
     let mut visible = true;
     let mut cur = Some(prim.clone());
-    let mut may_author = prim_authors_it;
     while let Some(p) = cur.filter(|p| !p.path().is_abs_root()) {
         if let Some(&v) = known.get(p.path()) {
             visible = v;
             break;
         }
+        // The walk's first prim is `prim` itself.
+        let may_author = !walked.is_empty() || prim_authors_it;
         walked.push(p.path().clone());
         // An opinion on a prim that is not imageable (an untyped prim) is ignored, as in C++.
-        if std::mem::replace(&mut may_author, true)
+        if may_author
             && Imageable::from_prim(p.clone())?.is_some()
             && let Some(v) = value_at(&p.attribute("visibility"), tc)?
             && v.as_str() == Some("invisible")
