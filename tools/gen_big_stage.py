@@ -4,7 +4,7 @@ item 5): N plain SphereLights, PER_GROUP (default 4, or K) to an Xform, every Xf
 that both the number of prims and the number of siblings under one parent grow with N (the
 shape that made the reader quadratic).
 
-    python3 tools/gen_big_stage.py N OUT.usda [--instanced] [--per-group K]
+    python3 tools/gen_big_stage.py N OUT.usda [--instanced | --own-layers] [--per-group K]
 
 Plain (default): every light is authored in OUT.usda with its own intensity, color and radius.
 
@@ -12,6 +12,10 @@ Plain (default): every light is authored in OUT.usda with its own intensity, col
 lights under its defaultPrim; each of the N / PER_GROUP Xforms of OUT.usda references it and is
 instanceable, so luxeval reads the lights as instance proxies. N must then be a multiple of
 PER_GROUP.
+
+--own-layers: as --instanced, but every Xform references a layer of its own (OUT's name with
+`_G<g>.usda`, PER_GROUP lights each) and none is instanceable: N / PER_GROUP distinct layers, the
+shape of a set whose every fixture is its own file.
 
 Plain text, no usd-core needed; the output is deterministic. usd-core opens both (check with
 `python3 -c 'from pxr import Usd; Usd.Stage.Open("OUT.usda")'`)."""
@@ -54,6 +58,9 @@ def main():
         del argv[k : k + 2]
     args = [a for a in argv if not a.startswith("--")]
     instanced = "--instanced" in argv
+    own_layers = "--own-layers" in argv
+    if instanced and own_layers:
+        sys.exit(__doc__)
     if len(args) != 2:
         sys.exit(__doc__)
     n, out = int(args[0]), args[1]
@@ -61,18 +68,28 @@ def main():
     with open(out, "w") as f:
         f.write(header)
         f.write('def Xform "World"\n{\n')
-        if instanced:
+        if instanced or own_layers:
             if n % PER_GROUP:
-                sys.exit(f"--instanced: N must be a multiple of {PER_GROUP}")
+                sys.exit(f"N must be a multiple of {PER_GROUP}")
             asset = os.path.splitext(out)[0] + "_asset.usda"
-            with open(asset, "w") as a:
-                a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
-                for k in range(PER_GROUP):
-                    a.write(light(f"L{k}", k, 4))
-                a.write("}\n")
+            if instanced:
+                with open(asset, "w") as a:
+                    a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
+                    for k in range(PER_GROUP):
+                        a.write(light(f"L{k}", k, 4))
+                    a.write("}\n")
             ref = os.path.basename(asset)
             for g in range(n // PER_GROUP):
-                meta = f" (\n        instanceable = true\n        references = @./{ref}@\n    )"
+                if own_layers:
+                    ref = os.path.basename(os.path.splitext(out)[0] + f"_G{g}.usda")
+                    with open(os.path.join(os.path.dirname(out) or ".", ref), "w") as a:
+                        a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
+                        for k in range(PER_GROUP):
+                            a.write(light(f"L{k}", g * PER_GROUP + k, 4))
+                        a.write("}\n")
+                    meta = f" (\n        references = @./{ref}@\n    )"
+                else:
+                    meta = f" (\n        instanceable = true\n        references = @./{ref}@\n    )"
                 f.write(group_open(g, meta) + "    }\n")
         else:
             for g in range((n + PER_GROUP - 1) // PER_GROUP):
