@@ -54,11 +54,12 @@ fn check_round(continuous: bool) {
     let Some(gpu) = common::gpu() else { return };
     let device = gpu.device_name();
     let mut rng = Rng::new(0x1E5_1E5);
-    let mut lights_of_round = lights(&mut rng, false);
-    if continuous {
-        lights_of_round = lights(&mut rng, true);
-    }
-    let refs: Vec<Reference> = lights_of_round
+    let with_jumps = lights(&mut rng, false);
+    let round = match continuous {
+        false => with_jumps,
+        true => lights(&mut rng, true),
+    };
+    let refs: Vec<Reference> = round
         .iter()
         .map(|l| Reference::new(l, TemperatureMode::Spec).expect("valid light"))
         .collect();

@@ -39,6 +39,16 @@ def light(name, i, indent):
     )
 
 
+def lamp_layer(path, first):
+    """Writes an asset layer: PER_GROUP lights (indices first, first + 1, ...) under its
+    defaultPrim "Lamp"."""
+    with open(path, "w") as a:
+        a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
+        for k in range(PER_GROUP):
+            a.write(light(f"L{k}", first + k, 4))
+        a.write("}\n")
+
+
 def group_open(g, meta=""):
     x, z = g % 100, g // 100
     return (
@@ -71,24 +81,16 @@ def main():
         if instanced or own_layers:
             if n % PER_GROUP:
                 sys.exit(f"N must be a multiple of {PER_GROUP}")
-            asset = os.path.splitext(out)[0] + "_asset.usda"
+            stem = os.path.splitext(out)[0]
             if instanced:
-                with open(asset, "w") as a:
-                    a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
-                    for k in range(PER_GROUP):
-                        a.write(light(f"L{k}", k, 4))
-                    a.write("}\n")
-            ref = os.path.basename(asset)
+                lamp_layer(stem + "_asset.usda", 0)
             for g in range(n // PER_GROUP):
                 if own_layers:
-                    ref = os.path.basename(os.path.splitext(out)[0] + f"_G{g}.usda")
-                    with open(os.path.join(os.path.dirname(out) or ".", ref), "w") as a:
-                        a.write('#usda 1.0\n(\n    defaultPrim = "Lamp"\n)\n\ndef Xform "Lamp"\n{\n')
-                        for k in range(PER_GROUP):
-                            a.write(light(f"L{k}", g * PER_GROUP + k, 4))
-                        a.write("}\n")
+                    lamp_layer(f"{stem}_G{g}.usda", g * PER_GROUP)
+                    ref = os.path.basename(f"{stem}_G{g}.usda")
                     meta = f" (\n        references = @./{ref}@\n    )"
                 else:
+                    ref = os.path.basename(stem + "_asset.usda")
                     meta = f" (\n        instanceable = true\n        references = @./{ref}@\n    )"
                 f.write(group_open(g, meta) + "    }\n")
         else:

@@ -315,8 +315,10 @@ impl UsdStage {
             // authored names composed them); where none may hold a spline, no attribute has a
             // spline field to ask about (3.5 % of `luxeval lights` on 30,000 plain lights).
             let splines = resolver.may_hold_splines();
-            for (a, _) in attrs.iter().zip(&has_spec).filter(|(_, s)| **s && splines) {
-                reject_spline(&p, &prim.attribute(a.name))?;
+            if splines {
+                for (a, _) in attrs.iter().zip(&has_spec).filter(|(_, s)| **s) {
+                    reject_spline(&p, &prim.attribute(a.name))?;
+                }
             }
             // Inputs of the schema table that this light's schema lacks (a renderer's own
             // namespaced inputs are not the table's, so they pass without a word).
@@ -349,8 +351,10 @@ impl UsdStage {
                 let own = match Xformable::from_prim(q.clone()).map_err(e)? {
                     Some(x) => {
                         let (ops, _) = x.ordered_xform_ops().map_err(|err| xform_error(&p, err))?;
-                        for op in ops.iter().filter(|_| splines) {
-                            reject_spline(&p, op.attribute())?;
+                        if splines {
+                            for op in &ops {
+                                reject_spline(&p, op.attribute())?;
+                            }
                         }
                         ops_need_own_xform(&ops).map_err(|err| xform_error(&p, err))?
                     }

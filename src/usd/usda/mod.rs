@@ -57,12 +57,7 @@ type R<T> = std::result::Result<T, SyntaxError>;
 /// Reads `text` (a whole `.usda` layer) and writes it back canonically. Prims, dictionaries,
 /// lists and tuples nested deeper than `max_nesting` are refused (the reader recurses per level).
 pub(super) fn canonical(text: &str, max_nesting: usize) -> R<Canonical> {
-    let (text, notes, has_spline) = read::Reader::new(text, lex::lex(text)?, max_nesting).read()?;
-    Ok(Canonical {
-        text,
-        notes,
-        has_spline,
-    })
+    read::Reader::new(text, lex::lex(text)?, max_nesting).read()
 }
 
 fn err<T>(line: usize, reason: impl Into<String>) -> R<T> {

@@ -64,10 +64,14 @@ impl<'a> Reader<'a> {
 
     /// The whole layer written canonically, the notes of what was read differently, and
     /// whether a property authors a spline.
-    pub(super) fn read(mut self) -> R<(String, Vec<String>, bool)> {
+    pub(super) fn read(mut self) -> R<super::Canonical> {
         self.layer()?;
         self.out.push('\n');
-        Ok((self.out, self.notes, self.has_spline))
+        Ok(super::Canonical {
+            text: self.out,
+            notes: self.notes,
+            has_spline: self.has_spline,
+        })
     }
 
     fn peek(&self) -> Option<&Tok<'a>> {
