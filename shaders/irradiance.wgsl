@@ -6,7 +6,8 @@
 //   formula when (d / smaller half-extent)·(d / height above its plane) exceeds
 //   IRR_LAMBERT_COND (Lambert's edge terms cancel like each factor), or when it is cut by the
 //   receiver's horizon (a clipped sliver cancels like its thinness).
-// On the host: lights flagged FLAG_HOST_IRRADIANCE (textured rects, textured domes other than
+// On the host: lights flagged FLAG_HOST_IRRADIANCE (textured rects over
+//   prepare::RECT_TEXELS_ON_DEVICE texels, textured domes other than
 //   latlong ones under a conformal frame with tables the device holds, masked domes whose
 //   portals of different multipliers rays cross in either order (irradiance/portals.wgsl), mesh
 //   lights whose triangles may hide one another, IES profiles bent by angleScale) give 0 here
@@ -16,6 +17,8 @@
 //   dome is integrated here; IES likewise only when an IES-shaped light is
 //   (gpu::shaders::Features). An IES-shaped light's lines split at its profile's grid surfaces
 //   (irradiance/line.wgsl) and its outer integral at their critical Ys (irradiance/critical.wgsl).
+//   A textured rect's integrand carries its filtered texture, split at the texture's break
+//   lines (irradiance/line.wgsl, irradiance/outer.wgsl; TEXTURE).
 // Optional parts: the chart quadrature (CHART) and treatAsLine (LINE) are compiled in only for
 //   scenes with a light that may need them (gpu::record::Record::features, which
 //   follows this file's switch): on lavapipe the quadrature is nearly all of the pipeline's
@@ -100,7 +103,9 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
                 let d = length(world_origin(light) - x);
                 let h = abs(dot(x - world_origin(light), light.normal.xyz));
                 let lambert = d * d <= IRR_LAMBERT_COND * size * h;
-                if !has_flag(light, FLAG_SHAPING) && lambert && rect_above_horizon(light, x, n) {
+                // (A textured rect's radiance varies over it: the quadrature.)
+                let plain = !has_flag(light, FLAG_SHAPING) && !has_flag(light, FLAG_RECT_TEXTURE);
+                if plain && lambert && rect_above_horizon(light, x, n) {
                     e = base * rect_lambert(light, x, n);
                 } else {
                     chart = plane_chart(light, x, light.size.x, light.size.y, REGION_SQUARE);

@@ -12,9 +12,9 @@
 use crate::common;
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
-use luxeval::testkit::Rng;
 use luxeval::testkit::rect::{near_rect_discontinuity, prepare_rects_with_filter};
-use luxeval::{Accumulate, Evaluator, Light, LightType, Shaping, Texture};
+use luxeval::testkit::{Rng, check, irradiance_samples};
+use luxeval::{Accumulate, Evaluator, Light, LightType, Reference, Shaping, TemperatureMode, Texture};
 
 const TOL: f64 = 1e-4;
 
@@ -198,6 +198,113 @@ fn gpu_matches_cpu_on_textured_rects() {
         failures.is_empty(),
         "{} of {total} beyond {TOL}: {:#?}",
         failures.len(),
+        &failures[..failures.len().min(10)]
+    );
+}
+
+/// The textures of the irradiance test: small enough that most receivers' quadratures fit
+/// lavapipe's loop budget (a receiver cut short is recomputed on the host, and counted).
+const IRRADIANCE_SIZES: [(u32, u32); 4] = [(1, 1), (2, 3), (3, 2), (4, 4)];
+
+/// Textured rects of up to `RECT_TEXELS_ON_DEVICE` texels are integrated on the device, their
+/// quadrature split at the texture's break lines (shaders/irradiance/line.wgsl, outer.wgsl):
+/// per light, every receiver within `check::TOLERANCE` of the reference (the CPU's exact split
+/// integral to 1e-9, src/cpu/irradiance/rect_texture.rs), both filters, every transform kind,
+/// shaped and unshaped; receivers from 1.05 to 6 sizes away (`testkit::irradiance_samples`)
+/// and close ones (0.02 to 0.5 of the smaller half-extent in front of the rect).
+#[test]
+fn gpu_irradiance_of_small_textured_rects_matches_the_reference() {
+    let Some(gpu) = common::gpu() else { return };
+    let mut rng = Rng::new(0x1EE7);
+    let mut lights = Vec::new();
+    for (k, (w, h)) in IRRADIANCE_SIZES.into_iter().enumerate() {
+        let file = png(w, h, &mut rng);
+        for (j, m) in transforms().into_iter().enumerate() {
+            let mut l = Light::rect(1.0 + 0.3 * k as f64, 0.6 + 0.2 * j as f64)
+                .with_path(format!("/Rect_{w}x{h}_{j}"))
+                .with_intensity(1.5 + j as f64)
+                .with_transform(m)
+                .with_texture(Texture::new(file.clone()));
+            if (k + j) % 2 == 1 {
+                l = l.with_shaping(Shaping {
+                    focus: 1.5,
+                    focus_tint: DVec3::new(0.2, 0.5, 1.0),
+                    cone_angle: 70.0,
+                    cone_softness: 0.5,
+                    ies: None,
+                });
+            }
+            lights.push(l);
+        }
+    }
+    let mut total = 0usize;
+    let mut recomputed = 0usize;
+    let mut lit = 0usize;
+    let mut worst = (0.0f64, String::new());
+    let mut failures = Vec::new();
+    for nearest in [false, true] {
+        let models = luxeval::testkit::dome::with_filter(&lights, nearest);
+        for light in &models {
+            let r = Reference::new(light, TemperatureMode::Spec).expect("valid light");
+            let (mut points, mut normals) = irradiance_samples(&r, 24, &mut rng);
+            let LightType::Rect { width, height } = light.kind else {
+                unreachable!()
+            };
+            for _ in 0..8 {
+                let local = DVec3::new(
+                    (rng.f64() - 0.5) * 1.2 * width,
+                    (rng.f64() - 0.5) * 1.2 * height,
+                    -(0.02 + 0.48 * rng.f64()) * 0.5 * width.min(height),
+                );
+                let x = light.world.transform_point3(local);
+                let toward = (light.world.transform_point3(DVec3::ZERO) - x).normalize();
+                points.push(f32s(x));
+                normals.push(f32s((toward + unit(&mut rng) * 0.5).normalize()));
+            }
+            let scene = gpu
+                .prepare(std::slice::from_ref(light))
+                .expect("GPU scene");
+            let got = scene
+                .irradiance(&points, &normals, Accumulate::Sum)
+                .expect("GPU irradiance");
+            recomputed += scene.host_recomputed_rows();
+            for i in 0..points.len() {
+                let v = |a: [f32; 3]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+                let cpu = r.irradiance(v(points[i]), v(normals[i]).normalize());
+                total += 1;
+                lit += (cpu.max_element() > 0.0) as usize;
+                let e = check::rel_error(cpu, got[i]);
+                let what = format!(
+                    "{} nearest={nearest} receiver {i}: gpu {:?} cpu {cpu:?}",
+                    light.path, got[i]
+                );
+                if e > worst.0 {
+                    worst = (e, what.clone());
+                }
+                if e > check::TOLERANCE {
+                    failures.push((e, what));
+                }
+            }
+        }
+    }
+    println!(
+        "textured rect irradiance on {}: {total} receivers ({lit} lit), {recomputed} recomputed \
+         on the host, worst {:.3e} ({})",
+        gpu.device_name(),
+        worst.0,
+        worst.1
+    );
+    assert!(lit * 2 > total, "only {lit} of {total} receivers lit");
+    assert!(
+        recomputed * 4 < total,
+        "{recomputed} of {total} receivers recomputed on the host"
+    );
+    failures.sort_by(|a, b| b.0.total_cmp(&a.0));
+    assert!(
+        failures.is_empty(),
+        "{} of {total} beyond {}: {:#?}",
+        failures.len(),
+        check::TOLERANCE,
         &failures[..failures.len().min(10)]
     );
 }

@@ -20,27 +20,33 @@
 //   belongs to neither side's run.
 // f32: every loop checks its own condition after it ends and sets irr_cut if it stopped short
 //   (lavapipe's loop budget, see shared/record.wgsl); the CPU has no such limit.
+// f32: a textured rect's vertical break lines (texel-centre lines, bilinear; texel edges,
+//   nearest) are streamed too (texel_break_after: they are evenly spaced, so the next one after
+//   X is a closed form); the CPU lists them (rect_texture::ChartTexture::xs) with the rest.
 // GPU-only inner_node, inner_rule, max3, inner_adaptive: the kernel's inner rule (above).
 // GPU-only line_piece: the body of the CPU's loop over pieces, a function here because the
 //   merge loop above calls it once per piece.
+// GPU-only TexelAxis, texel_axis, texel_break_after, rect_texture_factor: the streamed texel lines (above) and the
+//   texture factor of the integrand (the CPU: rect_texture::ChartTexture::value).
 
 // #import shared/record.wgsl
 // #import shared/shaping.wgsl
 // #import shared/roots.wgsl
 // #import irradiance/pieces.wgsl
 // #import irradiance/kinks.wgsl
+// #import shared/texture.wgsl
 
 const MAX_BPS: u32 = 14u;
 
 // Node k of the inner Gauss–Legendre rule on [s0, s0 + h] of one span's parameter.
-fn inner_node(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap, s0: f32, h: f32, k: u32) -> vec3<f32> {
+fn inner_node(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, y: f32, sp: PieceMap, s0: f32, h: f32, k: u32) -> vec3<f32> {
     let xd = map_eval(sp, s0 + h * IRR_GL_INNER_X[k], false);
     let w = a + e1 * xd.x;
     let nw = dot(n, w);
     if nw > 0.0 && xd.y != 0.0 {
         let l2 = dot(w, w);
         let e = -w / sqrt(l2);
-        return shaping(light, e) * (IRR_GL_INNER_W[k] * h * nw / (l2 * l2) * xd.y);
+        return shaping(light, e) * rect_texture_factor(light, xd.x, y) * (IRR_GL_INNER_W[k] * h * nw / (l2 * l2) * xd.y);
     }
     return vec3<f32>(0.0);
 }
@@ -48,13 +54,13 @@ fn inner_node(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: Piec
 // The inner rule on [s0, s1], its IRR_GL_INNER = 10 nodes written out rather than looped:
 // llvmpipe stops a shader invocation's loops after 65535 iterations in total (see
 // GpuContext::lights_per_dispatch), and this is the innermost, most repeated loop.
-fn inner_rule(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap, s0: f32, s1: f32) -> vec3<f32> {
+fn inner_rule(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, y: f32, sp: PieceMap, s0: f32, s1: f32) -> vec3<f32> {
     let h = s1 - s0;
-    return inner_node(light, n, a, e1, sp, s0, h, 0u) + inner_node(light, n, a, e1, sp, s0, h, 1u)
-        + inner_node(light, n, a, e1, sp, s0, h, 2u) + inner_node(light, n, a, e1, sp, s0, h, 3u)
-        + inner_node(light, n, a, e1, sp, s0, h, 4u) + inner_node(light, n, a, e1, sp, s0, h, 5u)
-        + inner_node(light, n, a, e1, sp, s0, h, 6u) + inner_node(light, n, a, e1, sp, s0, h, 7u)
-        + inner_node(light, n, a, e1, sp, s0, h, 8u) + inner_node(light, n, a, e1, sp, s0, h, 9u);
+    return inner_node(light, n, a, e1, y, sp, s0, h, 0u) + inner_node(light, n, a, e1, y, sp, s0, h, 1u)
+        + inner_node(light, n, a, e1, y, sp, s0, h, 2u) + inner_node(light, n, a, e1, y, sp, s0, h, 3u)
+        + inner_node(light, n, a, e1, y, sp, s0, h, 4u) + inner_node(light, n, a, e1, y, sp, s0, h, 5u)
+        + inner_node(light, n, a, e1, y, sp, s0, h, 6u) + inner_node(light, n, a, e1, y, sp, s0, h, 7u)
+        + inner_node(light, n, a, e1, y, sp, s0, h, 8u) + inner_node(light, n, a, e1, y, sp, s0, h, 9u);
 }
 
 fn max3(v: vec3<f32>) -> f32 {
@@ -70,7 +76,7 @@ fn max3(v: vec3<f32>) -> f32 {
 // pipeline's compile. The halves are compared and summed in the same order as before (and as
 // testkit::kernel_rule replays); the loop runs once per rule, 1 + 2 per halving, well inside
 // llvmpipe's loop budget (see GpuContext::lights_per_dispatch).
-fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: PieceMap) -> vec3<f32> {
+fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, y: f32, sp: PieceMap) -> vec3<f32> {
     var lo: array<f32, IRR_INNER_DEPTH + 1u>;
     var hi: array<f32, IRR_INNER_DEPTH + 1u>;
     var q: array<vec3<f32>, IRR_INNER_DEPTH + 1u>;
@@ -88,7 +94,7 @@ fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: 
     var done = false;
     loop {
         let mid = 0.5 * (p0 + p1);
-        let r = inner_rule(light, n, a, e1, sp, select(p0, mid, step == 2u), select(p1, mid, step == 1u));
+        let r = inner_rule(light, n, a, e1, y, sp, select(p0, mid, step == 2u), select(p1, mid, step == 1u));
         if step == 0u {
             parent = r;
             step = 1u;
@@ -132,8 +138,9 @@ fn inner_adaptive(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, sp: 
     return sum;
 }
 
-// ∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX along w = a + X e1, X ∈ [x0, x1].
-fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f32, x1: f32) -> vec3<f32> {
+// ∫ S(−ŵ)·max(0, n·w)/|w|⁴ dX along w = a + X e1, X ∈ [x0, x1], the line Y = y of the chart
+// (y is read only for a textured rect's texture factor).
+fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, y: f32, x0: f32, x1: f32) -> vec3<f32> {
     let na = dot(n, a);
     let ne = dot(n, e1);
     var lo = x0;
@@ -276,7 +283,11 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
     let cr = length(cross(a, e1));
     let width = cr / e12;
     let m = cr * cr / e12;
-    let unshaped = !has_flag(light, FLAG_SHAPING);
+    // (The closed form has no texture factor.)
+    let unshaped = !has_flag(light, FLAG_SHAPING) && !has_flag(light, FLAG_RECT_TEXTURE);
+    // A textured rect's vertical break lines, streamed (see the header); none without one.
+    let tex_cols = texel_axis(light, true);
+    var tex_next = texel_break_after(tex_cols, lo);
     // The streamed IES crossings (see the header); none without a profile.
     var cones: KinkRun;
     cones.next = 1e30;
@@ -307,8 +318,13 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
             gr1 = 0u;
             src_kind = 2u;
         }
+        if tex_next < t1 {
+            t1 = tex_next;
+            gr1 = 0u;
+            src_kind = 3u;
+        }
         if t1 > t0 {
-            sum += line_piece(light, n, a, e1, t0, t1, gr0 != 0u, gr1 != 0u, x_star, width, m, perp, unshaped);
+            sum += line_piece(light, n, a, e1, y, t0, t1, gr0 != 0u, gr1 != 0u, x_star, width, m, perp, unshaped);
             t0 = t1;
         }
         gr0 = gr1;
@@ -316,6 +332,8 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
             cones = run_next(cones, kb, al, el, true, true);
         } else if src_kind == 2u {
             planes = run_next(planes, kb, al, el, false, true);
+        } else if src_kind == 3u {
+            tex_next = texel_break_after(tex_cols, t1);
         } else {
             fi += 1u;
             if fi >= count {
@@ -332,7 +350,7 @@ fn line_integral(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, x0: f
 }
 
 // One smooth piece [t0, t1] of a line (g0, g1: whether its ends are graded), see line_integral.
-fn line_piece(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, t0: f32, t1: f32, g0: bool, g1: bool, x_star: f32, width: f32, m: f32, perp: vec3<f32>, unshaped: bool) -> vec3<f32> {
+fn line_piece(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, y: f32, t0: f32, t1: f32, g0: bool, g1: bool, x_star: f32, width: f32, m: f32, perp: vec3<f32>, unshaped: bool) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let pm = piece_map(t0, t1, x_star, width, false, false);
     if unshaped && pm.tan_map && m > 0.0 {
@@ -367,7 +385,7 @@ fn line_piece(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, t0: f32,
                 {
                     var j = 0u;
                     for (; j < spans; j++) {
-                        sum += inner_adaptive(light, n, a, e1, span(pp, j, spans));
+                        sum += inner_adaptive(light, n, a, e1, y, span(pp, j, spans));
                     }
                     if j < spans {
                         // Cut short by the device's loop budget (see irr_cut).
@@ -382,4 +400,61 @@ fn line_piece(light: Record, n: vec3<f32>, a: vec3<f32>, e1: vec3<f32>, t0: f32,
         }
     }
     return sum;
+}
+
+// The break lines of one axis of a textured rect's texture in chart coordinates (X = 1 − 2s,
+// Y = 1 − 2t, src/cpu/irradiance/rect_texture.rs): `n` texels, `c` 1 for texel-centre lines
+// (bilinear: −1 + (2j + 1)/n, j = 0 … n − 1; none for one texel, whose reconstruction is
+// constant) or 0 for texel edges (nearest: −1 + 2j/n, j = 1 … n − 1), the ends of
+// prepare::texture::axis_pieces. n = 0: no texture, no lines.
+struct TexelAxis {
+    n: f32,
+    c: f32,
+}
+
+// The horizontal (columns = true: the vertical) break lines of `light`'s texture when it is a
+// textured rect integrated here; none otherwise (and in a pipeline built without TEXTURE).
+fn texel_axis(light: Record, columns: bool) -> TexelAxis {
+    var axis = TexelAxis(0.0, 0.0);
+    // #if TEXTURE
+    if has_flag(light, FLAG_RECT_TEXTURE) {
+        let t = tex_info(light.tex.x);
+        let nearest = light.tex.y == FILTER_NEAREST;
+        let n = select(t.height, t.width, columns);
+        if nearest || n >= 2u {
+            axis = TexelAxis(f32(n), select(1.0, 0.0, nearest));
+        }
+    }
+    // #endif
+    return axis;
+}
+
+// The first break line of `axis` strictly after chart coordinate `t` (1e30 when none): the
+// lines are evenly spaced, so its index is a closed form (corrected once for rounding).
+fn texel_break_after(axis: TexelAxis, t: f32) -> f32 {
+    if axis.n == 0.0 {
+        return 1e30;
+    }
+    var j = max(floor(((t + 1.0) * axis.n - axis.c) * 0.5) + 1.0, 1.0 - axis.c);
+    var x = -1.0 + (2.0 * j + axis.c) / axis.n;
+    if x <= t {
+        j += 1.0;
+        x = -1.0 + (2.0 * j + axis.c) / axis.n;
+    }
+    if j > axis.n - 1.0 {
+        return 1e30;
+    }
+    return x;
+}
+
+// The texture factor of the integrand at chart point (X, Y) of a textured rect: the filtered
+// texture at s = (1 − X)/2, t = (1 − Y)/2 (rect_texel's local (x, y) over a 2 × 2 square); 1
+// for every other light.
+fn rect_texture_factor(light: Record, x: f32, y: f32) -> vec3<f32> {
+    // #if TEXTURE
+    if has_flag(light, FLAG_RECT_TEXTURE) {
+        return rect_texel(light.tex.x, x, y, 2.0, 2.0, light.tex.y);
+    }
+    // #endif
+    return vec3<f32>(1.0);
 }

@@ -6,6 +6,14 @@
 //   times, depth first, instead of the reference's globally adaptive Gauss–Kronrod to 1e-9.
 // f32: every loop checks its own condition after it ends and sets irr_cut if it stopped short
 //   (lavapipe's loop budget, see shared/record.wgsl); the CPU has no such limit.
+// f32: a textured rect's horizontal break lines (texel-centre lines or texel edges) are
+//   streamed into the pieces between the critical Ys (irradiance/line.wgsl texel_break_after;
+//   the CPU lists them in critical_ys). The Ys where the vertical ones meet the receiver's
+//   horizon, the focus plane or the kink cones or come nearest to x (the CPU's critical_ys
+//   treats them as straight edges) are not split at: there the outer integrand stays
+//   continuous with its first derivative (the integrand vanishes on the horizon, and the
+//   texture is continuous or its jump is a line the inner rule splits at), and the adaptive
+//   outer rule resolves it; tests/rect_conformance.rs holds the result to the reference.
 // GPU-only outer_gk, outer_adaptive: the kernel's outer rule (above).
 
 // #import irradiance/chart.wgsl
@@ -47,7 +55,7 @@ fn outer_gk(light: Record, c: Chart, n: vec3<f32>, sp: PieceMap, s0: f32, s1: f3
             }
             let xi = x_interval(c, yd.x);
             if xi.z > 0.0 {
-                let v = line_integral(light, n, c.w0 + c.e2 * yd.x, c.e1, xi.x, xi.y) * (h * yd.y * c.jac);
+                let v = line_integral(light, n, c.w0 + c.e2 * yd.x, c.e1, yd.x, xi.x, xi.y) * (h * yd.y * c.jac);
                 k += IRR_GK_WK[i] * v;
                 g += IRR_GK_WG[i] * v;
             }
@@ -104,22 +112,38 @@ fn chart_integral(light: Record, c: Chart, n: vec3<f32>) -> vec3<f32> {
     }
     var ys: array<f32, MAX_YS>;
     let count = critical_ys(light, c, n, &ys);
+    // A textured rect's horizontal break lines, streamed into the pieces (see the header).
+    let rows = texel_axis(light, false);
     var total = vec3<f32>(0.0);
     {
         var i = 0u;
         for (; i + 1u < count; i++) {
-            let pole = outer_pole(c, ys[i], ys[i + 1u]);
-            let pm = piece_map(ys[i], ys[i + 1u], pole.x, pole.y, false, false);
-            let spans = span_count(pm);
-            {
-                var j = 0u;
-                for (; j < spans; j++) {
-                    total += outer_adaptive(light, c, n, span(pm, j, spans));
+            var y0 = ys[i];
+            var more = true;
+            while more {
+                var y1 = texel_break_after(rows, y0);
+                if !(y1 < ys[i + 1u]) {
+                    y1 = ys[i + 1u];
+                    more = false;
                 }
-                if j < spans {
-                    // Cut short by the device's loop budget (see irr_cut).
-                    irr_cut = true;
+                let pole = outer_pole(c, y0, y1);
+                let pm = piece_map(y0, y1, pole.x, pole.y, false, false);
+                let spans = span_count(pm);
+                {
+                    var j = 0u;
+                    for (; j < spans; j++) {
+                        total += outer_adaptive(light, c, n, span(pm, j, spans));
+                    }
+                    if j < spans {
+                        // Cut short by the device's loop budget (see irr_cut).
+                        irr_cut = true;
+                    }
                 }
+                y0 = y1;
+            }
+            if more {
+                // Cut short by the device's loop budget (see irr_cut).
+                irr_cut = true;
             }
         }
         if i + 1u < count {
@@ -139,5 +163,5 @@ fn line_irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     if !(weight > 0.0) || !(hl > 0.0) || has_flag(light, FLAG_DARK) {
         return vec3<f32>(0.0);
     }
-    return light.base.xyz * line_integral(light, n, world_origin(light) - x, light.world_x.xyz, -hl, hl) * weight;
+    return light.base.xyz * line_integral(light, n, world_origin(light) - x, light.world_x.xyz, 0.0, -hl, hl) * weight;
 }

@@ -33,8 +33,12 @@ pub(crate) struct GpuLights {
     features: Features,
     /// Whether some IES-shaped light's irradiance is the device's (not FLAG_HOST_IRRADIANCE).
     irradiance_ies: bool,
-    /// Whether some textured dome's irradiance is the device's (irradiance/latlong_rows.wgsl).
+    /// Whether some textured dome's or rect's irradiance is the device's
+    /// (irradiance/latlong_rows.wgsl; irradiance/line.wgsl's texture factor).
     irradiance_texture: bool,
+    /// Whether some textured rect's irradiance is the device's (its quadrature splits at every
+    /// texel line: a long one, [`GpuLights::long_quadrature`]).
+    irradiance_rect_texture: bool,
     /// The row tables reserved in the texture atlas and not yet written
     /// ([`GpuLights::write_row_tables`]).
     pending_rows: std::sync::Mutex<Vec<super::texture_atlas::RowTables>>,
@@ -92,18 +96,19 @@ impl GpuLights {
     }
 
     /// Whether some light's irradiance quadrature may run long on the device (an IES-shaped
-    /// light it integrates, whose kinks multiply a line's pieces: GpuContext::lane_stride).
+    /// light it integrates, whose kinks multiply a line's pieces, or a textured rect, whose
+    /// texel lines do: GpuContext::lane_stride).
     pub(super) fn long_quadrature(&self) -> bool {
-        self.irradiance_ies
+        self.irradiance_ies || self.irradiance_rect_texture
     }
 
     /// The pipeline variant `kernel` needs for these lights: the optional parts some light
     /// needs (`GpuContext::pipeline` drops those the kernel's source lacks). The irradiance
-    /// kernel looks up no texture (a textured rect's irradiance is the host's, see
-    /// prepare::Prepared::irradiance_on_host); it needs
-    /// the IES lookup only for IES-shaped lights it integrates, and its TEXTURE part (the row
-    /// integral of a textured latlong dome, irradiance/latlong_rows.wgsl) only for domes it
-    /// integrates.
+    /// kernel needs the IES lookup only for IES-shaped lights it integrates, and its TEXTURE
+    /// part (the row integral of a textured latlong dome, irradiance/latlong_rows.wgsl; a
+    /// textured rect's texture factor, irradiance/line.wgsl) only for the textured domes and
+    /// rects it integrates (not those whose irradiance is the host's,
+    /// prepare::Prepared::irradiance_on_host).
     pub(super) fn variant(&self, kernel: Kernel) -> Features {
         let mut f = self.features;
         if kernel == Kernel::Irradiance {
@@ -287,7 +292,12 @@ impl GpuContext {
                     && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
             }),
             irradiance_texture: records.iter().any(|r| {
-                r.flags & super::record::FLAG_DOME_TEXTURE != 0
+                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE)
+                    != 0
+                    && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
+            }),
+            irradiance_rect_texture: records.iter().any(|r| {
+                r.flags & super::record::FLAG_RECT_TEXTURE != 0
                     && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
             }),
             pending_rows: std::sync::Mutex::new(tex_atlas.rows.clone()),

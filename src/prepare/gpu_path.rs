@@ -29,9 +29,12 @@ pub enum GpuPath {
     ///   (DESIGN.md §6 "what 'exact' means", src/cpu/irradiance/dome.rs) splits at texel-centre
     ///   lines and the horizon; a dome's irradiance depends on the normal only, so the reference
     ///   evaluates it once per distinct normal (one for a whole falloff map).
-    /// - Textured rects: the exact integral of the filtered texture over the surface, split at
-    ///   texel-centre lines (bilinear) or texel edges (nearest) and the receiver's horizon
-    ///   (src/cpu/irradiance/rect_texture.rs).
+    /// - Textured rects of more than [`RECT_TEXELS_ON_DEVICE`] texels: the exact integral of
+    ///   the filtered texture over the surface splits at texel-centre lines (bilinear) or texel
+    ///   edges (nearest) and the receiver's horizon (src/cpu/irradiance/rect_texture.rs), so
+    ///   its cost grows with the texels; the kernel integrates smaller ones
+    ///   (shaders/irradiance/line.wgsl and outer.wgsl), the CPU reference larger ones (from
+    ///   `--tolerance` 1e-4 on by moments of the texture, rect_fast.rs).
     /// - Masked domes whose portals may hide one another in more ways than the kernel sums
     ///   (`portal::overlaps`; §8 P2 mask mode), and masked textured domes the row integral does not take (the formats and
     ///   frames above): emission is the dome's own and radiance tests the portal crossings on
@@ -109,7 +112,13 @@ pub(super) fn decide(
     } else {
         match kind {
             KindData::Dome { texture: Some(t) } => latlong_rows::gpu_path(t),
-            KindData::Rect { texture: Some(_) } => GpuPath::HostIrradiance("it is a textured rect"),
+            KindData::Rect { texture: Some(t) }
+                if t.image.width * t.image.height > RECT_TEXELS_ON_DEVICE =>
+            {
+                GpuPath::HostIrradiance(
+                    "it is a textured rect with more texels than the device integrates",
+                )
+            }
             _ => GpuPath::Device,
         }
     }
@@ -142,6 +151,18 @@ pub(super) fn masked(
         }
     }
 }
+
+/// The most texels of a textured rect whose irradiance the kernel integrates (a larger one's is
+/// the CPU reference's, [`GpuPath::HostIrradiance`]). The kernel splits its quadrature at every
+/// texel line, as the reference's exact path does (src/cpu/irradiance/rect_texture.rs), at
+/// ~10³ evaluations of the integrand per texel per receiver with its f32 rule (the inner
+/// rule's 30 per piece of a line, ≥ 15 lines per texel row): ~4·10⁶ per receiver at 64 × 64,
+/// where the CPU's moment path (rect_fast.rs, the default tolerance) costs per receiver about
+/// what it costs at any size. Past 64 × 64 the device would spend more per receiver than the
+/// CPU path does on the host, so such textures stay there. On lavapipe a receiver of a
+/// texture past about 4 × 4 runs out of its loop budget and is recomputed on the host
+/// (`PreparedScene::host_recomputed_rows`).
+pub const RECT_TEXELS_ON_DEVICE: usize = 64 * 64;
 
 /// The most distinct front directions of a mesh light whose emission the kernel tests
 /// ([`GpuPath::HostIntensity`]); a mesh with more takes its emission from the host
