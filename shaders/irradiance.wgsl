@@ -14,7 +14,7 @@
 //   and the host adds the CPU reference's value (prepare::Prepared::irradiance_on_host gives the
 //   reasons). A textured latlong dome is integrated by rows of its texture
 //   (irradiance/latlong_rows.wgsl), the optional part TEXTURE, compiled in only when such a
-//   dome is integrated here; IES likewise only when an IES-shaped light is
+//   dome or a textured rect is integrated here; IES likewise only when an IES-shaped light is
 //   (gpu::shaders::Features). An IES-shaped light's lines split at its profile's grid surfaces
 //   (irradiance/line.wgsl) and its outer integral at their critical Ys (irradiance/critical.wgsl).
 //   A textured rect's integrand carries its filtered texture, split at the texture's break

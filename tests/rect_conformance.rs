@@ -1,8 +1,9 @@
 //! CPU (f64) vs GPU (f32) conformance of textured RectLights (DESIGN.md §6 "RectLight texture",
 //! §5): generated textures of several sizes, both filters, identity, rotated, non-uniformly
 //! scaled and sheared transforms, shaped and unshaped; emission, radiance and intensity within a
-//! relative 1e-4 per channel (irradiance of a textured rect is the CPU reference's on both paths,
-//! `query::irradiance_on_host`).
+//! relative 1e-4 per channel. Irradiance: textured rects of up to `RECT_TEXELS_ON_DEVICE` texels
+//! are integrated on the device (their receivers against the reference, the last test); larger
+//! ones are the CPU reference's on both paths (`prepare::GpuPath::HostIrradiance`).
 //!
 //! Excluded radiance samples (documented divergences 1 and 7 of shaders/shared/texture.wgsl): rays
 //! meeting the light's plane within a relative 1e-3 of the rect's edge (f32 may hit or miss),
@@ -12,9 +13,12 @@
 use crate::common;
 
 use glam::{DMat3, DMat4, DQuat, DVec3};
+use luxeval::testkit::ies::with_random_ies;
 use luxeval::testkit::rect::{near_rect_discontinuity, prepare_rects_with_filter};
 use luxeval::testkit::{Rng, check, irradiance_samples};
-use luxeval::{Accumulate, Evaluator, Light, LightType, Reference, Shaping, TemperatureMode, Texture};
+use luxeval::{
+    Accumulate, Evaluator, Light, LightType, Reference, Shaping, TemperatureMode, Texture,
+};
 
 const TOL: f64 = 1e-4;
 
@@ -210,7 +214,7 @@ const IRRADIANCE_SIZES: [(u32, u32); 4] = [(1, 1), (2, 3), (3, 2), (4, 4)];
 /// quadrature split at the texture's break lines (shaders/irradiance/line.wgsl, outer.wgsl):
 /// per light, every receiver within `check::TOLERANCE` of the reference (the CPU's exact split
 /// integral to 1e-9, src/cpu/irradiance/rect_texture.rs), both filters, every transform kind,
-/// shaped and unshaped; receivers from 1.05 to 6 sizes away (`testkit::irradiance_samples`)
+/// shaped and unshaped, three IES-shaped; receivers from 1.05 to 6 sizes away (`testkit::irradiance_samples`)
 /// and close ones (0.02 to 0.5 of the smaller half-extent in front of the rect).
 #[test]
 fn gpu_irradiance_of_small_textured_rects_matches_the_reference() {
@@ -237,6 +241,18 @@ fn gpu_irradiance_of_small_textured_rects_matches_the_reference() {
             lights.push(l);
         }
     }
+    // IES-shaped (continuous profiles of types C and A: their grid lines split the lines too,
+    // streamed beside the texture's).
+    let file = png(3, 2, &mut rng);
+    for (j, shape) in [1usize, 4, 9].into_iter().enumerate() {
+        let m = transforms()[j + 1];
+        let l = Light::rect(1.4, 0.9)
+            .with_path(format!("/Rect_ies_{shape}"))
+            .with_intensity(2.0)
+            .with_transform(m)
+            .with_texture(Texture::new(file.clone()));
+        lights.push(with_random_ies(l, &mut rng, shape, true));
+    }
     let mut total = 0usize;
     let mut recomputed = 0usize;
     let mut lit = 0usize;
@@ -261,9 +277,7 @@ fn gpu_irradiance_of_small_textured_rects_matches_the_reference() {
                 points.push(f32s(x));
                 normals.push(f32s((toward + unit(&mut rng) * 0.5).normalize()));
             }
-            let scene = gpu
-                .prepare(std::slice::from_ref(light))
-                .expect("GPU scene");
+            let scene = gpu.prepare(std::slice::from_ref(light)).expect("GPU scene");
             let got = scene
                 .irradiance(&points, &normals, Accumulate::Sum)
                 .expect("GPU irradiance");

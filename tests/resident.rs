@@ -530,6 +530,57 @@ fn png_texture(name: &str, img: &image::RgbImage) -> Texture {
     Texture::new(Asset::from_bytes(name, bytes.into_inner()))
 }
 
+/// A textured rect of up to `RECT_TEXELS_ON_DEVICE` (64 × 64) texels has its irradiance on the
+/// device (the texture factor of irradiance/line.wgsl), so the GPU-resident call accepts it and
+/// gives the host path's rows; one of more texels is the host's, and the call refuses it by
+/// name.
+#[test]
+fn small_textured_rect_irradiance_is_resident() {
+    let Some(r) = renderer() else { return };
+    let eval = Evaluator::from_wgpu(r.device.clone(), r.queue.clone()).unwrap();
+    let mut rng = Rng::new(33);
+    let png = |w: u32, h: u32, rng: &mut Rng| {
+        let img = image::RgbImage::from_fn(w, h, |_, _| {
+            image::Rgb([0, 1, 2].map(|_| 40 + rng.below(200) as u8))
+        });
+        png_texture(&format!("rect-{w}x{h}.png"), &img)
+    };
+    let mut lights = synthetic_lights(2);
+    lights.push(
+        Light::rect(2.0, 1.0)
+            .with_path("/Small")
+            .with_intensity(3.0)
+            .with_texture(png(3, 2, &mut rng)),
+    );
+    let scene = eval.prepare(&lights).unwrap();
+    let n = 129;
+    let pts = points(&mut rng, n);
+    let normals = unit_rows(&mut rng, n);
+    assert_resident_irradiance_is_the_host_paths(&r, &scene, &pts, &normals);
+    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
+    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
+    lights[2] = Light::rect(2.0, 1.0)
+        .with_path("/Large")
+        .with_texture(png(65, 64, &mut rng));
+    let scene = eval.prepare(&lights).unwrap();
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    match scene.encode_irradiance(
+        &mut enc,
+        &pts_buf,
+        &nrm_buf,
+        &out,
+        n as u32,
+        Accumulate::Sum,
+    ) {
+        Err(LuxError::NotOnDevice { light, reason, .. }) => {
+            assert_eq!(light, "/Large");
+            assert!(reason.contains("texels"), "{reason}");
+        }
+        other => panic!("expected NotOnDevice, got {other:?}"),
+    }
+}
+
 /// A textured latlong dome's irradiance is the kernel's (irradiance/latlong_rows.wgsl), so the
 /// GPU-resident call accepts it and gives the host path's rows; a mirroredBall dome's is the
 /// host's, and the call refuses it by name.

@@ -10,10 +10,10 @@
 //   streamed into the pieces between the critical Ys (irradiance/line.wgsl texel_break_after;
 //   the CPU lists them in critical_ys). The Ys where the vertical ones meet the receiver's
 //   horizon, the focus plane or the kink cones or come nearest to x (the CPU's critical_ys
-//   treats them as straight edges) are not split at: there the outer integrand stays
-//   continuous with its first derivative (the integrand vanishes on the horizon, and the
-//   texture is continuous or its jump is a line the inner rule splits at), and the adaptive
-//   outer rule resolves it; tests/rect_conformance.rs holds the result to the reference.
+//   treats them as straight edges) are not split at: the outer integrand stays continuous
+//   there (each line is split at the texture's lines, and the horizon's factor vanishes on
+//   it), only a derivative changes abruptly, and the adaptive outer rule resolves that;
+//   tests/rect_conformance.rs holds the result to the reference's.
 // GPU-only outer_gk, outer_adaptive: the kernel's outer rule (above).
 
 // #import irradiance/chart.wgsl

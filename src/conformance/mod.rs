@@ -96,7 +96,7 @@ pub struct CheckReport {
     pub rows: Vec<QueryReport>,
     /// The lights some or all of whose queries the CPU reference answers on every device
     /// (`GpuPath::Host`, `GpuPath::RadianceOnDevice`, `GpuPath::HostIntensity`: mesh lights;
-    /// `GpuPath::HostIrradiance`: textured rects, bent IES profiles, some textured and masked
+    /// `GpuPath::HostIrradiance`: large textured rects, bent IES profiles, some textured and masked
     /// domes) or on this one (a latlong dome whose row tables it cannot hold), with what is
     /// not compared and why.
     pub host_only: Vec<(String, String)>,
@@ -302,7 +302,8 @@ pub fn check_with(
             )
         }));
         // Irradiance: the CPU values (quadratures) are computed in parallel. Not for the lights
-        // whose irradiance the GPU path takes from the CPU reference (textured rects, textured
+        // whose irradiance the GPU path takes from the CPU reference (textured rects of more
+        // than prepare::RECT_TEXELS_ON_DEVICE texels, textured
         // domes but the latlong ones the kernel integrates, bent IES profiles:
         // Prepared::irradiance_on_host), so there is nothing to compare.
         let ni = if irradiance_on_host {

@@ -292,8 +292,7 @@ impl GpuContext {
                     && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
             }),
             irradiance_texture: records.iter().any(|r| {
-                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE)
-                    != 0
+                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE) != 0
                     && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
             }),
             irradiance_rect_texture: records.iter().any(|r| {

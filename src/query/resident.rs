@@ -174,7 +174,8 @@ impl PreparedScene {
     /// pairs, as [`PreparedScene::encode_emission`] does.
     ///
     /// Refused with [`LuxError::NotOnDevice`] naming the first such light when the scene holds
-    /// a light whose irradiance the host path computes on the CPU (textured rects, textured
+    /// a light whose irradiance the host path computes on the CPU (textured rects of more than
+    /// 64 × 64 texels, `prepare::gpu_path::RECT_TEXELS_ON_DEVICE`; textured
     /// domes, masked or not, but latlong ones under a conformal frame, masked domes whose
     /// portals overlap in more ways than the kernel sums, IES profiles of type B under
     /// angleScale:
