@@ -169,8 +169,12 @@ fn irradiance_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Prepared::irradiance_is_normal_only (a masked dome is the host's,
         // FLAG_HOST_IRRADIANCE, 0 in either pass).
         let normal_only = has_flag(lights[l], FLAG_NORMAL_ONLY);
-        let wanted = params.light_filter == LIGHTS_ALL
-            || (params.light_filter == LIGHTS_NORMAL_ONLY) == normal_only;
+        let which = params.light_filter & 3u;
+        // LIGHTS_SKIP_TEXTURED_RECTS: a textured rect without a profile is the host's in this
+        // call (query::scene host_takes: the CPU's moment path).
+        let skipped = (params.light_filter & LIGHTS_SKIP_TEXTURED_RECTS) != 0u
+            && has_flag(lights[l], FLAG_RECT_TEXTURE) && !has_flag(lights[l], FLAG_IES);
+        let wanted = (which == LIGHTS_ALL || (which == LIGHTS_NORMAL_ONLY) == normal_only) && !skipped;
         if valid && wanted {
             irr_cut = false;
             v = irradiance(lights[l], x, n);

@@ -100,6 +100,7 @@ pub const WGSL_CONSTANTS: &[(&str, u32)] = &[
     ("LIGHTS_ALL", LIGHTS_ALL),
     ("LIGHTS_NORMAL_ONLY", LIGHTS_NORMAL_ONLY),
     ("LIGHTS_POSITIONAL", LIGHTS_POSITIONAL),
+    ("LIGHTS_SKIP_TEXTURED_RECTS", LIGHTS_SKIP_TEXTURED_RECTS),
     ("SELECT_POWER", SELECT_POWER),
     ("SELECT_BOUND", SELECT_BOUND),
     ("SELECT_HAS_NORMALS", SELECT_HAS_NORMALS),
@@ -209,6 +210,11 @@ pub const LIGHTS_ALL: u32 = 0;
 pub const LIGHTS_NORMAL_ONLY: u32 = 1;
 /// `Params::light_filter`: every light but those of [`LIGHTS_NORMAL_ONLY`].
 pub const LIGHTS_POSITIONAL: u32 = 2;
+/// `Params::light_filter`, a bit beside one of the values above: skip the textured rects
+/// without an IES profile (FLAG_RECT_TEXTURE without FLAG_IES: those `cpu::irradiance::rect_fast`
+/// takes), whose irradiance a host-path call at a tolerance of 1e-4 or looser takes from the
+/// CPU's moment path instead (`query::scene` `host_takes`).
+pub const LIGHTS_SKIP_TEXTURED_RECTS: u32 = 4;
 
 /// `Params::select`: choose lights by power.
 pub const SELECT_POWER: u32 = 0;

@@ -153,15 +153,19 @@ pub(super) fn masked(
 }
 
 /// The most texels of a textured rect whose irradiance the kernel integrates (a larger one's is
-/// the CPU reference's, [`GpuPath::HostIrradiance`]). The kernel splits its quadrature at every
-/// texel line, as the reference's exact path does (src/cpu/irradiance/rect_texture.rs), at
-/// ~10³ evaluations of the integrand per texel per receiver with its f32 rule (the inner
-/// rule's 30 per piece of a line, ≥ 15 lines per texel row): ~4·10⁶ per receiver at 64 × 64,
-/// where the CPU's moment path (rect_fast.rs, the default tolerance) costs per receiver about
-/// what it costs at any size. Past 64 × 64 the device would spend more per receiver than the
-/// CPU path does on the host, so such textures stay there. On lavapipe a receiver of a
-/// texture past about 4 × 4 runs out of its loop budget and is recomputed on the host
-/// (`PreparedScene::host_recomputed_rows`).
+/// the CPU reference's, [`GpuPath::HostIrradiance`]): 64 × 64. The kernel splits its quadrature
+/// at every texel line, as the reference's exact path does (src/cpu/irradiance/rect_texture.rs),
+/// so its cost grows with the texels (≥ 450 evaluations of the integrand per texel per receiver
+/// with its f32 rule: 15 lines per texel row, 30 evaluations per piece of a line; lavapipe takes
+/// 16 ms per receiver at 8 × 8 and runs out of its loop budget past about 4 × 4), while the
+/// CPU's moment path (rect_fast.rs, from the default tolerance 1e-4 on) costs about the same at
+/// any size (20–40 µs per receiver on 2 cores for 8 × 8 to 64 × 64 seen from a few sizes away;
+/// BENCHMARKS.md "Small textured rects' irradiance on the device"). So host-path calls at such
+/// tolerances take textured rects without an IES profile from the CPU (`query::scene`
+/// `host_takes`), and the device integrates them in GPU-resident calls (which have no host step,
+/// and would refuse them otherwise) and at tighter tolerances (where the CPU also splits at
+/// every texel line). Past 64 × 64 the split would cost a receiver ~2·10⁶ evaluations or more:
+/// such textures stay on the host until a kernel of the moment path exists.
 pub const RECT_TEXELS_ON_DEVICE: usize = 64 * 64;
 
 /// The most distinct front directions of a mesh light whose emission the kernel tests

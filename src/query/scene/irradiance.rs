@@ -8,10 +8,12 @@ use rayon::prelude::*;
 use super::super::{Accumulate, Backend, check_pairs};
 use super::{PreparedScene, add_rows};
 use crate::cpu;
-use crate::cpu::irradiance::Adaptive;
+use crate::cpu::irradiance::{Adaptive, Rule, rect_fast};
 use crate::error::Result;
 use crate::gpu::Kernel;
-use crate::gpu::record::{LIGHTS_ALL, LIGHTS_NORMAL_ONLY, LIGHTS_POSITIONAL};
+use crate::gpu::record::{
+    LIGHTS_ALL, LIGHTS_NORMAL_ONLY, LIGHTS_POSITIONAL, LIGHTS_SKIP_TEXTURED_RECTS,
+};
 use crate::prepare::Prepared;
 
 impl PreparedScene {
@@ -51,7 +53,16 @@ impl PreparedScene {
         check_pairs(points, "points", normals, "normals")?;
         let per_light = acc == Accumulate::PerLight;
         let lights = if per_light { self.lights.len() } else { 1 };
-        let mut out = match self.irradiance_plan(normals) {
+        // The kernel skips the textured rects this call takes on the host (host_takes).
+        let skip = match self
+            .lights
+            .iter()
+            .any(|p| host_takes(p, rule) && !p.irradiance_on_host())
+        {
+            true => LIGHTS_SKIP_TEXTURED_RECTS,
+            false => 0,
+        };
+        let mut out = match self.irradiance_plan(normals, rule) {
             // One kernel row per distinct normal, copied to the rows that share it (the same
             // input bits give the same output bits, so this is the undeduplicated answer):
             // every light the kernel integrates, where all depend on the normal only; else
@@ -71,7 +82,7 @@ impl PreparedScene {
                     &origin,
                     Some(&distinct),
                     per_light,
-                    filter,
+                    filter | skip,
                     || cpu::irradiance_batch(&self.lights, &origin, &distinct, per_light, rule),
                 )?;
                 let everywhere = match split {
@@ -80,7 +91,7 @@ impl PreparedScene {
                         points,
                         Some(normals),
                         per_light,
-                        LIGHTS_POSITIONAL,
+                        LIGHTS_POSITIONAL | skip,
                         || cpu::irradiance_batch(&self.lights, points, normals, per_light, rule),
                     )?),
                     false => None,
@@ -96,9 +107,14 @@ impl PreparedScene {
                     })
                     .collect()
             }
-            None => self.run(Kernel::Irradiance, points, Some(normals), per_light, || {
-                cpu::irradiance_batch(&self.lights, points, normals, per_light, rule)
-            })?,
+            None => self.run_filtered(
+                Kernel::Irradiance,
+                points,
+                Some(normals),
+                per_light,
+                LIGHTS_ALL | skip,
+                || cpu::irradiance_batch(&self.lights, points, normals, per_light, rule),
+            )?,
         };
         if matches!(self.backend, Backend::Gpu(_)) {
             self.redo_spent_rows(points, normals, per_light, rule, &mut out);
@@ -117,11 +133,15 @@ impl PreparedScene {
     /// (`LIGHTS_POSITIONAL`) while the normal-only lights go over the distinct normals in
     /// another (`LIGHTS_NORMAL_ONLY`). `None` on the CPU reference or when every normal
     /// differs. The host's lights are added afterwards at every row (`add_host_irradiance`).
-    fn irradiance_plan(&self, normals: &[[f32; 3]]) -> Option<(Vec<[f32; 3]>, Vec<usize>, bool)> {
+    fn irradiance_plan(
+        &self,
+        normals: &[[f32; 3]],
+        rule: &Adaptive,
+    ) -> Option<(Vec<[f32; 3]>, Vec<usize>, bool)> {
         if !matches!(self.backend, Backend::Gpu(_)) || normals.len() < 2 {
             return None;
         }
-        let on_device = |p: &&Prepared| !p.irradiance_on_host();
+        let on_device = |p: &&Prepared| !host_takes(p, rule);
         let positional = self
             .lights
             .iter()
@@ -185,7 +205,7 @@ impl PreparedScene {
                 let (x, nn) = (&points[i..i + 1], &normals[i..i + 1]);
                 let sum: DVec3 = lights
                     .iter()
-                    .filter(|l| !l.irradiance_on_host())
+                    .filter(|l| !host_takes(l, rule))
                     .map(|l| cpu::irradiance_batch(std::slice::from_ref(l), x, nn, true, rule)[0])
                     .sum();
                 (r, sum.as_vec3().to_array())
@@ -206,8 +226,8 @@ impl PreparedScene {
         self.spent_rows.load(std::sync::atomic::Ordering::Relaxed)
     }
 
-    /// The GPU irradiance kernel gives 0 for the lights [`Prepared::irradiance_on_host`] names (see the
-    /// header of shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here.
+    /// The GPU irradiance kernel gives 0 for the lights [`host_takes`] names (see the header
+    /// of shaders/irradiance.wgsl): their irradiance is the CPU reference's, added here.
     fn add_host_irradiance(
         &self,
         points: &[[f32; 3]],
@@ -217,7 +237,7 @@ impl PreparedScene {
         out: &mut [[f32; 3]],
     ) {
         for (k, light) in self.lights.iter().enumerate() {
-            if !light.irradiance_on_host() {
+            if !host_takes(light, rule) {
                 continue;
             }
             let values =
@@ -225,6 +245,20 @@ impl PreparedScene {
             add_rows(out, k, per_light, values);
         }
     }
+}
+
+/// Whether a host-path call under `rule` takes `p`'s irradiance from the CPU reference: the
+/// lights whose irradiance is the host's on every call ([`Prepared::irradiance_on_host`]), and
+/// the textured rects the kernel integrates (up to `prepare::RECT_TEXELS_ON_DEVICE` texels)
+/// where the CPU's moment path takes them (`rect_fast::applies`, at a tolerance of 1e-4 or
+/// looser): its cost per receiver does not grow with the texels, the kernel's split at every
+/// texel line does (BENCHMARKS.md "Small textured rects' irradiance on the device"). The
+/// GPU-resident call, which has no host step, and calls at tighter tolerances (where the CPU
+/// splits at every texel line too) integrate them on the device. The kernel's
+/// `LIGHTS_SKIP_TEXTURED_RECTS` test (FLAG_RECT_TEXTURE without FLAG_IES) is
+/// `rect_fast::applies`.
+fn host_takes(p: &Prepared, rule: &Adaptive) -> bool {
+    p.irradiance_on_host() || (rule.texture_tolerance().is_some() && rect_fast::applies(p))
 }
 
 #[cfg(test)]
@@ -251,7 +285,7 @@ mod tests {
         let plan = |lights: &[Light], normals: &[[f32; 3]]| {
             eval.prepare(lights)
                 .expect("the lights prepare")
-                .irradiance_plan(normals)
+                .irradiance_plan(normals, &crate::cpu::irradiance::Adaptive::REFERENCE)
                 .map(|(d, of_row, split)| (d.len(), of_row, split))
         };
         // Normal-only lights alone: one pass over the distinct normals.
@@ -277,7 +311,59 @@ mod tests {
         // The CPU reference never plans.
         let cpu = crate::query::Evaluator::cpu();
         let scene = cpu.prepare(&[sphere, textured_dome()]).unwrap();
-        assert!(scene.irradiance_plan(&repeated).is_none());
+        assert!(
+            scene
+                .irradiance_plan(&repeated, &crate::cpu::irradiance::Adaptive::REFERENCE)
+                .is_none()
+        );
+    }
+
+    /// A textured rect the kernel integrates (up to RECT_TEXELS_ON_DEVICE texels) is the CPU
+    /// moment path's in a host-path call at a loose tolerance (`host_takes`): its rows are the
+    /// CPU evaluator's at that tolerance, bit for bit, while the sphere beside it stays the
+    /// device's; at the reference tolerance the device integrates it (within 1e-4 of the
+    /// reference, and not the reference's rows rounded).
+    #[test]
+    fn textured_rects_take_the_cpu_moment_path_at_loose_tolerances() {
+        let Some(eval) = crate::query::test_gpu() else {
+            return;
+        };
+        let png = crate::Asset::png(4, 3, |x, y| [30 * x as u8 + 40, 90, 50 * y as u8 + 20]);
+        let lights = [
+            Light::rect(2.0, 1.0)
+                .with_intensity(3.0)
+                .with_texture(Texture::new(png)),
+            Light::sphere(0.3).with_intensity(2.0),
+        ];
+        let points: Vec<[f32; 3]> = (0..12)
+            .map(|i| {
+                let i = i as f32;
+                [0.3 * (i % 4.0) - 0.5, 0.1 * i - 0.4, -1.0 - 0.1 * i]
+            })
+            .collect();
+        let normals = vec![[0.1f32, -0.2, 1.0]; points.len()];
+        let n = points.len();
+        let gpu = eval.prepare(&lights).unwrap();
+        let cpu = crate::query::Evaluator::cpu().prepare(&lights).unwrap();
+        let acc = Accumulate::PerLight;
+        let loose_gpu = gpu
+            .irradiance_with_tolerance(&points, &normals, acc, 1e-4)
+            .unwrap();
+        let loose_cpu = cpu
+            .irradiance_with_tolerance(&points, &normals, acc, 1e-4)
+            .unwrap();
+        assert_eq!(loose_gpu[..n], loose_cpu[..n], "the rect's rows at 1e-4");
+        assert_ne!(loose_gpu[n..], loose_cpu[n..], "the sphere's rows at 1e-4");
+        let exact_gpu = gpu.irradiance(&points, &normals, acc).unwrap();
+        let exact_cpu = cpu.irradiance(&points, &normals, acc).unwrap();
+        assert_ne!(exact_gpu[..n], exact_cpu[..n], "the rect's rows at 1e-9");
+        for (g, c) in exact_gpu[..n].iter().zip(&exact_cpu[..n]) {
+            for k in 0..3 {
+                assert!((g[k] - c[k]).abs() <= 1e-4 * c[k].abs(), "{g:?} vs {c:?}");
+            }
+        }
+        assert!(exact_cpu[..n].iter().all(|c| c[0] > 0.0));
+        assert_eq!(gpu.host_recomputed_rows(), 0);
     }
 
     /// A textured latlong dome's row tables (four times its texture) are built and written by
