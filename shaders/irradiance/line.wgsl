@@ -26,8 +26,9 @@
 // GPU-only inner_node, inner_rule, max3, inner_adaptive: the kernel's inner rule (above).
 // GPU-only line_piece: the body of the CPU's loop over pieces, a function here because the
 //   merge loop above calls it once per piece.
-// GPU-only TexelAxis, texel_axis, texel_break_after, rect_texture_factor: the streamed texel lines (above) and the
-//   texture factor of the integrand (the CPU: rect_texture::ChartTexture::value).
+// GPU-only TexelAxis, texel_axis, texel_break_after, rect_texture_factor: the streamed texel
+//   lines (above) and the texture factor of the integrand (the CPU:
+//   rect_texture::ChartTexture::value).
 
 // #import shared/record.wgsl
 // #import shared/shaping.wgsl
