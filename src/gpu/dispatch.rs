@@ -10,7 +10,9 @@ use rayon::prelude::*;
 use crate::error::{GpuFailure, LuxError, Result};
 
 use super::launch::{entry, params_block, params_entry, record_passes};
-use super::record::Record;
+use super::record::{
+    FLAG_HOST_IRRADIANCE, FLAG_IES, FLAG_RECT_TEXTURE, LIGHTS_SKIP_TEXTURED_RECTS, Record,
+};
 use super::shaders::Features;
 use super::{GpuContext, Kernel};
 
@@ -31,14 +33,6 @@ pub(crate) struct GpuLights {
     count: usize,
     /// The optional kernel parts any of the lights needs (`Record::features`).
     features: Features,
-    /// Whether some IES-shaped light's irradiance is the device's (not FLAG_HOST_IRRADIANCE).
-    irradiance_ies: bool,
-    /// Whether some textured dome's or rect's irradiance is the device's
-    /// (irradiance/latlong_rows.wgsl; irradiance/line.wgsl's texture factor).
-    irradiance_texture: bool,
-    /// Whether some textured rect's irradiance is the device's (its quadrature splits at every
-    /// texel line: a long one, [`GpuLights::long_quadrature`]).
-    irradiance_rect_texture: bool,
     /// The row tables reserved in the texture atlas and not yet written
     /// ([`GpuLights::write_row_tables`]).
     pending_rows: std::sync::Mutex<Vec<super::texture_atlas::RowTables>>,
@@ -95,27 +89,41 @@ impl GpuLights {
             .len()
     }
 
-    /// Whether some light's irradiance quadrature may run long on the device (an IES-shaped
-    /// light it integrates, whose kinks multiply a line's pieces, or a textured rect, whose
-    /// texel lines do: GpuContext::lane_stride).
-    pub(super) fn long_quadrature(&self) -> bool {
-        self.irradiance_ies || self.irradiance_rect_texture
+    /// The records the irradiance kernel integrates in a call with `light_filter`: not those
+    /// whose irradiance is the host's (FLAG_HOST_IRRADIANCE), nor, with
+    /// [`LIGHTS_SKIP_TEXTURED_RECTS`], the textured rects without a profile (the same test as
+    /// shaders/irradiance.wgsl's).
+    fn integrated(&self, light_filter: u32) -> impl Iterator<Item = &Record> {
+        let skip = light_filter & LIGHTS_SKIP_TEXTURED_RECTS != 0;
+        self.records.iter().filter(move |r| {
+            r.flags & FLAG_HOST_IRRADIANCE == 0
+                && !(skip && r.flags & FLAG_RECT_TEXTURE != 0 && r.flags & FLAG_IES == 0)
+        })
+    }
+
+    /// Whether some light's irradiance quadrature may run long on the device in a call with
+    /// `light_filter` (an IES-shaped light it integrates, whose kinks multiply a line's pieces,
+    /// or a textured rect, whose texel lines do: GpuContext::lane_stride).
+    pub(super) fn long_quadrature(&self, light_filter: u32) -> bool {
+        self.integrated(light_filter)
+            .any(|r| r.flags & (FLAG_IES | FLAG_RECT_TEXTURE) != 0)
     }
 
     /// The pipeline variant `kernel` needs for these lights: the optional parts some light
     /// needs (`GpuContext::pipeline` drops those the kernel's source lacks). The irradiance
-    /// kernel needs the IES lookup only for IES-shaped lights it integrates, and its TEXTURE
-    /// part (the row integral of a textured latlong dome, irradiance/latlong_rows.wgsl; a
-    /// textured rect's texture factor, irradiance/line.wgsl) only for the textured domes and
-    /// rects it integrates (not those whose irradiance is the host's,
-    /// prepare::Prepared::irradiance_on_host).
-    pub(super) fn variant(&self, kernel: Kernel) -> Features {
-        let mut f = self.features;
+    /// kernel needs only those of the lights it integrates in a call with `light_filter`
+    /// ([`GpuLights::integrated`]): the IES lookup for IES-shaped ones, its TEXTURE part (the
+    /// row integral of a textured latlong dome, irradiance/latlong_rows.wgsl; a textured
+    /// rect's texture factor, irradiance/line.wgsl) for textured ones, the chart quadrature
+    /// for those that take it; so a scene whose textured rects a call leaves to the host
+    /// compiles none of it for them.
+    pub(super) fn variant(&self, kernel: Kernel, light_filter: u32) -> Features {
         if kernel == Kernel::Irradiance {
-            f.ies = self.irradiance_ies;
-            f.texture = self.irradiance_texture;
+            self.integrated(light_filter)
+                .fold(Features::default(), |f, r| f.union(r.features()))
+        } else {
+            self.features
         }
-        f
     }
 }
 
@@ -287,18 +295,6 @@ impl GpuContext {
             features: records
                 .iter()
                 .fold(Features::default(), |f, r| f.union(r.features())),
-            irradiance_ies: records.iter().any(|r| {
-                r.flags & super::record::FLAG_IES != 0
-                    && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
-            }),
-            irradiance_texture: records.iter().any(|r| {
-                r.flags & (super::record::FLAG_DOME_TEXTURE | super::record::FLAG_RECT_TEXTURE) != 0
-                    && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
-            }),
-            irradiance_rect_texture: records.iter().any(|r| {
-                r.flags & super::record::FLAG_RECT_TEXTURE != 0
-                    && r.flags & super::record::FLAG_HOST_IRRADIANCE == 0
-            }),
             pending_rows: std::sync::Mutex::new(tex_atlas.rows.clone()),
         }))
     }
@@ -326,7 +322,7 @@ impl GpuContext {
         if n == 0 || count == 0 {
             return Ok(out);
         }
-        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
+        let pipeline = self.pipeline(kernel, lights.variant(kernel, light_filter))?;
         if kernel == Kernel::Irradiance {
             lights.write_row_tables(&self.device, &self.queue)?;
         }
@@ -343,7 +339,7 @@ impl GpuContext {
             *scratch = Some(self.scratch(key, lights));
         }
         let s = scratch.as_ref().expect("set above");
-        let lane_stride = self.lane_stride(kernel, lights);
+        let lane_stride = self.lane_stride(kernel, lights, light_filter);
         let result = self.run_chunks(
             &pipeline,
             kernel,

@@ -529,8 +529,11 @@ impl GpuContext {
     /// quadrature may be long (an IES profile's kinks multiply a line's pieces) runs one sample
     /// per [`LLVMPIPE_SHARED_LANES`] invocations so that each has the budget to itself.
     /// Elsewhere: 1.
-    pub(crate) fn lane_stride(&self, kernel: Kernel, lights: &GpuLights) -> u32 {
-        if self.is_llvmpipe() && kernel == Kernel::Irradiance && lights.long_quadrature() {
+    pub(crate) fn lane_stride(&self, kernel: Kernel, lights: &GpuLights, light_filter: u32) -> u32 {
+        if self.is_llvmpipe()
+            && kernel == Kernel::Irradiance
+            && lights.long_quadrature(light_filter)
+        {
             LLVMPIPE_SHARED_LANES
         } else {
             1

@@ -133,7 +133,7 @@ impl GpuContext {
         }
         let max_groups = self.limits.max_compute_workgroups_per_dimension.max(1);
         let wg = count.div_ceil(WORKGROUP_SIZE);
-        let lane_stride = self.lane_stride(kernel, lights);
+        let lane_stride = self.lane_stride(kernel, lights, super::record::LIGHTS_ALL);
         // Several rows per invocation (emission, intensity, radiance on a hardware adapter):
         // ⌈count / r⌉ invocations (shaders/shared/record.wgsl, `row_step`).
         let shape = super::RowShape {
@@ -360,7 +360,11 @@ impl GpuContext {
         grid: (u32, u32),
         rows: super::RowShape,
     ) -> Result<()> {
-        let pipeline = self.pipeline_with_rows(kernel, lights.variant(kernel), rows)?;
+        let pipeline = self.pipeline_with_rows(
+            kernel,
+            lights.variant(kernel, super::record::LIGHTS_ALL),
+            rows,
+        )?;
         if kernel == Kernel::Irradiance {
             lights.write_row_tables(&self.device, &self.queue)?;
         }

@@ -250,7 +250,7 @@ impl GpuContext {
         if n == 0 {
             return Ok(out);
         }
-        let pipeline = self.pipeline(kernel, lights.variant(kernel))?;
+        let pipeline = self.pipeline(kernel, lights.variant(kernel, super::record::LIGHTS_ALL))?;
         // The widest buffer holds 28 bytes a row; chunk_capacity counts 12.
         let chunk = (self.chunk_capacity(1, false) * 12 / 28).max(1).min(n);
         let dev = &self.device;
