@@ -163,8 +163,9 @@ pub(super) fn masked(
 /// BENCHMARKS.md "Small textured rects' irradiance on the device"). So host-path calls at such
 /// tolerances take textured rects without an IES profile from the CPU (`query::scene`
 /// `host_takes`), and the device integrates them in GPU-resident calls (which have no host step,
-/// and would refuse them otherwise) and at tighter tolerances (where the CPU also splits at
-/// every texel line). Past 64 × 64 the split would cost a receiver ~2·10⁶ evaluations or more:
+/// and would refuse them otherwise) and at the reference's tolerance (a GPU evaluator given
+/// none, the only one tighter than 1e-4 it takes; the CPU's path there splits at every texel
+/// line too). Past 64 × 64 the split would cost a receiver ~2·10⁶ evaluations or more:
 /// such textures stay on the host until a kernel of the moment path exists.
 pub const RECT_TEXELS_ON_DEVICE: usize = 64 * 64;
 

@@ -253,8 +253,8 @@ impl PreparedScene {
 /// where the CPU's moment path takes them (`rect_fast::applies`, at a tolerance of 1e-4 or
 /// looser): its cost per receiver does not grow with the texels, the kernel's split at every
 /// texel line does (BENCHMARKS.md "Small textured rects' irradiance on the device"). The
-/// GPU-resident call, which has no host step, and calls at tighter tolerances (where the CPU
-/// splits at every texel line too) integrate them on the device. The kernel's
+/// GPU-resident call, which has no host step, and calls at the reference's tolerance (where
+/// the CPU splits at every texel line too) integrate them on the device. The kernel's
 /// `LIGHTS_SKIP_TEXTURED_RECTS` test (FLAG_RECT_TEXTURE without FLAG_IES) is
 /// `rect_fast::applies`.
 fn host_takes(p: &Prepared, rule: &Adaptive) -> bool {
