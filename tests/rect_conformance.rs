@@ -52,13 +52,15 @@ fn transforms() -> [DMat4; 4] {
     ]
 }
 
-fn rects(rng: &mut Rng) -> Vec<(Light, DMat4)> {
+/// Textured rects of the given texture sizes (one generated texture each) under every transform
+/// of [`transforms`], shaped by cone, softness and focus on every other one.
+fn rects(rng: &mut Rng, sizes: &[(u32, u32)]) -> Vec<(Light, DMat4)> {
     let mut out = Vec::new();
-    for (k, (w, h)) in SIZES.into_iter().enumerate() {
+    for (k, &(w, h)) in sizes.iter().enumerate() {
         let file = png(w, h, rng);
         for (j, m) in transforms().into_iter().enumerate() {
             let mut l = Light::rect(1.0 + 0.3 * k as f64, 0.6 + 0.2 * j as f64)
-                .with_path(format!("/Rect_{k}_{j}"))
+                .with_path(format!("/Rect_{w}x{h}_{j}"))
                 .with_intensity(1.5 + j as f64)
                 .with_transform(m)
                 .with_texture(Texture::new(file.clone()));
@@ -94,7 +96,7 @@ fn gpu_matches_cpu_on_textured_rects() {
     let Some(gpu) = common::gpu() else { return };
     let cpu = Evaluator::cpu();
     let mut rng = Rng::new(0x4EC7);
-    let lights = rects(&mut rng);
+    let lights = rects(&mut rng, &SIZES);
     let models: Vec<Light> = lights.iter().map(|(l, _)| l.clone()).collect();
     let n = 800;
     let mut total = 0usize;
@@ -220,27 +222,10 @@ const IRRADIANCE_SIZES: [(u32, u32); 4] = [(1, 1), (2, 3), (3, 2), (4, 4)];
 fn gpu_irradiance_of_small_textured_rects_matches_the_reference() {
     let Some(gpu) = common::gpu() else { return };
     let mut rng = Rng::new(0x1EE7);
-    let mut lights = Vec::new();
-    for (k, (w, h)) in IRRADIANCE_SIZES.into_iter().enumerate() {
-        let file = png(w, h, &mut rng);
-        for (j, m) in transforms().into_iter().enumerate() {
-            let mut l = Light::rect(1.0 + 0.3 * k as f64, 0.6 + 0.2 * j as f64)
-                .with_path(format!("/Rect_{w}x{h}_{j}"))
-                .with_intensity(1.5 + j as f64)
-                .with_transform(m)
-                .with_texture(Texture::new(file.clone()));
-            if (k + j) % 2 == 1 {
-                l = l.with_shaping(Shaping {
-                    focus: 1.5,
-                    focus_tint: DVec3::new(0.2, 0.5, 1.0),
-                    cone_angle: 70.0,
-                    cone_softness: 0.5,
-                    ies: None,
-                });
-            }
-            lights.push(l);
-        }
-    }
+    let mut lights: Vec<Light> = rects(&mut rng, &IRRADIANCE_SIZES)
+        .into_iter()
+        .map(|(l, _)| l)
+        .collect();
     // IES-shaped (continuous profiles of types C and A: their grid lines split the lines too,
     // streamed beside the texture's).
     let file = png(3, 2, &mut rng);

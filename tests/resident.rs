@@ -523,6 +523,41 @@ fn assert_resident_irradiance_is_the_host_paths(
     }
 }
 
+/// `encode_irradiance` over `pts` and `normals` refuses `scene` with
+/// [`LuxError::NotOnDevice`] naming `light`, its reason containing `why`.
+fn assert_irradiance_refused(
+    r: &Renderer,
+    scene: &luxeval::PreparedScene,
+    pts: &[[f32; 3]],
+    normals: &[[f32; 3]],
+    light: &str,
+    why: &str,
+) {
+    let n = pts.len();
+    let pts_buf = r.buffer(pts, wgpu::BufferUsages::STORAGE);
+    let nrm_buf = r.buffer(normals, wgpu::BufferUsages::STORAGE);
+    let out = r.output(n);
+    let mut enc = r.encoder();
+    match scene.encode_irradiance(
+        &mut enc,
+        &pts_buf,
+        &nrm_buf,
+        &out,
+        n as u32,
+        Accumulate::Sum,
+    ) {
+        Err(LuxError::NotOnDevice {
+            light: named,
+            reason,
+            ..
+        }) => {
+            assert_eq!(named, light);
+            assert!(reason.contains(why), "{reason}");
+        }
+        other => panic!("expected NotOnDevice, got {other:?}"),
+    }
+}
+
 /// `img` encoded as a PNG texture named `name` (in memory).
 fn png_texture(name: &str, img: &image::RgbImage) -> Texture {
     let mut bytes = std::io::Cursor::new(Vec::new());
@@ -557,28 +592,11 @@ fn small_textured_rect_irradiance_is_resident() {
     let pts = points(&mut rng, n);
     let normals = unit_rows(&mut rng, n);
     assert_resident_irradiance_is_the_host_paths(&r, &scene, &pts, &normals);
-    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
-    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
     lights[2] = Light::rect(2.0, 1.0)
         .with_path("/Large")
         .with_texture(png(65, 64, &mut rng));
     let scene = eval.prepare(&lights).unwrap();
-    let out = r.output(n);
-    let mut enc = r.encoder();
-    match scene.encode_irradiance(
-        &mut enc,
-        &pts_buf,
-        &nrm_buf,
-        &out,
-        n as u32,
-        Accumulate::Sum,
-    ) {
-        Err(LuxError::NotOnDevice { light, reason, .. }) => {
-            assert_eq!(light, "/Large");
-            assert!(reason.contains("texels"), "{reason}");
-        }
-        other => panic!("expected NotOnDevice, got {other:?}"),
-    }
+    assert_irradiance_refused(&r, &scene, &pts, &normals, "/Large", "texels");
 }
 
 /// A textured latlong dome's irradiance is the kernel's (irradiance/latlong_rows.wgsl), so the
@@ -607,8 +625,6 @@ fn textured_latlong_dome_irradiance_is_resident() {
     let pts = points(&mut rng, n);
     let normals = unit_rows(&mut rng, n);
     assert_resident_irradiance_is_the_host_paths(&r, &scene, &pts, &normals);
-    let pts_buf = r.buffer(&pts, wgpu::BufferUsages::STORAGE);
-    let nrm_buf = r.buffer(&normals, wgpu::BufferUsages::STORAGE);
     lights[2] = Light::dome().with_path("/Ball").with_texture(png(
         TextureFormat::MirroredBall,
         16,
@@ -616,22 +632,7 @@ fn textured_latlong_dome_irradiance_is_resident() {
         &mut rng,
     ));
     let scene = eval.prepare(&lights).unwrap();
-    let out = r.output(n);
-    let mut enc = r.encoder();
-    match scene.encode_irradiance(
-        &mut enc,
-        &pts_buf,
-        &nrm_buf,
-        &out,
-        n as u32,
-        Accumulate::Sum,
-    ) {
-        Err(LuxError::NotOnDevice { light, reason, .. }) => {
-            assert_eq!(light, "/Ball");
-            assert!(reason.contains("latlong"), "{reason}");
-        }
-        other => panic!("expected NotOnDevice, got {other:?}"),
-    }
+    assert_irradiance_refused(&r, &scene, &pts, &normals, "/Ball", "latlong");
 }
 
 #[test]
