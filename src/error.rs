@@ -100,6 +100,11 @@ pub enum LuxError {
         source: Box<AssetError>,
     },
 
+    /// The caller gave up reading a stage ([`crate::Stage::load_with_progress`]'s `progress`
+    /// returned `Break`).
+    #[error("{}: reading the stage was cancelled", path.display())]
+    Cancelled { path: PathBuf },
+
     /// A file's content is malformed or unsupported.
     #[error("{}{}: {reason}", path.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
     Format {

@@ -97,7 +97,8 @@ pub use query::{lights_json, portal_multiplier};
 pub use synthetic::{Rng, synthetic_lights, synthetic_mesh_light, torus_rays};
 #[cfg(feature = "usd")]
 pub use usd::{
-    LightList, LinkCollection, RefusedInput, Stage, StageInfo, StageLight, TimeRule, UsdStage,
+    LightList, LinkCollection, LoadProgress, RefusedInput, Stage, StageInfo, StageLight, TimeRule,
+    UsdStage,
 };
 /// The wgpu luxeval is built with: GPU-resident callers ([`Evaluator::from_wgpu`],
 /// [`PreparedScene::encode_emission`]) create their device and buffers with this one, so that

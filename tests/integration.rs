@@ -44,6 +44,7 @@ mod robustness;
 mod sample_conformance;
 mod sample_resident;
 mod sampling;
+mod stage_progress;
 mod tolerance;
 mod twins;
 mod usd_fixtures;

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use indicatif::ProgressDrawTarget;
 use luxeval::{Evaluator, Light, LuxError, PreparedScene, Stage};
 
 use crate::args::{DeviceArg, SceneArgs, ToleranceArg};
@@ -40,9 +41,32 @@ fn lights_and_layers(args: &SceneArgs) -> CliResult<(Vec<Light>, Vec<PathBuf>)> 
 }
 
 /// Loads the stage; an error about a light's attribute or transform is prefixed with the stage's
-/// path (file errors already name their file).
+/// path (file errors already name their file). A load that takes longer than half a second
+/// says on a terminal's stderr which step it is at (`Stage::load_with_progress`), and clears
+/// the line when done.
 pub fn load(path: &std::path::Path, time: Option<f64>) -> CliResult<Stage> {
-    Stage::load(path, time).map_err(|e| match e {
+    let start = std::time::Instant::now();
+    // Hidden until the load has taken half a second: most stages read in milliseconds, and a
+    // line flashed on every command would be noise. indicatif draws nothing where stderr is
+    // not a terminal.
+    let bar = indicatif::ProgressBar::with_draw_target(None, ProgressDrawTarget::hidden());
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+            .expect("static template"),
+    );
+    let mut shown = false;
+    let stage = Stage::load_with_progress(path, time, |p| {
+        if !shown && start.elapsed() >= std::time::Duration::from_millis(500) {
+            shown = true;
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+            // openusd's parse and composition report nothing for seconds on big stages.
+            bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        }
+        bar.set_message(format!("reading {}: {p}", path.display()));
+        std::ops::ControlFlow::Continue(())
+    });
+    bar.finish_and_clear();
+    stage.map_err(|e| match e {
         LuxError::InvalidAttribute { .. } | LuxError::InvalidTransform { .. } => in_scene(path, e),
         e => e.into(),
     })

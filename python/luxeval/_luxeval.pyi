@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from typing import Any, Literal, Optional, Sequence, Union
+from typing import Any, Callable, Literal, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -39,15 +39,27 @@ def device_name(device: Device = "auto") -> str:
 class Stage:
     """A USD stage (.usda, .usdc, .usdz) and its lights, read once at one time.
 
-    ``Stage(path, time=None)`` reads the lights at ``time`` (a USD time code); without one, at
-    the stage's ``startTimeCode`` when authored, else at each attribute's earliest time sample.
+    ``Stage(path, time=None, progress=None)`` reads the lights at ``time`` (a USD time code);
+    without one, at the stage's ``startTimeCode`` when authored, else at each attribute's
+    earliest time sample. ``progress(step, done, total)``, when given, is called while the stage
+    is read (``step``: ``"opening"``, ``"checking"``, ``"composing"``, ``"finding"``,
+    ``"reading"``; ``done``/``total`` item counts or ``None``), at each step's ends, every 1,024
+    items and every quarter second; an exception it raises stops the reading and propagates.
+    Ctrl-C stops a long read with ``KeyboardInterrupt``.
     Raises ``InputError`` when the file is missing, unreadable or malformed (naming the file and
     line or prim). Queries take any real dtype in C or Fortran order (C-contiguous float32 is
     used without a copy) and return ``numpy.float32`` arrays (``sample``: a dict of arrays); the lights are prepared once per
     (lights, device, temperature_mode, texture_filter, portal_mode) and reused. Picklable: unpickling opens the stage again.
     """
 
-    def __init__(self, path: Union[str, os.PathLike[str]], time: Optional[float] = None) -> None: ...
+    def __init__(
+        self,
+        path: Union[str, os.PathLike[str]],
+        time: Optional[float] = None,
+        progress: Optional[
+            Callable[[Literal["opening", "checking", "composing", "finding", "reading"], Optional[int], Optional[int]], object]
+        ] = None,
+    ) -> None: ...
     @property
     def path(self) -> str:
         """The stage's path, as given."""

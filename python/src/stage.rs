@@ -1,13 +1,15 @@
 //! `luxeval.Stage`: a USD stage's lights read once, queried any number of times.
 
 use std::collections::HashMap;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
 use luxeval::{
-    Accumulate, PreparedScene, SampleOptions, Stage as ReadStage, TemperatureMode, TextureFilter,
-    TimeRule,
+    Accumulate, LoadProgress, PreparedScene, SampleOptions, Stage as ReadStage, TemperatureMode,
+    TextureFilter, TimeRule,
 };
+use pyo3::exceptions::PyTypeError;
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple, PyType};
@@ -22,10 +24,18 @@ mod sampling;
 
 /// A USD stage (``.usda``, ``.usdc``, ``.usdz``) and its lights, read once at one time.
 ///
-/// ``Stage(path, time=None)`` opens the stage with every composition arc and payload loaded and
-/// reads its lights at ``time`` (a USD time code); without one, at the stage's ``startTimeCode``
-/// when it is authored, else at each attribute's earliest time sample (USD's EarliestTime), as
-/// ``luxeval lights`` does.
+/// ``Stage(path, time=None, progress=None)`` opens the stage with every composition arc and
+/// payload loaded and reads its lights at ``time`` (a USD time code); without one, at the stage's
+/// ``startTimeCode`` when it is authored, else at each attribute's earliest time sample (USD's
+/// EarliestTime), as ``luxeval lights`` does. ``progress``, when given, is called as
+/// ``progress(step, done, total)`` while a stage is read: ``step`` is ``"opening"``,
+/// ``"checking"`` (every layer the root reaches), ``"composing"`` (``done`` prims found so far,
+/// ``total`` None), ``"finding"`` (``done`` of ``total`` prims asked whether they are lights)
+/// or ``"reading"`` (``done`` of ``total`` lights read), at each step's start and end, every
+/// 1,024 items and, while nothing new comes, every quarter second again; an exception it raises
+/// stops the reading and is raised by ``Stage``. Ctrl-C stops it with ``KeyboardInterrupt``, with
+/// or without ``progress`` (openusd's parse and composition run on to their end in the
+/// background first, then the reading thread stops).
 ///
 /// The queries (``emission``, ``radiance``, ``irradiance``, ``falloff``, ``sample``, ``pdf``)
 /// take NumPy arrays (any real dtype, C or Fortran order; C-contiguous float32 is used without a
@@ -82,17 +92,56 @@ impl Stage {
 #[pymethods]
 impl Stage {
     #[new]
-    #[pyo3(signature = (path, time = None))]
-    fn new(py: Python<'_>, path: PathBuf, time: Option<f64>) -> PyResult<Stage> {
+    #[pyo3(signature = (path, time = None, progress = None))]
+    fn new(
+        py: Python<'_>,
+        path: PathBuf,
+        time: Option<f64>,
+        progress: Option<Py<PyAny>>,
+    ) -> PyResult<Stage> {
         if let Some(t) = time.filter(|t| !t.is_finite()) {
             return Err(errors::input(format!(
                 "time: {t} is not a finite time code"
             )));
         }
+        if let Some(p) = &progress
+            && !p.bind(py).is_callable()
+        {
+            return Err(PyTypeError::new_err("progress: must be callable or None"));
+        }
         let absolute = std::path::absolute(&path).unwrap_or_else(|_| path.clone());
-        let scene = py.detach(|| {
-            no_panic(|| ReadStage::load(&path, time).map_err(|e| errors::lux(e, None)))
+        // The stage is read on a thread of the library's own; this thread, the GIL released,
+        // is told each step (and the last one again every quarter second), runs `progress`
+        // and Python's signal handlers, and gives up on the first exception either raises
+        // (KeyboardInterrupt included), which is then raised here.
+        let mut raised: Option<PyErr> = None;
+        let loaded = py.detach(|| {
+            no_panic(|| {
+                Ok(ReadStage::load_with_progress(&path, time, |p| {
+                    Python::attach(|py| {
+                        let r = py.check_signals().and_then(|()| match &progress {
+                            Some(f) => {
+                                let (step, done, total) = progress_args(p);
+                                f.call1(py, (step, done, total)).map(drop)
+                            }
+                            None => Ok(()),
+                        });
+                        match r {
+                            Ok(()) => ControlFlow::Continue(()),
+                            Err(e) => {
+                                raised = Some(e);
+                                ControlFlow::Break(())
+                            }
+                        }
+                    })
+                }))
+            })
         })?;
+        let scene = match (loaded, raised) {
+            (_, Some(e)) => return Err(e),
+            (Ok(scene), None) => scene,
+            (Err(e), None) => return Err(errors::lux(e, None)),
+        };
         let lights_json = luxeval::lights_json(&scene, luxeval::PortalMode::Hint)
             .map(|v| v.to_string())
             .map_err(|e| errors::DeviceError::new_err(format!("serialising the lights: {e}")))?;
@@ -586,4 +635,18 @@ fn paired(a_name: &str, a: usize, b_name: &str, b: usize) -> PyResult<()> {
         )));
     }
     Ok(())
+}
+
+/// `progress`'s arguments for one report: the step's name, the items done (prims found while
+/// composing) and their total, `None` where a step has none.
+fn progress_args(p: LoadProgress) -> (&'static str, Option<u64>, Option<u64>) {
+    match p {
+        LoadProgress::Opening => ("opening", None, None),
+        LoadProgress::Checking => ("checking", None, None),
+        LoadProgress::Traversing { prims } => ("composing", Some(prims), None),
+        LoadProgress::Finding { done, total } => ("finding", Some(done), Some(total)),
+        LoadProgress::Reading { done, total } => ("reading", Some(done), Some(total)),
+        // A step a later library adds, without counts.
+        _ => ("working", None, None),
+    }
 }

@@ -25,6 +25,7 @@ mod diagnostics;
 mod light;
 mod mesh;
 mod portals;
+mod progress;
 mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;
@@ -34,6 +35,7 @@ mod values;
 mod xform;
 
 pub use light::RefusedInput;
+pub use progress::LoadProgress;
 pub use scene::{Stage, StageLight, TimeRule};
 pub use stage::{StageInfo, UsdStage};
 pub use unapplied::{LightList, LinkCollection};

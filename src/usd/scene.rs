@@ -6,11 +6,16 @@
 //! which time the stage is read at (DESIGN.md §2 "Query time").
 //! The conversion of each light prim into a model light is [`super::light`]'s.
 
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+use std::sync::mpsc::RecvTimeoutError;
 
 use serde::Serialize;
 
 use super::light::{NotEvaluated, Read, RefusedInput, read};
+use super::progress::{LoadProgress, Reporter, Stopped, relay};
 use super::stage::{self as usd, UsdStage};
 use super::unapplied::{LightList, LinkCollection};
 use crate::error::{LuxError, Result};
@@ -135,9 +140,30 @@ impl Stage {
     pub fn load(path: &Path, time: Option<f64>) -> Result<Stage> {
         check_time(time)?;
         let owned = path.to_path_buf();
-        on_large_stack(path, move || {
-            let usd = UsdStage::open(&owned)?;
-            let stage = usd.read(time)?;
+        on_large_stack(path, None, move |report| {
+            let usd = UsdStage::open_reporting(&owned, report)?;
+            let stage = usd.read_reporting(time, report)?;
+            Ok((stage, usd))
+        })
+    }
+
+    /// [`Stage::load`], telling `progress` where the reading has got to ([`LoadProgress`]: a
+    /// step's start and end, and every 1,024 prims or lights within it; while none comes for a
+    /// quarter of a second, the last one again). `progress` runs on the
+    /// calling thread while the stage is read on its own; returning `Break` gives up: the call
+    /// returns [`LuxError::Cancelled`] at once, and the reading thread stops at its next report
+    /// (openusd's composition of the stage cannot be interrupted, so a stop asked for while
+    /// the stage is being composed frees its memory only once that is done).
+    pub fn load_with_progress(
+        path: &Path,
+        time: Option<f64>,
+        mut progress: impl FnMut(LoadProgress) -> ControlFlow<()>,
+    ) -> Result<Stage> {
+        check_time(time)?;
+        let owned = path.to_path_buf();
+        on_large_stack(path, Some(&mut progress), move |report| {
+            let usd = UsdStage::open_reporting(&owned, report)?;
+            let stage = usd.read_reporting(time, report)?;
             Ok((stage, usd))
         })
     }
@@ -288,6 +314,11 @@ impl UsdStage {
     /// The stage's lights at `time`; without one, at its `startTimeCode` when authored, else at
     /// USD's EarliestTime (DESIGN.md §2 "Query time").
     pub fn read(&self, time: Option<f64>) -> Result<Stage> {
+        self.read_reporting(time, &mut Reporter::silent())
+    }
+
+    /// [`UsdStage::read`], reporting each light read to `report`.
+    fn read_reporting(&self, time: Option<f64>, report: &mut Reporter) -> Result<Stage> {
         check_time(time)?;
         let rule = match time {
             Some(t) => TimeRule::Given(t),
@@ -296,11 +327,15 @@ impl UsdStage {
                 None => TimeRule::Earliest,
             },
         };
-        self.read_at(rule)
+        self.read_at_reporting(rule, report)
     }
 
     /// The stage's lights read as `rule` says.
     pub fn read_at(&self, rule: TimeRule) -> Result<Stage> {
+        self.read_at_reporting(rule, &mut Reporter::silent())
+    }
+
+    fn read_at_reporting(&self, rule: TimeRule, report: &mut Reporter) -> Result<Stage> {
         let at = match rule {
             TimeRule::Given(t) | TimeRule::StartTimeCode(t) => {
                 check_time(Some(t))?;
@@ -316,10 +351,14 @@ impl UsdStage {
         };
         let max_mesh_triangles = self.limits().max_mesh_triangles;
         let mut lights: Vec<StageLight> = self
-            .lights_at(at)?
+            .lights_at(at, report)?
             .into_iter()
             .map(|p| StageLight::from_prim(p, up, max_mesh_triangles))
             .collect();
+        let total = lights.len() as u64;
+        report
+            .report(LoadProgress::Reading { done: total, total })
+            .map_err(|Stopped| usd::cancelled(self.file()))?;
         super::portals::attach(&mut lights);
         Ok(Stage {
             file: self.file().to_path_buf(),
@@ -355,28 +394,76 @@ pub const STACK_BYTES: usize = 512 << 20;
 /// never abort the process.
 fn on_large_stack<T: Send + 'static, L>(
     path: &Path,
-    f: impl FnOnce() -> Result<(T, L)> + Send + 'static,
+    mut progress: Option<&mut dyn FnMut(LoadProgress) -> ControlFlow<()>>,
+    f: impl FnOnce(&mut Reporter) -> Result<(T, L)> + Send + 'static,
 ) -> Result<T> {
-    let (tx, rx) = std::sync::mpsc::sync_channel(1);
+    // Reports are a step's start and end and one every 1,024 items: a few hundred for the
+    // largest stages; a caller slower than the reader holds it back at 64.
+    let (tx, rx) = std::sync::mpsc::sync_channel(64);
+    let stop = Arc::new(AtomicBool::new(false));
+    let mut reporter = match progress {
+        Some(_) => {
+            let tx = tx.clone();
+            Reporter::new(
+                move |p| {
+                    // The receiver is gone once the caller gave up: nothing is left to tell.
+                    let _ = tx.send(Message::Progress(p));
+                },
+                stop.clone(),
+            )
+        }
+        None => Reporter::silent(),
+    };
     let handle = std::thread::Builder::new()
         .name("luxeval-stage".into())
         .stack_size(STACK_BYTES)
-        .spawn(move || match f() {
+        .spawn(move || match f(&mut reporter) {
             Ok((value, rest)) => {
-                // The receiver is gone only if the caller panicked; nothing is left to tell.
-                let _ = tx.send(Ok(value));
+                // The receiver is gone only if the caller panicked or gave up; nothing is
+                // left to tell.
+                let _ = tx.send(Message::Done(Ok(value)));
+                drop(reporter);
                 drop(rest);
             }
             Err(e) => {
-                let _ = tx.send(Err(e));
+                let _ = tx.send(Message::Done(Err(e)));
             }
         });
-    match handle {
-        Ok(h) => match rx.recv() {
-            Ok(r) => r,
-            // No answer: the thread panicked (its sender dropped while unwinding).
-            Err(_) => {
-                let panic = match h.join() {
+    let handle = match handle {
+        Ok(h) => h,
+        // No thread (out of memory or address space).
+        Err(_) => {
+            return Err(LuxError::input(
+                "stage",
+                "cannot start the thread that reads the stage (out of memory?)",
+            ));
+        }
+    };
+    // The last report, repeated to `progress` while the reader is silent (openusd parsing or
+    // composing), so that a display stays alive and a caller can give up meanwhile.
+    let mut last = LoadProgress::Opening;
+    loop {
+        let message = match progress {
+            Some(_) => match rx.recv_timeout(HEARTBEAT) {
+                Err(RecvTimeoutError::Timeout) => Ok(Message::Progress(last)),
+                Err(RecvTimeoutError::Disconnected) => Err(()),
+                Ok(m) => Ok(m),
+            },
+            None => rx.recv().map_err(|_| ()),
+        };
+        match message {
+            Ok(Message::Progress(p)) => {
+                last = p;
+                if let Some(progress) = progress.as_deref_mut()
+                    && relay(progress, p, &stop).is_break()
+                {
+                    return Err(usd::cancelled(path));
+                }
+            }
+            Ok(Message::Done(r)) => return r,
+            // No answer: the thread panicked (its senders dropped while unwinding).
+            Err(()) => {
+                let panic = match handle.join() {
                     Err(panic) => panic,
                     Ok(()) => Box::new("the reading thread ended without an answer"),
                 };
@@ -385,18 +472,23 @@ fn on_large_stack<T: Send + 'static, L>(
                     .map(String::as_str)
                     .or_else(|| panic.downcast_ref::<&str>().copied())
                     .unwrap_or("no message");
-                Err(LuxError::input(
+                return Err(LuxError::input(
                     path.display().to_string(),
                     format!("the USD reader failed on this file (it panicked: {msg})"),
-                ))
+                ));
             }
-        },
-        // No thread (out of memory or address space).
-        Err(_) => Err(LuxError::input(
-            "stage",
-            "cannot start the thread that reads the stage (out of memory?)",
-        )),
+        }
     }
+}
+
+/// How long the caller of [`Stage::load_with_progress`] waits for a report before it tells
+/// `progress` the last one again.
+const HEARTBEAT: std::time::Duration = std::time::Duration::from_millis(250);
+
+/// What the reading thread sends its caller.
+enum Message<T> {
+    Progress(LoadProgress),
+    Done(Result<T>),
 }
 
 fn check_time(time: Option<f64>) -> Result<()> {

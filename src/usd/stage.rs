@@ -11,6 +11,7 @@ use openusd_schemas::geom::{Xformable, XformableExt};
 use super::arcs::preflight;
 use super::diagnostics::{check_composition, open_error, stage_error};
 use super::mesh::{MeshArrays, read_arrays};
+use super::progress::{LoadProgress, Reporter, Stopped};
 use super::resolver::LimitedResolver;
 use super::unapplied::{self, LightExtras, LightList, ListSite};
 use super::values::{authors, convert, reject_spline, value_at, visible_at};
@@ -19,6 +20,13 @@ use crate::error::{LuxError, Result};
 use crate::limits::{ENV_MAX_FILE_BYTES, Limits, raise_hint};
 use crate::model::schema;
 use crate::model::{Input, Value};
+
+/// The error of a read the caller gave up on ([`Reporter`]).
+pub(super) fn cancelled(path: &Path) -> LuxError {
+    LuxError::Cancelled {
+        path: path.to_path_buf(),
+    }
+}
 
 /// Prim types that are lights.
 pub const LIGHT_TYPES: &[&str] = &[
@@ -159,6 +167,14 @@ impl UsdStage {
     /// that cannot be found, or is in a format luxeval does not read, is left out with a
     /// warning ([`UsdStage::warnings`]), as usd-core leaves it out.
     pub fn open(path: &Path) -> Result<UsdStage> {
+        Self::open_reporting(path, &mut Reporter::silent())
+    }
+
+    /// [`UsdStage::open`], reporting each step to `report` and stopping when it says so
+    /// ([`crate::Stage::load_with_progress`]). openusd's traversal cannot be interrupted: a stop
+    /// asked for while the stage is composed takes effect once it is.
+    pub(crate) fn open_reporting(path: &Path, report: &mut Reporter) -> Result<UsdStage> {
+        let go = |r: std::result::Result<(), Stopped>| r.map_err(|Stopped| cancelled(path));
         // The filesystem's own error (not found, permission denied) is the clearest message.
         let io = |source| LuxError::Io {
             path: path.to_path_buf(),
@@ -199,6 +215,7 @@ impl UsdStage {
             reason: "the path is not valid UTF-8, which openusd requires".into(),
         })?;
         let resolver = LimitedResolver::new(&limits);
+        go(report.report(LoadProgress::Opening))?;
         // Opening reads the root layer stack and composes nothing; the checks of `preflight`
         // run before anything is composed, on the layers the stage has read.
         let stage = ousd::Stage::builder()
@@ -207,6 +224,7 @@ impl UsdStage {
             .load(ousd::InitialLoadSet::LoadAll)
             .open(name)
             .map_err(|e| open_error(path, e))?;
+        go(report.report(LoadProgress::Checking))?;
         preflight(path, &resolver, &limits, &stage)?;
         let e = |e: openusd::Error| stage_error(path, e);
 
@@ -250,9 +268,23 @@ impl UsdStage {
         // Default predicate (active, loaded, defined, non-abstract) as usd-core's Traverse(),
         // descending into instances: a light inside an instanced asset lights the scene too.
         let mut paths = Vec::new();
+        go(report.report(LoadProgress::Traversing { prims: 0 }))?;
+        // The visitor cannot end the traversal: once the caller gives up it only stops
+        // reporting, and the stop is taken below.
+        let mut stopped = Ok(());
         stage
-            .traverse(PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone()))
+            .traverse(PrimPredicate::DEFAULT_PROXIES, |p| {
+                paths.push(p.clone());
+                if stopped.is_ok() {
+                    stopped = report.step(paths.len() as u64, |prims| LoadProgress::Traversing {
+                        prims,
+                    });
+                }
+            })
             .map_err(e)?;
+        go(stopped)?;
+        let total = paths.len() as u64;
+        go(report.report(LoadProgress::Traversing { prims: total }))?;
         let mut warnings = check_composition(path, &stage)?;
 
         let mut lights = Vec::new();
@@ -262,7 +294,9 @@ impl UsdStage {
         // however many lights it holds.
         let mut own_xform_chain_of: HashMap<sdf::Path, bool> = HashMap::new();
         let mut attrs_of: HashMap<(String, Vec<String>), Rc<[schema::SchemaAttr]>> = HashMap::new();
-        for p in paths {
+        go(report.report(LoadProgress::Finding { done: 0, total }))?;
+        for (i, p) in paths.into_iter().enumerate() {
+            go(report.step(i as u64, |done| LoadProgress::Finding { done, total }))?;
             let prim = stage.prim(&p).map_err(|err| e(err.into()))?;
             let usd_type = prim
                 .type_name()
@@ -395,6 +429,7 @@ impl UsdStage {
                 own_xform_chain,
             });
         }
+        go(report.report(LoadProgress::Finding { done: total, total }))?;
         // Reading attributes can compose more (e.g. the prims an inherit arc names).
         for w in check_composition(path, &stage)? {
             if !warnings.contains(&w) {
@@ -445,14 +480,18 @@ impl UsdStage {
         &self.file
     }
 
-    /// Every light prim, in traversal order, resolved at `time`.
-    pub(crate) fn lights_at(&self, time: Time) -> Result<Vec<LightPrim>> {
+    /// Every light prim, in traversal order, resolved at `time`, each reported to `report`.
+    pub(crate) fn lights_at(&self, time: Time, report: &mut Reporter) -> Result<Vec<LightPrim>> {
         let tc = time.code();
         let e = |err: openusd::Error| stage_error(&self.file, err);
+        let go = |r: std::result::Result<(), Stopped>| r.map_err(|Stopped| cancelled(&self.file));
         let mut cache = WorldCache::new(tc);
         let mut visible_of = HashMap::new();
         let mut out = Vec::with_capacity(self.lights.len());
-        for site in &self.lights {
+        let total = self.lights.len() as u64;
+        go(report.report(LoadProgress::Reading { done: 0, total }))?;
+        for (i, site) in self.lights.iter().enumerate() {
+            go(report.step(i as u64, |done| LoadProgress::Reading { done, total }))?;
             let visible =
                 visible_at(&site.prim, site.authors_visibility, tc, &mut visible_of).map_err(e)?;
             let world = match site.own_xform_chain {
@@ -500,6 +539,7 @@ impl UsdStage {
                 portals: site.portals.clone(),
             });
         }
+        // The step's end is reported once the lights are converted (`UsdStage::read_at`).
         Ok(out)
     }
 
