@@ -33,6 +33,13 @@
 //   the host recomputes it on the CPU reference (query::PreparedScene::irradiance).
 // f32: the receiver normal is normalised in irradiance_main (the CPU: in cpu::irradiance_batch);
 //   a zero normal gives 0 on both.
+// f32: the shaping's exact shortcuts (sphere_uniform, uniform_shaping: a shaped sphere or rect
+//   whose shaping is 1 on every direction it is seen in is the unshaped one's closed form, any
+//   shaped light whose shaping is 0 there gives 0) are taken in every call; the CPU takes them
+//   at loose tolerances only (Adaptive::shortcuts: bit for bit, the reference integrates), and
+//   with a margin of 1e-9 rad where the kernel's is 1e-4 rad plus the f32 rounding of the
+//   direction. A shaped rect whose shaping is 1 takes Lambert's formula under the same
+//   conditions as an unshaped one (IRR_LAMBERT_COND), else the quadrature.
 // GPU-only irradiance_main: the kernel's entry point.
 
 // #import shared/record.wgsl
@@ -84,11 +91,18 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             }
         }
         case KIND_SPHERE: {
+            let r = light.size.x * length(light.world_x.xyz);
+            // A shaped sphere whose shaping is 1 (or 0) on every direction it is seen in.
+            var k = -1.0;
+            if has_flag(light, FLAG_SHAPING) && has_flag(light, FLAG_SIMILARITY) {
+                k = sphere_uniform(light, x, r);
+            }
             if has_flag(light, FLAG_TREAT_AS_POINT_OR_LINE) {
                 e = point_irradiance(light, x, n);
             } else if !has_flag(light, FLAG_SHAPING) && has_flag(light, FLAG_SIMILARITY) {
-                let r = light.size.x * length(light.world_x.xyz);
                 e = base * sphere_cap(world_origin(light), r, x, n);
+            } else if k >= 0.0 {
+                e = base * (k * sphere_cap(world_origin(light), r, x, n));
             } else {
                 chart = sphere_chart(light, x);
                 use_chart = true;
@@ -105,10 +119,16 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
                 let lambert = d * d <= IRR_LAMBERT_COND * size * h;
                 // (A textured rect's radiance varies over it: the quadrature.)
                 let plain = !has_flag(light, FLAG_SHAPING) && !has_flag(light, FLAG_RECT_TEXTURE);
-                if plain && lambert && rect_above_horizon(light, x, n) {
+                chart = plane_chart(light, x, light.size.x, light.size.y, REGION_SQUARE);
+                // A shaped rect whose shaping is 1 on every direction it is seen in is the
+                // unshaped one (the shaping's 0 is taken below).
+                var k = -1.0;
+                if !plain && !has_flag(light, FLAG_RECT_TEXTURE) {
+                    k = uniform_shaping(light, direction_cone(chart), x);
+                }
+                if (plain || k == 1.0) && lambert && rect_above_horizon(light, x, n) {
                     e = base * rect_lambert(light, x, n);
                 } else {
-                    chart = plane_chart(light, x, light.size.x, light.size.y, REGION_SQUARE);
                     use_chart = true;
                 }
             }
@@ -138,11 +158,46 @@ fn irradiance(light: Record, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         default: {}
     }
     // #if CHART
-    if use_chart {
+    // A shaped light whose shaping is 0 on every direction it is seen in gives 0.
+    if use_chart && !(has_flag(light, FLAG_SHAPING) && uniform_shaping(light, direction_cone(chart), x) == 0.0) {
         e = base * chart_integral(light, chart, n);
     }
     // #endif
     return e * light.irr.x;
+}
+
+// uniform_shaping for a sphere of world radius r (under a similarity) seen from x: its
+// directions fill the cone of half-angle asin(r/d) around the centre's.
+fn sphere_uniform(light: Record, x: vec3<f32>, r: f32) -> f32 {
+    let w = world_origin(light) - x;
+    let d = length(w);
+    if !(d > r) {
+        return -1.0;
+    }
+    return uniform_shaping(light, vec4<f32>(w / d, asin(r / d)), x);
+}
+
+// The shaping factor when it is exactly 0 or 1 on every emission direction of a light seen from
+// x within `cone` (unit direction toward the light, half-angle; w < 0: none, direction_cone),
+// else -1 (the CPU: None; see the CPU twin for why it is exact). Only the cone: no IES profile,
+// and a focus that changes nothing (focus ≤ 0 or a white tint) for the factor 1.
+fn uniform_shaping(light: Record, cone: vec4<f32>, x: vec3<f32>) -> f32 {
+    if !has_flag(light, FLAG_SHAPING) || has_flag(light, FLAG_IES) || !(cone.w >= 0.0) {
+        return -1.0;
+    }
+    // The margin covers the f32 rounding of the direction (|x|·ε relative to the distance) and
+    // of the angles.
+    let d = length(world_origin(light) - x);
+    let margin = 1e-4 + 1e-6 * (length(x) + length(world_origin(light))) / d;
+    let theta = off_axis_angle(light.axis.xyz, -cone.xyz);
+    if theta - cone.w > light.cone.x + margin {
+        return 0.0;
+    }
+    let focus_inactive = !(light.focus_tint.w > 0.0) || all(light.focus_tint.xyz == vec3<f32>(1.0));
+    if focus_inactive && theta + cone.w + margin < light.cone.y && light.cone.y <= light.cone.x {
+        return 1.0;
+    }
+    return -1.0;
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)

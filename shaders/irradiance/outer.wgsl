@@ -40,6 +40,23 @@ fn outer_pole(c: Chart, y0: f32, y1: f32) -> vec2<f32> {
     return vec2<f32>(y_foot, sqrt(h * h + d * e1l * d * e1l) * e1l / sqrt(vv));
 }
 
+// A cone holding every direction of the chart's region (see the CPU twin): (unit ŵ0, half-angle
+// asin(R/|w0|)), or w = -1 where R is not below |w0|/2 and for a cylinder's region (the CPU
+// bounds that one too; the kernel does not use it).
+fn direction_cone(c: Chart) -> vec4<f32> {
+    var r = -1.0;
+    if c.region == REGION_SQUARE {
+        r = length(c.e1) + length(c.e2);
+    } else if c.region == REGION_DISK {
+        r = sqrt(dot(c.e1, c.e1) + dot(c.e2, c.e2));
+    }
+    let d = length(c.w0);
+    if !(r >= 0.0) || !(r < 0.5 * d) {
+        return vec4<f32>(0.0, 0.0, 0.0, -1.0);
+    }
+    return vec4<f32>(c.w0 / d, asin(r / d));
+}
+
 // The Gauss–Kronrod 7/15 pair on [s0, s1] of one outer span's parameter: (Kronrod value,
 // |Kronrod − Gauss| in the largest channel).
 fn outer_gk(light: Record, c: Chart, n: vec3<f32>, sp: PieceMap, s0: f32, s1: f32) -> vec4<f32> {
