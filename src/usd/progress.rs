@@ -1,5 +1,5 @@
 //! Where reading a stage has got to, for a progress display, and the way a caller stops it
-//! ([`crate::Stage::load_with_progress`]).
+//! ([`super::scene::Stage::load_with_progress`]).
 //!
 //! A big stage takes seconds to read (BENCHMARKS.md "Big stages": 100,000 lights in ~12 s on two
 //! cores, most of it openusd composing), and a stage whose arcs reach many distinct layers far
@@ -58,7 +58,7 @@ pub(crate) struct Reporter {
 }
 
 /// The caller gave up ([`Reporter::step`]); the reader returns it as
-/// [`crate::LuxError::Cancelled`].
+/// [`crate::error::LuxError::Cancelled`].
 #[derive(Debug)]
 pub(crate) struct Stopped;
 

@@ -171,7 +171,7 @@ impl UsdStage {
     }
 
     /// [`UsdStage::open`], reporting each step to `report` and stopping when it says so
-    /// ([`crate::Stage::load_with_progress`]). openusd's traversal cannot be interrupted: a stop
+    /// ([`super::scene::Stage::load_with_progress`]). openusd's traversal cannot be interrupted: a stop
     /// asked for while the stage is composed takes effect once it is.
     pub(crate) fn open_reporting(path: &Path, report: &mut Reporter) -> Result<UsdStage> {
         let go = |r: std::result::Result<(), Stopped>| r.map_err(|Stopped| cancelled(path));
