@@ -26,6 +26,7 @@ mod light;
 mod mesh;
 mod portals;
 mod progress;
+mod reading;
 mod resolver;
 pub(crate) mod scene;
 pub(crate) mod stage;
